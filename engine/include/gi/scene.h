@@ -1,0 +1,134 @@
+// Scene data shared by every loader, the Vulkan renderer and (later) the reference renderer.
+// Plain data, no Vulkan: loaders fill it, Scene::updateWorldTransforms() derives world state.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
+
+namespace gi {
+
+struct Vertex {
+  glm::vec3 position{0.0f};
+  glm::vec3 normal{0.0f, 0.0f, 1.0f};
+  glm::vec2 uv{0.0f};
+};
+
+// One triangle list with one material (a glTF primitive, an OBJ material group).
+struct Mesh {
+  std::string name;
+  std::vector<Vertex> vertices;
+  std::vector<uint32_t> indices;  // triangle list, always 32-bit after loading
+  uint32_t material = 0;
+  std::vector<float> triangleAreas;  // object-space area per triangle (mesh_processing)
+  glm::vec3 boundsMin{0.0f}, boundsMax{0.0f};
+  size_t triangleCount() const { return indices.size() / 3; }
+};
+
+struct Texture {
+  std::string name;
+  int width = 0, height = 0;
+  std::vector<uint8_t> rgba8;  // width*height*4, sRGB-encoded colour
+};
+
+struct Material {
+  std::string name;
+  glm::vec4 baseColor{0.8f, 0.8f, 0.8f, 1.0f};  // linear
+  int baseColorTexture = -1;                     // index into Scene::textures
+  glm::vec3 emission{0.0f};                      // linear radiance added on top of lighting
+  float roughness = 0.8f;
+  float metallic = 0.0f;
+};
+
+struct Camera {
+  std::string name;
+  float yfov = glm::radians(45.0f);  // radians
+  float aspect = 0.0f;               // 0: use the output's aspect
+  float znear = 0.05f;
+  float zfar = 1000.0f;
+};
+
+enum class LightType { Directional, Point, Spot };
+
+struct Light {
+  std::string name;
+  LightType type = LightType::Point;
+  glm::vec3 color{1.0f};
+  float intensity = 1.0f;  // glTF units: lux (directional) or candela (point/spot)
+  float range = 0.0f;      // 0: infinite
+  float innerConeAngle = 0.0f;
+  float outerConeAngle = glm::radians(45.0f);
+  bool castsShadows = true;
+};
+
+struct Node {
+  std::string name;
+  int parent = -1;
+  std::vector<int> children;
+  glm::mat4 local{1.0f};
+  glm::mat4 world{1.0f};    // derived by Scene::updateWorldTransforms()
+  std::vector<int> meshes;  // indices into Scene::meshes
+  int camera = -1;          // index into Scene::cameras
+  int light = -1;           // index into Scene::lights
+};
+
+// Procedural sky (default) lights the scene's ambient term and the background.
+struct Environment {
+  enum class Kind { Sky, Constant } kind = Kind::Sky;
+  glm::vec3 zenithColor{0.25f, 0.45f, 0.85f};
+  glm::vec3 horizonColor{0.85f, 0.9f, 1.0f};
+  glm::vec3 groundColor{0.3f, 0.27f, 0.25f};
+  glm::vec3 constantColor{1.0f};
+  float intensity = 1.0f;
+};
+
+// An effect the scene asks for, with optional setting overrides (given meaning by the effect
+// registry; the scene only carries them).
+struct EffectRequest {
+  std::string name;
+  nlohmann::json settings = nlohmann::json::object();
+};
+
+struct Scene {
+  std::string sourcePath;  // file it came from ("default" for the built-in scene)
+  std::vector<Mesh> meshes;
+  std::vector<Material> materials;  // never empty after loading (a default material is added)
+  std::vector<Texture> textures;
+  std::vector<Camera> cameras;
+  std::vector<Light> lights;
+  std::vector<Node> nodes;
+  std::vector<int> roots;       // top-level nodes
+  int activeCameraNode = -1;    // node carrying the camera used for rendering, -1: frame bounds
+  Environment environment;
+  std::vector<EffectRequest> effects;
+  std::vector<std::string> warnings;  // things sanitised while loading (e.g. recomputed normals)
+
+  // Recompute Node::world from Node::local down the hierarchy.
+  void updateWorldTransforms();
+  // World-space bounds of all mesh instances (after updateWorldTransforms).
+  void worldBounds(glm::vec3& outMin, glm::vec3& outMax) const;
+  size_t triangleCount() const;  // sum over meshes (each mesh counted once)
+  // Add a node at the root with the given transform; returns its index.
+  int addNode(const std::string& name, const glm::mat4& local, int parent = -1);
+};
+
+// A camera ready for rendering: view and projection matrices (reverse-Z), derived from a node
+// or by framing the scene bounds.
+struct CameraView {
+  glm::mat4 view{1.0f};
+  glm::mat4 proj{1.0f};  // reverse-Z: depth 1 at znear, 0 at zfar
+  glm::vec3 position{0.0f};
+  float znear = 0.05f, zfar = 1000.0f, yfov = glm::radians(45.0f);
+};
+
+// Reverse-Z perspective projection (Vulkan clip space, depth 1 at near, 0 at far).
+glm::mat4 perspectiveReverseZ(float yfov, float aspect, float znear, float zfar);
+CameraView cameraFromNode(const Scene& scene, int node, float aspect);
+CameraView cameraFramingBounds(const glm::vec3& bmin, const glm::vec3& bmax, float aspect);
+CameraView activeCamera(const Scene& scene, float aspect);
+
+}  // namespace gi
