@@ -1,0 +1,180 @@
+// gi-render: headless command-line renderer. Renders a scene (JSON scene, model file or the
+// built-in default) and writes the image; --timings prints the median GPU time of each pass.
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "gi/errors.h"
+#include "gi/image_io.h"
+#include "gi/renderer.h"
+#include "gi/scene_io.h"
+#include "gi/vk/context.h"
+
+namespace {
+
+const char* kUsage =
+    "usage: gi-render --scene FILE|default --out IMAGE.png|IMAGE.pfm [options]\n"
+    "  --width W --height H   image size (default 640x480)\n"
+    "  --frames N             frames to render; timings are medians over them (default 1)\n"
+    "  --time T               animation clock in seconds (default 0)\n"
+    "  --timings              print the median GPU time of each pass and peak memory\n"
+    "  --view TARGET          write a raw target instead of the final image:\n"
+    "                         output, lit, depth, normal, albedo, material, emission, motion, floor\n"
+    "  --exposure E           exposure before tonemapping (default 1)\n"
+    "  --validation           enable Vulkan validation layers (also GI_VALIDATION=1)\n"
+    "  --device NAME          pick the Vulkan device by name or index (also GI_DEVICE)\n";
+
+struct Options {
+  std::string scene, out, view = "output", device;
+  uint32_t width = 640, height = 480;
+  int frames = 1;
+  double time = 0.0;
+  float exposure = 1.0f;
+  bool timings = false, validation = false;
+};
+
+[[noreturn]] void usageError(const std::string& message) {
+  throw gi::Error(gi::ErrorKind::Usage, "", message + " (see gi-render --help)");
+}
+
+double parseNumber(const std::string& flag, const char* text, double lo, double hi) {
+  char* end = nullptr;
+  double v = std::strtod(text, &end);
+  if (end == text || *end != '\0' || !(v >= lo && v <= hi))
+    usageError(flag + " expects a number in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+               "], got '" + text + "'");
+  return v;
+}
+
+Options parseArgs(int argc, char** argv) {
+  Options o;
+  o.validation = gi::vk::ContextOptions::fromEnvironment().validation;
+  for (int i = 1; i < argc; ++i) {
+    std::string a = argv[i];
+    auto value = [&]() -> const char* {
+      if (i + 1 >= argc) usageError(a + " needs a value");
+      return argv[++i];
+    };
+    if (a == "--help" || a == "-h") {
+      std::fputs(kUsage, stdout);
+      std::exit(0);
+    } else if (a == "--scene") o.scene = value();
+    else if (a == "--out") o.out = value();
+    else if (a == "--width") o.width = uint32_t(parseNumber(a, value(), 1, 16384));
+    else if (a == "--height") o.height = uint32_t(parseNumber(a, value(), 1, 16384));
+    else if (a == "--frames") o.frames = int(parseNumber(a, value(), 1, 100000));
+    else if (a == "--time") o.time = parseNumber(a, value(), -1e9, 1e9);
+    else if (a == "--exposure") o.exposure = float(parseNumber(a, value(), 0, 1e6));
+    else if (a == "--view") o.view = value();
+    else if (a == "--device") o.device = value();
+    else if (a == "--timings") o.timings = true;
+    else if (a == "--validation") o.validation = true;
+    else usageError("unknown argument '" + a + "'");
+  }
+  if (o.scene.empty()) usageError("--scene is required");
+  if (o.out.empty()) usageError("--out is required");
+  return o;
+}
+
+gi::Target parseView(const std::string& v) {
+  static const std::map<std::string, gi::Target> views = {
+      {"output", gi::Target::Output}, {"lit", gi::Target::Lit},         {"depth", gi::Target::Depth},
+      {"normal", gi::Target::Normal}, {"albedo", gi::Target::Albedo},   {"material", gi::Target::Material},
+      {"emission", gi::Target::Emission}, {"motion", gi::Target::Motion}, {"floor", gi::Target::Floor}};
+  auto it = views.find(v);
+  if (it == views.end()) usageError("unknown --view '" + v + "'");
+  return it->second;
+}
+
+// Float target -> 8-bit preview (values clamped to [0,1]; normals/motion shifted to be visible).
+gi::ImageRGBA8 toPreview(const gi::ImageRGBA32F& img, gi::Target t) {
+  gi::ImageRGBA8 out{img.width, img.height, std::vector<uint8_t>(img.pixels.size())};
+  for (size_t i = 0; i < img.pixels.size(); ++i) {
+    float v = img.pixels[i];
+    if ((t == gi::Target::Normal || t == gi::Target::Motion) && i % 4 != 3) v = v * 0.5f + 0.5f;
+    if (t == gi::Target::Depth && i % 4 != 3) v = img.pixels[i - i % 4];
+    if (i % 4 == 3) v = 1.0f;
+    out.pixels[i] = uint8_t(std::clamp(v, 0.0f, 1.0f) * 255.0f + 0.5f);
+  }
+  return out;
+}
+
+int run(const Options& o) {
+  const std::string ext = std::filesystem::path(o.out).extension().string();
+  if (ext != ".png" && ext != ".pfm")
+    throw gi::Error(gi::ErrorKind::Usage, o.out, "output must end in .png or .pfm");
+  const gi::Target view = parseView(o.view);
+  // Load (and validate) the scene before any Vulkan work, so bad input fails fast.
+  gi::Scene scene = gi::loadScene(o.scene);
+  for (const std::string& w : scene.warnings) std::fprintf(stderr, "gi-render: warning: %s\n", w.c_str());
+
+  gi::vk::ContextOptions ctxOptions = gi::vk::ContextOptions::fromEnvironment();
+  ctxOptions.validation = o.validation;
+  if (!o.device.empty()) ctxOptions.device = o.device;
+  gi::vk::Context ctx(ctxOptions);
+
+  gi::RenderSettings settings;
+  settings.width = o.width;
+  settings.height = o.height;
+  settings.exposure = o.exposure;
+  settings.floorPass = o.timings || view == gi::Target::Floor;
+  gi::Renderer renderer(ctx, scene, settings);
+
+  std::map<std::string, std::vector<double>> samples;
+  for (int f = 0; f < o.frames; ++f) {
+    renderer.renderFrame();
+    for (const auto& t : renderer.lastTimings()) samples[t.name].push_back(t.ms);
+  }
+
+  if (ext == ".pfm") {
+    gi::writePfm(o.out, renderer.readTarget(view == gi::Target::Output ? gi::Target::Lit : view));
+  } else if (view == gi::Target::Output) {
+    gi::writePng(o.out, renderer.readOutput());
+  } else {
+    gi::writePng(o.out, toPreview(renderer.readTarget(view), view));
+  }
+
+  if (o.timings) {
+    std::printf("scene %s, %ux%u, %zu triangles, %d frame(s), device %s\n", o.scene.c_str(), o.width,
+                o.height, scene.triangleCount(), o.frames, ctx.deviceName().c_str());
+    std::printf("%-12s %12s\n", "pass", "median ms");
+    double total = 0;
+    for (const std::string& name : renderer.passNames()) {
+      std::vector<double> v = samples[name];
+      std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+      double median = v[v.size() / 2];
+      total += median;
+      std::printf("%-12s %12.3f\n", name.c_str(), median);
+    }
+    std::printf("%-12s %12.3f\n", "total", total);
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    std::printf("peak memory %.1f MiB\n", usage.ru_maxrss / 1024.0);
+  }
+  if (ctx.validationErrors() > 0) {
+    std::fprintf(stderr, "gi-render: error: %u Vulkan validation error(s)\n", ctx.validationErrors());
+    return 3;
+  }
+  std::printf("wrote %s\n", o.out.c_str());
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(parseArgs(argc, argv));
+  } catch (const gi::Error& e) {
+    std::fprintf(stderr, "gi-render: error (%s): %s\n", gi::errorKindName(e.kind()), e.what());
+    return e.kind() == gi::ErrorKind::Usage ? 2 : 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "gi-render: error: %s\n", e.what());
+    return 1;
+  }
+}

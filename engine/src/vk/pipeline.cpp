@@ -1,0 +1,231 @@
+#include "gi/vk/pipeline.h"
+
+#include <utility>
+
+#include "gi/vk/common.h"
+
+namespace gi::vk {
+
+namespace {
+VkShaderModule createModule(VkDevice device, const std::vector<uint32_t>& code) {
+  VkShaderModuleCreateInfo info{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+  info.codeSize = code.size() * 4;
+  info.pCode = code.data();
+  VkShaderModule module;
+  check(vkCreateShaderModule(device, &info, nullptr, &module), "vkCreateShaderModule");
+  return module;
+}
+}  // namespace
+
+void Pipeline::createLayout(const std::vector<Binding>& bindings, uint32_t pushConstantBytes) {
+  std::vector<VkDescriptorSetLayoutBinding> vkBindings;
+  for (const Binding& b : bindings)
+    vkBindings.push_back({b.binding, b.type, b.count, b.stages, nullptr});
+  VkDescriptorSetLayoutCreateInfo setInfo{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+  setInfo.bindingCount = static_cast<uint32_t>(vkBindings.size());
+  setInfo.pBindings = vkBindings.data();
+  check(vkCreateDescriptorSetLayout(ctx_->device(), &setInfo, nullptr, &setLayout_),
+        "vkCreateDescriptorSetLayout");
+  VkPushConstantRange range{VK_SHADER_STAGE_ALL, 0, pushConstantBytes};
+  VkPipelineLayoutCreateInfo info{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+  info.setLayoutCount = 1;
+  info.pSetLayouts = &setLayout_;
+  info.pushConstantRangeCount = pushConstantBytes ? 1 : 0;
+  info.pPushConstantRanges = &range;
+  check(vkCreatePipelineLayout(ctx_->device(), &info, nullptr, &layout_), "vkCreatePipelineLayout");
+}
+
+Pipeline Pipeline::compute(Context& ctx, const std::vector<uint32_t>& spirv,
+                           const std::vector<Binding>& bindings, uint32_t pushConstantBytes) {
+  Pipeline p;
+  p.ctx_ = &ctx;
+  p.bindPoint_ = VK_PIPELINE_BIND_POINT_COMPUTE;
+  p.createLayout(bindings, pushConstantBytes);
+  VkShaderModule module = createModule(ctx.device(), spirv);
+  VkComputePipelineCreateInfo info{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+  info.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+  info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+  info.stage.module = module;
+  info.stage.pName = "main";
+  info.layout = p.layout_;
+  VkResult r = vkCreateComputePipelines(ctx.device(), ctx.pipelineCache(), 1, &info, nullptr, &p.pipeline_);
+  vkDestroyShaderModule(ctx.device(), module, nullptr);
+  check(r, "vkCreateComputePipelines");
+  return p;
+}
+
+Pipeline Pipeline::graphics(Context& ctx, const GraphicsDesc& d) {
+  Pipeline p;
+  p.ctx_ = &ctx;
+  p.bindPoint_ = VK_PIPELINE_BIND_POINT_GRAPHICS;
+  p.createLayout(d.bindings, d.pushConstantBytes);
+
+  VkShaderModule vs = createModule(ctx.device(), d.vertex);
+  VkShaderModule fs = createModule(ctx.device(), d.fragment);
+  VkPipelineShaderStageCreateInfo stages[2] = {
+      {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_VERTEX_BIT, vs, "main", nullptr},
+      {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_FRAGMENT_BIT, fs, "main", nullptr}};
+
+  VkVertexInputBindingDescription vbinding{0, d.vertexLayout.stride, VK_VERTEX_INPUT_RATE_VERTEX};
+  VkPipelineVertexInputStateCreateInfo vertexInput{VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
+  if (d.vertexLayout.stride) {
+    vertexInput.vertexBindingDescriptionCount = 1;
+    vertexInput.pVertexBindingDescriptions = &vbinding;
+    vertexInput.vertexAttributeDescriptionCount = static_cast<uint32_t>(d.vertexLayout.attributes.size());
+    vertexInput.pVertexAttributeDescriptions = d.vertexLayout.attributes.data();
+  }
+  VkPipelineInputAssemblyStateCreateInfo assembly{VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
+  assembly.topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
+  VkPipelineViewportStateCreateInfo viewport{VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO};
+  viewport.viewportCount = 1;
+  viewport.scissorCount = 1;
+  VkPipelineRasterizationStateCreateInfo raster{VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
+  raster.polygonMode = VK_POLYGON_MODE_FILL;
+  raster.cullMode = d.cullMode;
+  raster.frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE;
+  raster.lineWidth = 1.0f;
+  VkPipelineMultisampleStateCreateInfo msaa{VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
+  msaa.rasterizationSamples = VK_SAMPLE_COUNT_1_BIT;
+  VkPipelineDepthStencilStateCreateInfo depth{VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
+  depth.depthTestEnable = d.depthFormat != VK_FORMAT_UNDEFINED;
+  depth.depthWriteEnable = d.depthWrite;
+  depth.depthCompareOp = d.depthCompare;
+  std::vector<VkPipelineColorBlendAttachmentState> blends(d.colorFormats.size());
+  for (auto& b : blends) b.colorWriteMask = 0xF;
+  VkPipelineColorBlendStateCreateInfo blend{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
+  blend.attachmentCount = static_cast<uint32_t>(blends.size());
+  blend.pAttachments = blends.data();
+  VkDynamicState dynamicStates[] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
+  VkPipelineDynamicStateCreateInfo dynamic{VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
+  dynamic.dynamicStateCount = 2;
+  dynamic.pDynamicStates = dynamicStates;
+  VkPipelineRenderingCreateInfo rendering{VK_STRUCTURE_TYPE_PIPELINE_RENDERING_CREATE_INFO};
+  rendering.colorAttachmentCount = static_cast<uint32_t>(d.colorFormats.size());
+  rendering.pColorAttachmentFormats = d.colorFormats.data();
+  rendering.depthAttachmentFormat = d.depthFormat;
+
+  VkGraphicsPipelineCreateInfo info{VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO};
+  info.pNext = &rendering;
+  info.stageCount = 2;
+  info.pStages = stages;
+  info.pVertexInputState = &vertexInput;
+  info.pInputAssemblyState = &assembly;
+  info.pViewportState = &viewport;
+  info.pRasterizationState = &raster;
+  info.pMultisampleState = &msaa;
+  info.pDepthStencilState = &depth;
+  info.pColorBlendState = &blend;
+  info.pDynamicState = &dynamic;
+  info.layout = p.layout_;
+  VkResult r = vkCreateGraphicsPipelines(ctx.device(), ctx.pipelineCache(), 1, &info, nullptr, &p.pipeline_);
+  vkDestroyShaderModule(ctx.device(), vs, nullptr);
+  vkDestroyShaderModule(ctx.device(), fs, nullptr);
+  check(r, "vkCreateGraphicsPipelines");
+  return p;
+}
+
+Pipeline& Pipeline::operator=(Pipeline&& o) noexcept {
+  if (this != &o) {
+    reset();
+    ctx_ = std::exchange(o.ctx_, nullptr);
+    setLayout_ = std::exchange(o.setLayout_, VK_NULL_HANDLE);
+    layout_ = std::exchange(o.layout_, VK_NULL_HANDLE);
+    pipeline_ = std::exchange(o.pipeline_, VK_NULL_HANDLE);
+    bindPoint_ = o.bindPoint_;
+  }
+  return *this;
+}
+
+void Pipeline::reset() {
+  if (!ctx_) return;
+  VkDevice d = ctx_->device();
+  if (pipeline_) vkDestroyPipeline(d, pipeline_, nullptr);
+  if (layout_) vkDestroyPipelineLayout(d, layout_, nullptr);
+  if (setLayout_) vkDestroyDescriptorSetLayout(d, setLayout_, nullptr);
+  pipeline_ = VK_NULL_HANDLE;
+  layout_ = VK_NULL_HANDLE;
+  setLayout_ = VK_NULL_HANDLE;
+  ctx_ = nullptr;
+}
+
+DescriptorArena::~DescriptorArena() {
+  for (VkDescriptorPool p : pools_) vkDestroyDescriptorPool(ctx_->device(), p, nullptr);
+}
+
+VkDescriptorPool DescriptorArena::newPool() {
+  const VkDescriptorPoolSize sizes[] = {
+      {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 512}, {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 128},
+      {VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 128}, {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 128},
+      {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, 128}, {VK_DESCRIPTOR_TYPE_SAMPLER, 32}};
+  VkDescriptorPoolCreateInfo info{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+  info.maxSets = 128;
+  info.poolSizeCount = static_cast<uint32_t>(std::size(sizes));
+  info.pPoolSizes = sizes;
+  VkDescriptorPool pool;
+  check(vkCreateDescriptorPool(ctx_->device(), &info, nullptr, &pool), "vkCreateDescriptorPool");
+  pools_.push_back(pool);
+  return pool;
+}
+
+VkDescriptorSet DescriptorArena::allocate(VkDescriptorSetLayout layout) {
+  for (;;) {
+    if (current_ == pools_.size()) newPool();
+    VkDescriptorSetAllocateInfo info{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+    info.descriptorPool = pools_[current_];
+    info.descriptorSetCount = 1;
+    info.pSetLayouts = &layout;
+    VkDescriptorSet set;
+    VkResult r = vkAllocateDescriptorSets(ctx_->device(), &info, &set);
+    if (r == VK_SUCCESS) return set;
+    if (r != VK_ERROR_OUT_OF_POOL_MEMORY && r != VK_ERROR_FRAGMENTED_POOL) check(r, "vkAllocateDescriptorSets");
+    ++current_;  // this pool is full: move on to the next (created on demand)
+  }
+}
+
+void DescriptorArena::reset() {
+  for (VkDescriptorPool p : pools_) vkResetDescriptorPool(ctx_->device(), p, 0);
+  current_ = 0;
+}
+
+DescriptorWriter& DescriptorWriter::sampled(uint32_t binding, VkImageView view, VkSampler sampler,
+                                            VkImageLayout layout, uint32_t element) {
+  images_.push_back({sampler, view, layout});
+  pending_.push_back({binding, element, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, images_.size() - 1});
+  return *this;
+}
+
+DescriptorWriter& DescriptorWriter::storageImage(uint32_t binding, VkImageView view) {
+  images_.push_back({VK_NULL_HANDLE, view, VK_IMAGE_LAYOUT_GENERAL});
+  pending_.push_back({binding, 0, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, images_.size() - 1});
+  return *this;
+}
+
+DescriptorWriter& DescriptorWriter::buffer(uint32_t binding, VkDescriptorType type, VkBuffer buffer,
+                                           VkDeviceSize offset, VkDeviceSize range) {
+  buffers_.push_back({buffer, offset, range});
+  pending_.push_back({binding, 0, type, buffers_.size() - 1});
+  return *this;
+}
+
+void DescriptorWriter::update(VkDevice device, VkDescriptorSet set) {
+  std::vector<VkWriteDescriptorSet> writes;
+  for (const Pending& p : pending_) {
+    VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+    w.dstSet = set;
+    w.dstBinding = p.binding;
+    w.dstArrayElement = p.element;
+    w.descriptorCount = 1;
+    w.descriptorType = p.type;
+    if (p.type == VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER || p.type == VK_DESCRIPTOR_TYPE_STORAGE_BUFFER)
+      w.pBufferInfo = &buffers_[p.info];
+    else
+      w.pImageInfo = &images_[p.info];
+    writes.push_back(w);
+  }
+  vkUpdateDescriptorSets(device, static_cast<uint32_t>(writes.size()), writes.data(), 0, nullptr);
+  pending_.clear();
+  images_.clear();
+  buffers_.clear();
+}
+
+}  // namespace gi::vk
