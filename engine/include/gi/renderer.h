@@ -42,6 +42,10 @@ class Renderer {
   ImageRGBA8 readOutput();                 // tonemapped 8-bit image
   ImageRGBA32F readTarget(Target target);  // any target as float RGBA (depth in r)
   const CameraView& camera() const;
+  // The tonemapped RGBA8 image; after renderFrame() it is in VK_IMAGE_LAYOUT_GENERAL and all
+  // writes are complete (a presenter copies it into a swapchain image).
+  VkImage outputImage() const;
+  VkExtent2D outputExtent() const;
 
  private:
   struct Impl;

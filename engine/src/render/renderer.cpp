@@ -517,6 +517,8 @@ const std::vector<PassTiming>& Renderer::lastTimings() const { return impl_->tim
 std::vector<std::string> Renderer::passNames() const { return impl_->executed; }
 const CameraView& Renderer::camera() const { return impl_->cameraView; }
 ImageRGBA32F Renderer::readTarget(Target target) { return impl_->readTarget(target); }
+VkImage Renderer::outputImage() const { return impl_->output.image.handle(); }
+VkExtent2D Renderer::outputExtent() const { return {impl_->settings.width, impl_->settings.height}; }
 
 ImageRGBA8 Renderer::readOutput() {
   std::vector<uint8_t> raw = impl_->readRaw(impl_->output);
