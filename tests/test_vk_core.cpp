@@ -1,0 +1,135 @@
+// Vulkan core services: sub-allocation, run-time GLSL compilation, the on-disk pipeline cache.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <set>
+
+#include "gi/errors.h"
+#include "gi/vk/memory.h"
+#include "gi/vk/pipeline.h"
+#include "gi/vk/resources.h"
+#include "vulkan_fixture.h"
+
+namespace gi {
+namespace {
+
+using test::VulkanTest;
+
+TEST(FreeList, AlignsAndNeverOverlaps) {
+  vk::FreeList list(1 << 20);
+  std::mt19937 rng(7);
+  std::vector<std::pair<VkDeviceSize, VkDeviceSize>> live;
+  for (int i = 0; i < 2000; ++i) {
+    if (!live.empty() && rng() % 3 == 0) {  // free a random live range
+      size_t k = rng() % live.size();
+      list.free(live[k].first, live[k].second);
+      live.erase(live.begin() + long(k));
+      continue;
+    }
+    VkDeviceSize size = 1 + rng() % 4096, align = VkDeviceSize(1) << (rng() % 9);
+    auto offset = list.allocate(size, align);
+    if (!offset) continue;
+    EXPECT_EQ(*offset % align, 0u);
+    EXPECT_LE(*offset + size, list.capacity());
+    for (auto& [o, s] : live) ASSERT_TRUE(*offset + size <= o || o + s <= *offset) << "overlap";
+    live.emplace_back(*offset, size);
+  }
+  for (auto& [o, s] : live) list.free(o, s);
+  EXPECT_EQ(list.used(), 0u);
+  EXPECT_EQ(list.freeRangeCount(), 1u) << "free ranges must coalesce back into one";
+}
+
+TEST(FreeList, ReportsExhaustion) {
+  vk::FreeList list(256);
+  EXPECT_TRUE(list.allocate(200, 1));
+  EXPECT_FALSE(list.allocate(100, 1));
+  EXPECT_TRUE(list.allocate(56, 1));
+}
+
+class VkCoreTest : public VulkanTest {};
+
+TEST_F(VkCoreTest, ManyBuffersShareFewMemoryBlocks) {
+  const size_t blocksBefore = ctx().allocator().blockCount();
+  std::vector<vk::Buffer> buffers;
+  for (int i = 0; i < 200; ++i)
+    buffers.emplace_back(ctx(), 4096 + i * 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, i % 2 == 0);
+  // 200 resources, but only one block per memory type in use (sub-allocation).
+  EXPECT_LE(ctx().allocator().blockCount() - blocksBefore, 2u);
+  buffers.clear();
+  EXPECT_EQ(ctx().allocator().blockCount(), blocksBefore);
+}
+
+TEST_F(VkCoreTest, RuntimeGlslCompilesEngineShaders) {
+  const std::string dir = std::string(GI_SOURCE_DIR) + "/engine/shaders";
+  for (const char* name : {"lighting.comp", "tonemap.comp", "gbuffer.vert", "gbuffer.frag"}) {
+    std::vector<uint32_t> spirv = vk::compileGlslFile(dir + "/" + name, {dir});
+    ASSERT_GT(spirv.size(), 5u) << name;
+    EXPECT_EQ(spirv[0], 0x07230203u) << name;
+  }
+  // A run-time compiled compute shader builds a pipeline without validation errors.
+  vk::Pipeline p = vk::Pipeline::compute(ctx(), vk::compileGlslFile(dir + "/floor.comp", {dir}),
+                                         {{0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
+                                          {1, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER},
+                                          {2, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE}});
+  EXPECT_NE(p.handle(), VK_NULL_HANDLE);
+}
+
+TEST_F(VkCoreTest, RuntimeGlslErrorNamesSourceAndLine) {
+  const std::string bad = "#version 460\nlayout(local_size_x = 1) in;\nvoid main() { undefinedThing = 1; }\n";
+  try {
+    vk::compileGlsl(bad, VK_SHADER_STAGE_COMPUTE_BIT, "broken.comp");
+    FAIL() << "expected a compilation error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::Parse);
+    EXPECT_NE(std::string(e.what()).find("broken.comp"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("undefinedThing"), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(VkCoreTest, MissingSpirvIsAClearError) {
+  try {
+    vk::loadSpirv("does-not-exist.comp");
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), ErrorKind::FileNotFound);
+    EXPECT_NE(std::string(e.what()).find("does-not-exist.comp.spv"), std::string::npos);
+  }
+}
+
+TEST(PipelineCache, WrittenToDiskAndReloaded) {
+  const auto path = std::filesystem::temp_directory_path() / "gi-test-cache-roundtrip.bin";
+  std::filesystem::remove(path);
+  auto makeContext = [&] {
+    vk::ContextOptions o;
+    o.validation = true;
+    o.pipelineCachePath = path.string();
+    return std::make_unique<vk::Context>(o);
+  };
+  {
+    auto ctx = makeContext();
+    vk::Pipeline p = vk::Pipeline::compute(*ctx, vk::loadSpirv("floor.comp"),
+                                           {{0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
+                                            {1, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER},
+                                            {2, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE}});
+    EXPECT_EQ(ctx->validationErrors(), 0u);
+  }
+  ASSERT_TRUE(std::filesystem::exists(path));
+  // At least the header naming this device (lavapipe stores nothing beyond it).
+  ASSERT_GE(std::filesystem::file_size(path), sizeof(VkPipelineCacheHeaderVersionOne));
+  {
+    VkPipelineCacheHeaderVersionOne header{};
+    std::ifstream(path, std::ios::binary).read(reinterpret_cast<char*>(&header), sizeof header);
+    EXPECT_EQ(header.headerVersion, VK_PIPELINE_CACHE_HEADER_VERSION_ONE);
+    EXPECT_GE(header.headerSize, 32u);
+  }
+  // A corrupt cache file is ignored, not trusted.
+  { std::ofstream(path, std::ios::binary) << "garbage that is not a pipeline cache header at all......"; }
+  auto ctx = makeContext();
+  EXPECT_EQ(ctx->validationErrors(), 0u);
+  std::filesystem::remove(path);
+}
+
+}  // namespace
+}  // namespace gi
