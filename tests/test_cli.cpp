@@ -1,0 +1,144 @@
+// gi-render end to end: the default scene renders deterministically; every broken input exits
+// non-zero with a message naming the file, and leaves no output file behind.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <set>
+
+#include "gi/image_io.h"
+#include "process.h"
+#include "test_support.h"
+
+namespace gi {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string render(const std::string& scene, const std::string& out, const std::string& extra = "") {
+  return test::binPath("gi-render") + " --validation --width 160 --height 120 --scene '" + scene +
+         "' --out '" + out + "' " + extra;
+}
+
+TEST(Cli, DefaultSceneRendersDeterministically) {
+  const std::string dir = test::makeTempDir("cli-default");
+  auto a = test::runCommand(render("default", dir + "/a.png", "--frames 2 --timings"));
+  ASSERT_EQ(a.exitCode, 0) << a.output;
+  auto b = test::runCommand(render("default", dir + "/b.png"));
+  ASSERT_EQ(b.exitCode, 0) << b.output;
+  EXPECT_EQ(a.output.find("validation"), std::string::npos) << a.output;
+  for (const char* pass : {"gbuffer", "lighting", "tonemap", "floor"})
+    EXPECT_NE(a.output.find(pass), std::string::npos) << "timing table lacks " << pass << "\n" << a.output;
+  ImageRGBA8 ia = readPng(dir + "/a.png"), ib = readPng(dir + "/b.png");
+  ASSERT_EQ(ia.width, 160);
+  ASSERT_EQ(ia.height, 120);
+  EXPECT_EQ(ia.pixels, ib.pixels) << "lavapipe renders deterministically; two runs must match";
+  // Not a blank image: many distinct colours (walls, boxes, sphere, sky).
+  std::set<uint32_t> colours;
+  for (size_t i = 0; i < ia.pixels.size(); i += 4)
+    colours.insert(ia.pixels[i] | ia.pixels[i + 1] << 8 | ia.pixels[i + 2] << 16);
+  EXPECT_GT(colours.size(), 200u);
+}
+
+TEST(Cli, HdrOutputIsFinite) {
+  const std::string dir = test::makeTempDir("cli-pfm");
+  auto r = test::runCommand(render("default", dir + "/lit.pfm"));
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  ImageRGBA32F img = readPfm(dir + "/lit.pfm");
+  for (float v : img.pixels) ASSERT_TRUE(std::isfinite(v));
+}
+
+struct BadInput {
+  std::string name, path;
+};
+
+class CliBadInput : public ::testing::TestWithParam<BadInput> {};
+
+TEST_P(CliBadInput, FailsCleanlyWithoutOutput) {
+  const std::string dir = test::makeTempDir("cli-bad-" + GetParam().name);
+  const std::string out = dir + "/out.png";
+  auto r = test::runCommand(render(GetParam().path, out));
+  EXPECT_NE(r.exitCode, 0) << r.output;
+  EXPECT_LT(r.exitCode, 128) << "crashed (signal): " << r.output;
+  EXPECT_NE(r.output.find("error"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(fs::path(GetParam().path).filename().string()), std::string::npos)
+      << "message must name the file: " << r.output;
+  EXPECT_FALSE(fs::exists(out)) << "partial output left behind";
+  EXPECT_TRUE(fs::is_empty(dir)) << "temporary files left behind";
+}
+
+std::vector<BadInput> badInputs() {
+  const std::string dir = test::makeTempDir("cli-bad-inputs");
+  std::ofstream(dir + "/empty.gltf");
+  std::ofstream(dir + "/empty.json");
+  std::ofstream(dir + "/garbage.glb") << "this is not a glTF binary";
+  std::ofstream(dir + "/unknown_key.json") << R"({"camera": {"position": [0,0,5]}, "colour": 1})";
+  std::ofstream(dir + "/missing_model.json") << R"({"models": [{"file": "no-such-model.gltf"}]})";
+  std::ofstream(dir + "/model.xyz") << "1 2 3";
+  const std::string g = test::assimpModel("glTF2/");
+  return {
+      {"missing", dir + "/does-not-exist.gltf"},
+      {"empty_gltf", dir + "/empty.gltf"},
+      {"empty_json", dir + "/empty.json"},
+      {"garbage", dir + "/garbage.glb"},
+      {"unknown_key", dir + "/unknown_key.json"},
+      {"missing_model", dir + "/missing_model.json"},
+      {"unsupported_ext", dir + "/model.xyz"},
+      {"index_out_of_range", g + "IndexOutOfRange/IndexOutOfRange.gltf"},
+      {"missing_bin", g + "MissingBin/BoxTextured.gltf"},
+      {"recursive_nodes", g + "RecursiveNodes/RecursiveNodes.gltf"},
+      {"incorrect_vertex_arrays", g + "IncorrectVertexArrays/Cube.gltf"},
+      {"wrong_types", g + "wrongTypes/badArray.gltf"},
+      {"schema_failure", g + "SchemaFailures/sceneWrongType.gltf"},
+  };
+}
+
+INSTANTIATE_TEST_SUITE_P(Broken, CliBadInput, ::testing::ValuesIn(badInputs()),
+                         [](const auto& info) { return info.param.name; });
+
+TEST(Cli, BadNormalsAreRepairedNotNaN) {
+  const std::string dir = test::makeTempDir("cli-badnormals");
+  const std::string model = test::assimpModel("glTF2/BoxBadNormals-glTF-Binary/BoxBadNormals.glb");
+  auto r = test::runCommand(render(model, dir + "/n.pfm", "--view normal"));
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  ImageRGBA32F img = readPfm(dir + "/n.pfm");
+  size_t geometry = 0;
+  for (size_t i = 0; i < img.pixels.size(); i += 4) {
+    for (int c = 0; c < 3; ++c) ASSERT_TRUE(std::isfinite(img.pixels[i + c]));
+    float len = std::sqrt(img.pixels[i] * img.pixels[i] + img.pixels[i + 1] * img.pixels[i + 1] +
+                          img.pixels[i + 2] * img.pixels[i + 2]);
+    if (len > 0.0f) {
+      ++geometry;
+      EXPECT_NEAR(len, 1.0f, 2e-3f);
+    }
+  }
+  EXPECT_GT(geometry, 100u);
+}
+
+TEST(Cli, InfinitePositionsNeverRenderNaN) {
+  const std::string dir = test::makeTempDir("cli-infinites");
+  const std::string model = test::assimpModel("glTF2/BoxWithInfinites-glTF-Binary/BoxWithInfinites.glb");
+  auto r = test::runCommand(render(model, dir + "/lit.pfm"));
+  if (r.exitCode != 0) {  // rejected: then with a clear message and no output
+    EXPECT_NE(r.output.find("BoxWithInfinites"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(dir + "/lit.pfm"));
+    return;
+  }
+  ImageRGBA32F img = readPfm(dir + "/lit.pfm");
+  for (float v : img.pixels) ASSERT_TRUE(std::isfinite(v));
+}
+
+TEST(Cli, UsageErrors) {
+  auto r = test::runCommand(test::binPath("gi-render") + " --scene default");
+  EXPECT_EQ(r.exitCode, 2) << r.output;
+  EXPECT_NE(r.output.find("--out"), std::string::npos);
+  r = test::runCommand(test::binPath("gi-render") + " --scene default --out x.png --width -3");
+  EXPECT_EQ(r.exitCode, 2) << r.output;
+  r = test::runCommand(test::binPath("gi-render") + " --scene default --out x.png --bogus");
+  EXPECT_EQ(r.exitCode, 2) << r.output;
+  EXPECT_NE(r.output.find("--bogus"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace gi
