@@ -12,6 +12,7 @@ GI_PACKAGES=(
   libglm-dev libtinygltf-dev nlohmann-json3-dev libopenmesh-dev libglfw3-dev libimgui-dev
   libstb-dev libembree-dev libgtest-dev libbenchmark-dev
   assimp-testmodels
+  xvfb xauth  # test_window runs gi-render --window on a virtual X server
 )
 
 gi_install_missing() {

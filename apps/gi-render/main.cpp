@@ -1,12 +1,15 @@
-// gi-render: headless command-line renderer. Renders a scene (JSON scene, model file or the
-// built-in default) and writes the image; --timings prints the median GPU time of each pass.
+// gi-render: command-line renderer. Renders a scene (JSON scene, model file or the built-in
+// default) and writes the image, or shows it in a window (--window); --timings prints the
+// median GPU time of each pass.
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <climits>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -15,13 +18,18 @@
 #include "gi/renderer.h"
 #include "gi/scene_io.h"
 #include "gi/vk/context.h"
+#include "gi/vk/swapchain.h"
+#include "window.h"
 
 namespace {
 
 const char* kUsage =
     "usage: gi-render --scene FILE|default --out IMAGE.png|IMAGE.pfm [options]\n"
-    "  --width W --height H   image size (default 640x480)\n"
-    "  --frames N             frames to render; timings are medians over them (default 1)\n"
+    "       gi-render --scene FILE|default --window [--out IMAGE] [options]\n"
+    "  --window               show the frames in a window (until closed, or --frames N)\n"
+    "  --width W --height H   image (and window) size (default 640x480)\n"
+    "  --frames N             frames to render; timings are medians over them\n"
+    "                         (default 1; with --window: until the window is closed)\n"
     "  --time T               animation clock in seconds (default 0)\n"
     "  --timings              print the median GPU time of each pass and peak memory\n"
     "  --view TARGET          write a raw target instead of the final image:\n"
@@ -33,10 +41,10 @@ const char* kUsage =
 struct Options {
   std::string scene, out, view = "output", device;
   uint32_t width = 640, height = 480;
-  int frames = 1;
+  int frames = 0;  // 0: not given (one frame, or until the window closes)
   double time = 0.0;
   float exposure = 1.0f;
-  bool timings = false, validation = false;
+  bool timings = false, validation = false, window = false;
 };
 
 [[noreturn]] void usageError(const std::string& message) {
@@ -75,10 +83,11 @@ Options parseArgs(int argc, char** argv) {
     else if (a == "--device") o.device = value();
     else if (a == "--timings") o.timings = true;
     else if (a == "--validation") o.validation = true;
+    else if (a == "--window") o.window = true;
     else usageError("unknown argument '" + a + "'");
   }
   if (o.scene.empty()) usageError("--scene is required");
-  if (o.out.empty()) usageError("--out is required");
+  if (o.out.empty() && !o.window) usageError("--out is required (or --window)");
   return o;
 }
 
@@ -105,9 +114,18 @@ gi::ImageRGBA8 toPreview(const gi::ImageRGBA32F& img, gi::Target t) {
   return out;
 }
 
+void writeImage(const std::string& path, gi::Target view, gi::Renderer& renderer) {
+  if (std::filesystem::path(path).extension() == ".pfm")
+    gi::writePfm(path, renderer.readTarget(view == gi::Target::Output ? gi::Target::Lit : view));
+  else if (view == gi::Target::Output)
+    gi::writePng(path, renderer.readOutput());
+  else
+    gi::writePng(path, toPreview(renderer.readTarget(view), view));
+}
+
 int run(const Options& o) {
   const std::string ext = std::filesystem::path(o.out).extension().string();
-  if (ext != ".png" && ext != ".pfm")
+  if (!o.out.empty() && ext != ".png" && ext != ".pfm")
     throw gi::Error(gi::ErrorKind::Usage, o.out, "output must end in .png or .pfm");
   const gi::Target view = parseView(o.view);
   // Load (and validate) the scene before any Vulkan work, so bad input fails fast.
@@ -117,6 +135,12 @@ int run(const Options& o) {
   gi::vk::ContextOptions ctxOptions = gi::vk::ContextOptions::fromEnvironment();
   ctxOptions.validation = o.validation;
   if (!o.device.empty()) ctxOptions.device = o.device;
+  std::optional<AppWindow> window;  // outlives the context and the swapchain's surface
+  if (o.window) {
+    window.emplace(o.width, o.height, "gi-render: " + o.scene);
+    ctxOptions.instanceExtensions = AppWindow::instanceExtensions();
+    ctxOptions.swapchain = true;
+  }
   gi::vk::Context ctx(ctxOptions);
 
   gi::RenderSettings settings;
@@ -125,24 +149,23 @@ int run(const Options& o) {
   settings.exposure = o.exposure;
   settings.floorPass = o.timings || view == gi::Target::Floor;
   gi::Renderer renderer(ctx, scene, settings);
+  std::optional<gi::vk::Swapchain> swapchain;
+  if (window) swapchain.emplace(ctx, window->handle());
 
   std::map<std::string, std::vector<double>> samples;
-  for (int f = 0; f < o.frames; ++f) {
+  const int frames = o.frames > 0 ? o.frames : window ? INT_MAX : 1;
+  int rendered = 0;
+  for (; rendered < frames && !(window && window->closed()); ++rendered) {
     renderer.renderFrame();
     for (const auto& t : renderer.lastTimings()) samples[t.name].push_back(t.ms);
+    if (swapchain) swapchain->present(renderer);
   }
+  if (rendered == 0) std::printf("window closed before the first frame\n");
+  if (rendered > 0 && !o.out.empty()) writeImage(o.out, view, renderer);
 
-  if (ext == ".pfm") {
-    gi::writePfm(o.out, renderer.readTarget(view == gi::Target::Output ? gi::Target::Lit : view));
-  } else if (view == gi::Target::Output) {
-    gi::writePng(o.out, renderer.readOutput());
-  } else {
-    gi::writePng(o.out, toPreview(renderer.readTarget(view), view));
-  }
-
-  if (o.timings) {
+  if (o.timings && rendered > 0) {
     std::printf("scene %s, %ux%u, %zu triangles, %d frame(s), device %s\n", o.scene.c_str(), o.width,
-                o.height, scene.triangleCount(), o.frames, ctx.deviceName().c_str());
+                o.height, scene.triangleCount(), rendered, ctx.deviceName().c_str());
     std::printf("%-12s %12s\n", "pass", "median ms");
     double total = 0;
     for (const std::string& name : renderer.passNames()) {
@@ -161,7 +184,7 @@ int run(const Options& o) {
     std::fprintf(stderr, "gi-render: error: %u Vulkan validation error(s)\n", ctx.validationErrors());
     return 3;
   }
-  std::printf("wrote %s\n", o.out.c_str());
+  if (rendered > 0 && !o.out.empty()) std::printf("wrote %s\n", o.out.c_str());
   return 0;
 }
 
