@@ -10,7 +10,7 @@ GI_PACKAGES=(
   libvulkan-dev vulkan-validationlayers mesa-vulkan-drivers vulkan-tools
   glslang-tools glslang-dev libshaderc-dev spirv-tools
   libglm-dev libtinygltf-dev nlohmann-json3-dev libopenmesh-dev libglfw3-dev libimgui-dev
-  libstb-dev libembree-dev libgtest-dev libbenchmark-dev
+  libstb-dev libembree-dev libgtest-dev libbenchmark-dev clang-format clang-tidy
   assimp-testmodels
   xvfb xauth  # test_window runs gi-render --window on a virtual X server
 )
