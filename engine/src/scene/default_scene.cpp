@@ -1,0 +1,138 @@
+// The built-in scene (a Cornell-box-like room) and the defaults added to bare model files.
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "gi/scene_io.h"
+#include "scene_io_util.h"
+
+namespace gi {
+namespace {
+
+int addMaterial(Scene& s, const std::string& name, glm::vec3 color, float roughness = 0.9f,
+                glm::vec3 emission = glm::vec3(0.0f)) {
+  Material m;
+  m.name = name;
+  m.baseColor = glm::vec4(color, 1.0f);
+  m.roughness = roughness;
+  m.emission = emission;
+  s.materials.push_back(m);
+  return static_cast<int>(s.materials.size()) - 1;
+}
+
+// Adds `mesh` with `material` under a new root node with transform `local`.
+int addMeshNode(Scene& s, const std::string& name, Mesh mesh, int material,
+                const glm::mat4& local) {
+  mesh.name = name;
+  mesh.material = static_cast<uint32_t>(material);
+  s.meshes.push_back(std::move(mesh));
+  int node = s.addNode(name, local);
+  s.nodes[node].meshes.push_back(static_cast<int>(s.meshes.size()) - 1);
+  return node;
+}
+
+glm::mat4 translate(glm::vec3 t) { return glm::translate(glm::mat4(1.0f), t); }
+glm::mat4 rotate(float degrees, glm::vec3 axis) {
+  return glm::rotate(glm::mat4(1.0f), glm::radians(degrees), axis);
+}
+
+}  // namespace
+
+Scene makeDefaultScene() {
+  Scene s;
+  s.sourcePath = "default";
+  // Albedos of the classic Cornell box (linear).
+  const int white = addMaterial(s, "white", {0.73f, 0.73f, 0.73f});
+  const int red = addMaterial(s, "red", {0.63f, 0.065f, 0.05f});
+  const int green = addMaterial(s, "green", {0.14f, 0.45f, 0.091f});
+  const int sphere = addMaterial(s, "sphere", {0.25f, 0.4f, 0.8f}, 0.3f);
+  const int lamp = addMaterial(s, "light", {1.0f, 1.0f, 1.0f}, 0.9f, {12.0f, 10.8f, 9.0f});
+
+  // Room: x, y, z in [-1, 1], open towards +z where the camera stands. The plane faces +y;
+  // each wall is rotated so that it faces into the room.
+  const Mesh wall = detail::makePlane(2.0f, 2.0f);
+  addMeshNode(s, "floor", wall, white, translate({0, -1, 0}));
+  addMeshNode(s, "ceiling", wall, white, translate({0, 1, 0}) * rotate(180, {1, 0, 0}));
+  addMeshNode(s, "back wall", wall, white, translate({0, 0, -1}) * rotate(90, {1, 0, 0}));
+  addMeshNode(s, "left wall", wall, red, translate({-1, 0, 0}) * rotate(-90, {0, 0, 1}));
+  addMeshNode(s, "right wall", wall, green, translate({1, 0, 0}) * rotate(90, {0, 0, 1}));
+
+  // Blocks as in the classic box: a short one front-right, a tall one back-left, turned
+  // towards each other; the sphere rests on the short block.
+  addMeshNode(s, "short block", detail::makeBox({0.6f, 0.6f, 0.6f}), white,
+              translate({0.33f, -0.7f, 0.3f}) * rotate(-17, {0, 1, 0}));
+  addMeshNode(s, "tall block", detail::makeBox({0.6f, 1.2f, 0.6f}), white,
+              translate({-0.35f, -0.4f, -0.35f}) * rotate(17, {0, 1, 0}));
+  addMeshNode(s, "sphere", detail::makeSphere(0.25f, 32, 16), sphere,
+              translate({0.33f, -0.4f + 0.25f, 0.3f}));
+
+  // Lamp: a small emissive quad just under the ceiling plus a point light below it (the
+  // rasteriser's direct lighting comes from the point light; the quad is what is seen).
+  addMeshNode(s, "lamp", detail::makePlane(0.5f, 0.4f), lamp,
+              translate({0, 0.995f, 0}) * rotate(180, {1, 0, 0}));
+  Light light;
+  light.name = "ceiling light";
+  light.type = LightType::Point;
+  light.color = {1.0f, 0.9f, 0.75f};
+  light.intensity = 4.0f;
+  light.castsShadows = true;
+  s.lights.push_back(light);
+  s.nodes[s.addNode("ceiling light", translate({0, 0.9f, 0}))].light = 0;
+
+  // Camera on the open side looking down -z (its local forward), framing the opening.
+  Camera cam;
+  cam.name = "camera";
+  cam.yfov = glm::radians(39.3f);
+  cam.znear = 0.1f;
+  cam.zfar = 20.0f;
+  s.cameras.push_back(cam);
+  s.activeCameraNode = s.addNode("camera", translate({0, 0, 3.9f}));
+  s.nodes[s.activeCameraNode].camera = 0;
+
+  s.environment.kind = Environment::Kind::Sky;
+  s.environment.intensity = 0.5f;
+  s.updateWorldTransforms();
+  return s;
+}
+
+void addDefaultCameraAndLight(Scene& scene) {
+  scene.updateWorldTransforms();
+  glm::vec3 bmin, bmax;
+  scene.worldBounds(bmin, bmax);
+  const glm::vec3 centre = 0.5f * (bmin + bmax);
+  const float radius = std::max(0.5f * glm::length(bmax - bmin), 1e-3f);
+
+  int cameraNode = -1;
+  for (size_t i = 0; i < scene.nodes.size() && cameraNode < 0; ++i)
+    if (scene.nodes[i].camera >= 0) cameraNode = static_cast<int>(i);
+  if (cameraNode < 0) {
+    // Aspect 1 frames the bounds for any output at least as wide as it is tall.
+    CameraView view = cameraFramingBounds(bmin, bmax, 1.0f);
+    Camera cam;
+    cam.name = "default camera";
+    cam.yfov = view.yfov;
+    cam.znear = view.znear;
+    cam.zfar = view.zfar;
+    scene.cameras.push_back(cam);
+    cameraNode = scene.addNode(cam.name, glm::inverse(view.view));  // world = inverse(view)
+    scene.nodes[cameraNode].camera = static_cast<int>(scene.cameras.size()) - 1;
+  }
+  if (scene.activeCameraNode < 0) scene.activeCameraNode = cameraNode;
+
+  if (scene.lights.empty()) {
+    // Sun from above and in front (the framing camera's side, +z), shining down and back. A
+    // light points along its node's -z axis, so the node looks along the light direction.
+    const glm::vec3 dir = glm::normalize(glm::vec3(-0.4f, -1.0f, -0.6f));
+    const glm::vec3 pos = centre - dir * (2.0f * radius);
+    Light sun;
+    sun.name = "default sun";
+    sun.type = LightType::Directional;
+    sun.color = {1.0f, 0.96f, 0.9f};
+    sun.intensity = 3.0f;
+    sun.castsShadows = true;
+    scene.lights.push_back(sun);
+    int node = scene.addNode(sun.name, glm::inverse(glm::lookAt(pos, pos + dir, {0, 1, 0})));
+    scene.nodes[node].light = static_cast<int>(scene.lights.size()) - 1;
+  }
+  scene.updateWorldTransforms();
+}
+
+}  // namespace gi

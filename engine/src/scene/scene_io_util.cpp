@@ -1,0 +1,103 @@
+#include "scene_io_util.h"
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "gi/errors.h"
+#include "gi/scene_io.h"
+
+namespace gi::detail {
+
+namespace fs = std::filesystem;
+
+std::string readTextFile(const std::string& path) {
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw Error(ErrorKind::FileNotFound, path, "file does not exist");
+  if (fs::is_directory(path, ec))
+    throw Error(ErrorKind::FileNotFound, path, "is a directory, not a file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(ErrorKind::FileNotFound, path, "cannot open the file for reading");
+  std::ostringstream text;
+  text << in.rdbuf();
+  std::string s = std::move(text).str();
+  if (std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isspace(c); }))
+    throw Error(ErrorKind::EmptyFile, path, "file is empty");
+  return s;
+}
+
+std::string lowerExtension(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
+
+void addProcessedMeshes(Scene& scene, std::vector<Mesh> meshes, const std::string& path,
+                        bool weld) {
+  size_t kept = 0, nonFinite = 0;
+  for (Mesh& mesh : meshes) {
+    MeshFixReport r = processMesh(mesh, weld);
+    nonFinite += r.droppedNonFiniteTriangles;
+    const std::string who = path + ": mesh '" + mesh.name + "': ";
+    if (r.droppedNonFiniteTriangles)
+      scene.warnings.push_back(who + "dropped " + std::to_string(r.droppedNonFiniteTriangles) +
+                               " triangles with NaN/Inf positions");
+    if (r.droppedDegenerateTriangles)
+      scene.warnings.push_back(who + "dropped " + std::to_string(r.droppedDegenerateTriangles) +
+                               " degenerate triangles");
+    if (r.recomputedNormals)
+      scene.warnings.push_back(who + "computed " + std::to_string(r.recomputedNormals) +
+                               " missing or invalid vertex normals");
+    if (mesh.triangleCount() == 0) {
+      scene.warnings.push_back(who + "no usable triangles left, mesh skipped");
+      continue;
+    }
+    scene.meshes.push_back(std::move(mesh));
+    int node = scene.addNode(scene.meshes.back().name, glm::mat4(1.0f));
+    scene.nodes[node].meshes.push_back(static_cast<int>(scene.meshes.size()) - 1);
+    ++kept;
+  }
+  if (kept == 0 && nonFinite > 0)
+    throw Error(ErrorKind::NonFinite, path,
+                "every triangle has NaN/Inf positions; no geometry left");
+  if (kept == 0) throw Error(ErrorKind::InvalidData, path, "no triangles (no usable geometry)");
+}
+
+void mergeScene(Scene& scene, Scene model, const std::string& name, const glm::mat4& transform) {
+  const int meshOffset = static_cast<int>(scene.meshes.size());
+  const int materialOffset = static_cast<int>(scene.materials.size());
+  const int textureOffset = static_cast<int>(scene.textures.size());
+  const int cameraOffset = static_cast<int>(scene.cameras.size());
+  const int lightOffset = static_cast<int>(scene.lights.size());
+  const int parent = scene.addNode(name, transform);
+  const int nodeOffset = static_cast<int>(scene.nodes.size());
+
+  for (Texture& t : model.textures) scene.textures.push_back(std::move(t));
+  for (Material& m : model.materials) {
+    if (m.baseColorTexture >= 0) m.baseColorTexture += textureOffset;
+    scene.materials.push_back(std::move(m));
+  }
+  for (Mesh& m : model.meshes) {
+    m.material += static_cast<uint32_t>(materialOffset);
+    scene.meshes.push_back(std::move(m));
+  }
+  for (Camera& c : model.cameras) scene.cameras.push_back(std::move(c));
+  for (Light& l : model.lights) scene.lights.push_back(std::move(l));
+  for (Node& n : model.nodes) {
+    n.parent = n.parent < 0 ? parent : n.parent + nodeOffset;
+    for (int& c : n.children) c += nodeOffset;
+    for (int& m : n.meshes) m += meshOffset;
+    if (n.camera >= 0) n.camera += cameraOffset;
+    if (n.light >= 0) n.light += lightOffset;
+    scene.nodes.push_back(std::move(n));
+  }
+  for (int r : model.roots) scene.nodes[parent].children.push_back(r + nodeOffset);
+  if (scene.activeCameraNode < 0 && model.activeCameraNode >= 0)
+    scene.activeCameraNode = model.activeCameraNode + nodeOffset;
+  for (std::string& w : model.warnings) scene.warnings.push_back(std::move(w));
+}
+
+}  // namespace gi::detail

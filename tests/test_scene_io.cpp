@@ -1,0 +1,388 @@
+// Scene loading: OBJ/PLY models, the built-in scene, JSON scene files and their errors.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include "gi/errors.h"
+#include "gi/scene_io.h"
+#include "test_support.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// A fresh folder per test for files written on the fly.
+class TempDir {
+ public:
+  TempDir() {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = fs::temp_directory_path() /
+           ("gi_test_scene_io_" + std::to_string(::getpid()) + "_" + info->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  ~TempDir() { fs::remove_all(dir_); }
+  std::string write(const std::string& name, const std::string& text) const {
+    fs::path p = dir_ / name;
+    fs::create_directories(p.parent_path());
+    std::ofstream(p, std::ios::binary) << text;
+    return p.string();
+  }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+
+ private:
+  fs::path dir_;
+};
+
+// Runs `load` and checks that it throws gi::Error of `kind` whose message names `file` (and
+// contains `fragment`, when given).
+void expectError(const std::function<void()>& load, gi::ErrorKind kind, const std::string& file,
+                 const std::string& fragment = "") {
+  try {
+    load();
+    ADD_FAILURE() << "expected " << gi::errorKindName(kind) << " for " << file;
+  } catch (const gi::Error& e) {
+    EXPECT_EQ(e.kind(), kind) << "got " << gi::errorKindName(e.kind()) << ": " << e.what();
+    EXPECT_NE(std::string(e.what()).find(file), std::string::npos) << e.what();
+    if (!fragment.empty()) {
+      EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+    }
+  }
+}
+
+bool finite(const glm::vec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+bool finite(const glm::mat4& m) {
+  for (int c = 0; c < 4; ++c)
+    for (int r = 0; r < 4; ++r)
+      if (!std::isfinite(m[c][r])) return false;
+  return true;
+}
+
+// Geometry is usable: finite, unit normals, one area per triangle, indices in range.
+void expectSaneScene(const gi::Scene& s) {
+  ASSERT_FALSE(s.materials.empty());
+  for (const gi::Mesh& m : s.meshes) {
+    EXPECT_EQ(m.triangleAreas.size(), m.triangleCount()) << m.name;
+    EXPECT_LT(m.material, s.materials.size()) << m.name;
+    for (const gi::Vertex& v : m.vertices) {
+      ASSERT_TRUE(finite(v.position)) << m.name;
+      ASSERT_NEAR(glm::length(v.normal), 1.0f, 1e-3f) << m.name;
+    }
+    for (uint32_t i : m.indices) ASSERT_LT(i, m.vertices.size()) << m.name;
+    for (float a : m.triangleAreas) ASSERT_TRUE(std::isfinite(a) && a > 0.0f) << m.name;
+  }
+  for (const gi::Node& n : s.nodes) EXPECT_TRUE(finite(n.world)) << n.name;
+  ASSERT_GE(s.activeCameraNode, 0);
+  EXPECT_GE(s.nodes[s.activeCameraNode].camera, 0);
+  EXPECT_FALSE(s.lights.empty());
+}
+
+// Triangles a fan triangulation makes of the OBJ's faces, counted from the text.
+size_t objTriangles(const std::string& path) {
+  std::ifstream in(path);
+  std::string line;
+  size_t triangles = 0;
+  while (std::getline(in, line)) {
+    std::istringstream words(line);
+    std::string kw, corner;
+    if (!(words >> kw) || kw != "f") continue;
+    size_t corners = 0;
+    while (words >> corner) ++corners;
+    triangles += corners - 2;
+  }
+  return triangles;
+}
+
+size_t plyHeaderFaces(const std::string& path) {
+  std::ifstream in(path);
+  std::string line;
+  while (std::getline(in, line) && line.rfind("end_header", 0) != 0) {
+    std::istringstream words(line);
+    std::string a, b;
+    size_t n = 0;
+    if (words >> a >> b >> n && a == "element" && b == "face") return n;
+  }
+  return 0;
+}
+
+// ---------------------------------------------------------------------------------------------
+// OBJ / PLY
+
+TEST(SceneIo, CornellBoxObj) {
+  GI_REQUIRE_SHARED_ASSET(path, "cornell_box/cornell_box.obj");
+  gi::Scene s = gi::loadScene(path);
+  expectSaneScene(s);
+  const size_t expected = objTriangles(path);
+  EXPECT_EQ(expected, 36u);  // 18 quads (SOURCE.txt); the front wall's face is commented out
+  EXPECT_EQ(s.triangleCount(), expected);
+  bool emissive = false;
+  for (const gi::Mesh& m : s.meshes) {
+    const gi::Material& mat = s.materials[m.material];
+    EXPECT_EQ(m.name, mat.name);  // one mesh per material group
+    if (mat.name == "light") {
+      EXPECT_FLOAT_EQ(mat.emission.x, 20.0f);
+      EXPECT_EQ(m.triangleCount(), 2u);
+      emissive = true;
+    } else {
+      EXPECT_EQ(mat.emission, glm::vec3(0.0f)) << mat.name;
+    }
+    if (mat.name == "red") {
+      EXPECT_EQ(glm::vec3(mat.baseColor), glm::vec3(1, 0, 0));
+    }
+  }
+  EXPECT_TRUE(emissive);
+  // Flat faces: the floor's normals point up (its winding faces into the box).
+  for (const gi::Mesh& m : s.meshes) {
+    if (m.name != "green") continue;
+    for (const gi::Vertex& v : m.vertices) EXPECT_NEAR(v.normal.x, 1.0f, 1e-4f);
+  }
+}
+
+TEST(SceneIo, BunnyPly) {
+  GI_REQUIRE_SHARED_ASSET(path, "stanford_bunny/reconstruction/bun_zipper.ply");
+  gi::Scene s = gi::loadScene(path);
+  expectSaneScene(s);
+  EXPECT_EQ(plyHeaderFaces(path), 69451u);
+  EXPECT_EQ(s.triangleCount(), plyHeaderFaces(path));
+  ASSERT_EQ(s.meshes.size(), 1u);
+  EXPECT_LE(s.meshes[0].vertices.size(), 35947u);  // unreferenced vertices are removed
+  EXPECT_GT(s.meshes[0].vertices.size(), 34000u);
+  EXPECT_EQ(s.lights[0].type, gi::LightType::Directional);  // the default sun
+}
+
+TEST(SceneIo, ObjPolygonsGroupsAndRelativeIndices) {
+  TempDir dir;
+  dir.write("m.mtl",
+            "newmtl a\nKd 0.5 0.25 1\nNs 98\n"
+            "newmtl glow\nKe 1 2 3\n"
+            "newmtl lamp_light\nKa 4 4 4\n"
+            "newmtl ambient\nKa 4 4 4\n");
+  const std::string obj = dir.write("m.obj",
+                                    "mtllib m.mtl\n"
+                                    "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0.5 1.5 0\n"
+                                    "vn 0 0 1\nvt 0 0\nvt 1 1\n"
+                                    "usemtl a\nf 1/1/1 2/2/1 3//1 5 4\n"  // pentagon: 3 triangles
+                                    "usemtl glow\nf -5 -4 -3\n"           // relative indices
+                                    "usemtl lamp_light\nf 1 2 3\n"
+                                    "usemtl ambient\nf 1 2 3\n"
+                                    "usemtl a\r\nf 1 3 4\n");  // back to a, CRLF line end
+  gi::Scene s = gi::loadMeshFile(obj);
+  EXPECT_EQ(s.triangleCount(), 7u);
+  ASSERT_EQ(s.meshes.size(), 4u);
+  for (const gi::Mesh& m : s.meshes) {
+    const gi::Material& mat = s.materials[m.material];
+    if (mat.name == "a") {
+      EXPECT_EQ(m.triangleCount(), 4u);
+      EXPECT_FLOAT_EQ(mat.baseColor.y, 0.25f);
+      EXPECT_NEAR(mat.roughness, 0.1414f, 1e-3f);
+      EXPECT_FLOAT_EQ(m.vertices[0].uv.y, 1.0f);  // flipped: OBJ's v points up
+    }
+    if (mat.name == "glow") {
+      EXPECT_EQ(mat.emission, glm::vec3(1, 2, 3));
+    } else if (mat.name == "lamp_light") {
+      EXPECT_EQ(mat.emission, glm::vec3(4));  // Ka of a light
+    } else if (mat.name == "ambient") {
+      EXPECT_EQ(mat.emission, glm::vec3(0));  // Ka is only ambient
+    }
+  }
+  expectSaneScene(s);
+}
+
+TEST(SceneIo, ObjSmoothingGroupsShareVertices) {
+  TempDir dir;
+  // Two triangles folded along the shared edge 2-3.
+  const std::string geometry = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n";
+  gi::Scene flat = gi::loadMeshFile(dir.write("flat.obj", geometry + "f 1 2 3\nf 1 4 2\n"));
+  gi::Scene smooth =
+      gi::loadMeshFile(dir.write("smooth.obj", geometry + "s 1\nf 1 2 3\nf 1 4 2\n"));
+  EXPECT_EQ(flat.meshes[0].vertices.size(), 6u);    // each face its own corners
+  EXPECT_EQ(smooth.meshes[0].vertices.size(), 4u);  // shared, normals averaged
+  for (const gi::Vertex& v : flat.meshes[0].vertices)
+    EXPECT_NEAR(std::abs(v.normal.y) + std::abs(v.normal.z), 1.0f, 1e-5f);  // a face normal
+}
+
+TEST(SceneIo, ObjErrors) {
+  TempDir dir;
+  using K = gi::ErrorKind;
+  const std::string v3 = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+  std::string p = dir.path("missing.obj");
+  expectError([&] { gi::loadMeshFile(p); }, K::FileNotFound, p);
+  p = dir.write("empty.obj", "");
+  expectError([&] { gi::loadScene(p); }, K::EmptyFile, p);
+  p = dir.write("blank.obj", "  \n\n");
+  expectError([&] { gi::loadScene(p); }, K::EmptyFile, p);
+  p = dir.write("badnum.obj", "v 0 0 x\n");
+  expectError([&] { gi::loadScene(p); }, K::Parse, p, "line 1");
+  p = dir.write("short.obj", v3 + "f 1 2\n");
+  expectError([&] { gi::loadScene(p); }, K::Parse, p, "line 4");
+  p = dir.write("range.obj", v3 + "f 1 2 4\n");
+  expectError([&] { gi::loadScene(p); }, K::IndexOutOfRange, p, "line 4");
+  p = dir.write("zero.obj", v3 + "f 0 1 2\n");
+  expectError([&] { gi::loadScene(p); }, K::IndexOutOfRange, p);
+  p = dir.write("negative.obj", v3 + "f -1 -2 -4\n");
+  expectError([&] { gi::loadScene(p); }, K::IndexOutOfRange, p);
+  p = dir.write("normal.obj", v3 + "f 1//1 2//1 3//1\n");
+  expectError([&] { gi::loadScene(p); }, K::IndexOutOfRange, p, "normal");
+  p = dir.write("nofaces.obj", v3 + "# just points\n");
+  expectError([&] { gi::loadScene(p); }, K::InvalidData, p);
+  p = dir.write("nan.obj", "v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  expectError([&] { gi::loadScene(p); }, K::NonFinite, p);
+  p = dir.write("flat.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n");  // collinear only
+  expectError([&] { gi::loadScene(p); }, K::InvalidData, p);
+}
+
+TEST(SceneIo, ObjNaNTrianglesDroppedWithWarning) {
+  TempDir dir;
+  const std::string p = dir.write(
+      "m.obj", "mtllib nowhere.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv inf 0 0\nf 1 2 3\nf 1 2 4\n");
+  gi::Scene s = gi::loadMeshFile(p);
+  EXPECT_EQ(s.triangleCount(), 1u);
+  std::string all;
+  for (const std::string& w : s.warnings) all += w + "\n";
+  EXPECT_NE(all.find("NaN/Inf"), std::string::npos) << all;
+  EXPECT_NE(all.find("nowhere.mtl"), std::string::npos) << all;
+  expectSaneScene(s);
+}
+
+std::string plyHeader(int vertices, int faces) {
+  return "ply\nformat ascii 1.0\ncomment test\nelement vertex " + std::to_string(vertices) +
+         "\nproperty float x\nproperty float y\nproperty float z\nelement face " +
+         std::to_string(faces) + "\nproperty list uchar int vertex_indices\nend_header\n";
+}
+
+TEST(SceneIo, PlyAsciiAndBinary) {
+  TempDir dir;
+  // A quad (fan-triangulated) and a triangle with a repeated corner (dropped as degenerate).
+  gi::Scene s = gi::loadMeshFile(dir.write(
+      "a.ply", plyHeader(4, 2) + "0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n3 0 1 1\n"));
+  EXPECT_EQ(s.triangleCount(), 2u);
+  expectSaneScene(s);
+
+  std::string bin =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n"
+      "property float y\nproperty float z\nelement face 1\n"
+      "property list uchar int vertex_indices\nend_header\n";
+  const float xyz[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  bin.append(reinterpret_cast<const char*>(xyz), sizeof(xyz));
+  const unsigned char n = 3;
+  const int32_t idx[3] = {0, 1, 2};
+  bin.append(reinterpret_cast<const char*>(&n), 1);
+  bin.append(reinterpret_cast<const char*>(idx), sizeof(idx));
+  gi::Scene b = gi::loadMeshFile(dir.write("b.ply", bin));
+  EXPECT_EQ(b.triangleCount(), 1u);
+  EXPECT_NEAR(b.meshes[0].triangleAreas[0], 0.5f, 1e-6f);
+}
+
+TEST(SceneIo, PlyErrors) {
+  TempDir dir;
+  using K = gi::ErrorKind;
+  std::string p = dir.write("empty.ply", "");
+  expectError([&] { gi::loadScene(p); }, K::EmptyFile, p);
+  // OpenMesh alone never returns on a header cut short; we must.
+  p = dir.write("cut.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nprop");
+  expectError([&] { gi::loadScene(p); }, K::Parse, p);
+  p = dir.write("notply.ply", "hello\n");
+  expectError([&] { gi::loadScene(p); }, K::Parse, p);
+  p = dir.write("range.ply", plyHeader(3, 1) + "0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n");
+  expectError([&] { gi::loadScene(p); }, K::IndexOutOfRange, p, "7");
+  p = dir.write("truncated.ply", plyHeader(3, 2) + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  expectError([&] { gi::loadScene(p); }, K::Parse, p);
+  p = dir.write("huge.ply", plyHeader(1000000000, 1) + "0 0 0\n");
+  expectError([&] { gi::loadScene(p); }, K::Parse, p);
+  p = dir.write("points.ply", plyHeader(3, 0) + "0 0 0\n1 0 0\n0 1 0\n");
+  expectError([&] { gi::loadScene(p); }, K::InvalidData, p);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Built-in scene and defaults
+
+TEST(SceneIo, DefaultScene) {
+  gi::Scene s = gi::loadScene("default");
+  EXPECT_EQ(s.sourcePath, "default");
+  expectSaneScene(s);
+  ASSERT_EQ(s.cameras.size(), 1u);
+  EXPECT_GE(s.lights.size(), 1u);
+  EXPECT_EQ(s.environment.kind, gi::Environment::Kind::Sky);
+
+  // Walls, floor and ceiling face into the room; every mesh's winding matches its normals.
+  int emissiveQuads = 0;
+  for (const gi::Node& n : s.nodes) {
+    for (int mi : n.meshes) {
+      const gi::Mesh& m = s.meshes[mi];
+      for (size_t t = 0; t < m.triangleCount(); ++t) {
+        const gi::Vertex& a = m.vertices[m.indices[3 * t]];
+        glm::vec3 geo = glm::cross(m.vertices[m.indices[3 * t + 1]].position - a.position,
+                                   m.vertices[m.indices[3 * t + 2]].position - a.position);
+        ASSERT_GT(glm::dot(geo, a.normal), 0.0f) << m.name << " triangle " << t;
+      }
+      if (n.name.find("wall") != std::string::npos || n.name == "floor" || n.name == "ceiling") {
+        glm::vec3 p = glm::vec3(n.world * glm::vec4(m.vertices[0].position, 1.0f));
+        glm::vec3 normal = glm::mat3(n.world) * m.vertices[0].normal;
+        EXPECT_GT(glm::dot(normal, -p), 0.0f) << n.name;  // towards the room's centre
+      }
+      const gi::Material& mat = s.materials[m.material];
+      if (mat.emission.x > 0.0f) {
+        ++emissiveQuads;
+        EXPECT_EQ(m.triangleCount(), 2u);
+        glm::vec3 down = glm::mat3(n.world) * m.vertices[0].normal;
+        EXPECT_LT(down.y, -0.99f);  // shines down from the ceiling
+      }
+    }
+  }
+  EXPECT_EQ(emissiveQuads, 1);
+  EXPECT_GT(s.triangleCount(), 32u * 16u);  // the sphere alone has ~2 * 32 * 15
+
+  // The camera stands in front of the open side and sees the room's centre ahead.
+  gi::CameraView view = gi::activeCamera(s, 16.0f / 9.0f);
+  EXPECT_GT(view.position.z, 1.0f);
+  glm::vec3 centreInView = glm::vec3(view.view * glm::vec4(0, 0, 0, 1));
+  EXPECT_LT(centreInView.z, 0.0f);
+  EXPECT_NEAR(centreInView.x, 0.0f, 1e-4f);
+}
+
+TEST(SceneIo, DefaultCameraAndLightFrameTheModel) {
+  TempDir dir;
+  gi::Scene s = gi::loadMeshFile(
+      dir.write("t.obj", "v 10 0 0\nv 12 0 0\nv 10 2 0\nf 1 2 3\n"));
+  ASSERT_EQ(s.cameras.size(), 1u);
+  ASSERT_EQ(s.lights.size(), 1u);
+  EXPECT_TRUE(s.lights[0].castsShadows);
+  gi::CameraView view = gi::activeCamera(s, 1.0f);
+  glm::vec3 c = glm::vec3(view.view * glm::vec4(11, 1, 0, 1));  // bounds centre
+  EXPECT_NEAR(c.x, 0.0f, 1e-3f);
+  EXPECT_NEAR(c.y, 0.0f, 1e-3f);
+  EXPECT_LT(c.z, 0.0f);
+  EXPECT_GT(-c.z, view.znear);
+  EXPECT_LT(-c.z, view.zfar);
+  // The sun shines downwards (along its node's -z).
+  for (const gi::Node& n : s.nodes) {
+    if (n.light >= 0) {
+      EXPECT_LT((n.world * glm::vec4(0, 0, -1, 0)).y, -0.5f);
+    }
+  }
+
+  // Scenes that have both keep them.
+  size_t nodes = s.nodes.size();
+  gi::addDefaultCameraAndLight(s);
+  EXPECT_EQ(s.nodes.size(), nodes);
+}
+
+TEST(SceneIo, UnsupportedAndMissing) {
+  TempDir dir;
+  std::string p = dir.write("x.fbx", "data");
+  expectError([&] { gi::loadScene(p); }, gi::ErrorKind::Unsupported, p);
+  p = dir.path("nothing.gltf");
+  expectError([&] { gi::loadScene(p); }, gi::ErrorKind::FileNotFound, p);
+  p = dir.path("nothing.stl");
+  expectError([&] { gi::loadScene(p); }, gi::ErrorKind::FileNotFound, p);
+}
+
+}  // namespace
