@@ -47,7 +47,7 @@ struct Material {
 struct Camera {
   std::string name;
   float yfov = glm::radians(45.0f);  // radians
-  float aspect = 0.0f;               // 0: use the output's aspect
+  float aspect = 0.0f;               // as stored in the file; rendering uses the output's
   float znear = 0.05f;
   float zfar = 1000.0f;
 };

@@ -98,8 +98,9 @@ CameraView cameraFromNode(const Scene& scene, int nodeIndex, float aspect) {
   v.znear = std::max(cam.znear, 1e-6f);
   v.zfar = std::max(cam.zfar, v.znear * 2.0f);
   v.yfov = std::clamp(cam.yfov, 1e-3f, 3.1f);
-  float a = cam.aspect > 0.0f ? cam.aspect : aspect;
-  v.proj = perspectiveReverseZ(v.yfov, a, v.znear, v.zfar);
+  // The output's aspect wins over the file's: a glTF aspectRatio of 1 on a 4:3 image would
+  // stretch the picture. The vertical field of view is kept.
+  v.proj = perspectiveReverseZ(v.yfov, aspect, v.znear, v.zfar);
   return v;
 }
 
