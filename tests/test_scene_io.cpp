@@ -1,5 +1,6 @@
 // Scene loading: OBJ/PLY models, the built-in scene, JSON scene files and their errors.
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -261,8 +262,8 @@ std::string plyHeader(int vertices, int faces) {
 TEST(SceneIo, PlyAsciiAndBinary) {
   TempDir dir;
   // A quad (fan-triangulated) and a triangle with a repeated corner (dropped as degenerate).
-  gi::Scene s = gi::loadMeshFile(dir.write(
-      "a.ply", plyHeader(4, 2) + "0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n3 0 1 1\n"));
+  gi::Scene s = gi::loadMeshFile(
+      dir.write("a.ply", plyHeader(4, 2) + "0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n3 0 1 1\n"));
   EXPECT_EQ(s.triangleCount(), 2u);
   expectSaneScene(s);
 
@@ -350,8 +351,7 @@ TEST(SceneIo, DefaultScene) {
 
 TEST(SceneIo, DefaultCameraAndLightFrameTheModel) {
   TempDir dir;
-  gi::Scene s = gi::loadMeshFile(
-      dir.write("t.obj", "v 10 0 0\nv 12 0 0\nv 10 2 0\nf 1 2 3\n"));
+  gi::Scene s = gi::loadMeshFile(dir.write("t.obj", "v 10 0 0\nv 12 0 0\nv 10 2 0\nf 1 2 3\n"));
   ASSERT_EQ(s.cameras.size(), 1u);
   ASSERT_EQ(s.lights.size(), 1u);
   EXPECT_TRUE(s.lights[0].castsShadows);
@@ -383,6 +383,275 @@ TEST(SceneIo, UnsupportedAndMissing) {
   expectError([&] { gi::loadScene(p); }, gi::ErrorKind::FileNotFound, p);
   p = dir.path("nothing.stl");
   expectError([&] { gi::loadScene(p); }, gi::ErrorKind::FileNotFound, p);
+}
+
+// ---------------------------------------------------------------------------------------------
+// JSON scenes
+
+const char* kTriangleObj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+
+// World position of the model's first vertex (the node holding mesh `mesh`).
+glm::vec3 worldOfFirstVertex(const gi::Scene& s, int mesh) {
+  for (const gi::Node& n : s.nodes)
+    for (int m : n.meshes)
+      if (m == mesh) return glm::vec3(n.world * glm::vec4(s.meshes[m].vertices[0].position, 1));
+  ADD_FAILURE() << "no node holds mesh " << mesh;
+  return glm::vec3(NAN);
+}
+
+void expectVec(const glm::vec3& a, const glm::vec3& b, float eps = 1e-4f) {
+  EXPECT_NEAR(a.x, b.x, eps);
+  EXPECT_NEAR(a.y, b.y, eps);
+  EXPECT_NEAR(a.z, b.z, eps);
+}
+
+TEST(SceneIo, JsonSceneWithModelAndOverrides) {
+  TempDir dir;
+  dir.write("models/tri.obj", kTriangleObj);
+  const std::string path = dir.write("scene.json", R"({
+    // comments are allowed
+    "description": "test",
+    "models": [
+      { "file": "models/tri.obj", "name": "moved", "translation": [1, 2, 3], "scale": 2 },
+      { "file": "models/tri.obj", "rotation": [0, 90, 0] },
+      { "file": "models/tri.obj", "rotation": [0, 0, 0.7071068, 0.7071068], "scale": [1, 3, 1] },
+      { "primitive": "sphere", "radius": 0.5, "segments": 8, "rings": 4,
+        "material": { "name": "glow", "base_color": [1, 0, 0], "emission": [2, 2, 2] } },
+      { "primitive": "box", "size": [1, 2, 3], "translation": [0, -5, 0] },
+      { "primitive": "plane", "size": [4, 2] }
+    ],
+    "camera": { "position": [0, 1, 5], "target": [0, 1, 0], "yfov_deg": 60, "near": 0.5, "far": 50 },
+    "lights": [
+      { "type": "point", "position": [0, 3, 0], "color": [1, 0.5, 0.25], "intensity": 7, "range": 9 },
+      { "type": "spot", "position": [1, 1, 1], "direction": [0, 0, -1], "inner_cone_deg": 10,
+        "outer_cone_deg": 20, "casts_shadows": false },
+      { "type": "directional", "direction": [0, -1, 0] }
+    ],
+    "environment": { "type": "constant", "color": [0.1, 0.2, 0.3], "intensity": 2 },
+    "effects": [ "ssao", { "name": "ssdo", "settings": { "radius": 0.5, "bounce": true } } ]
+  })");
+  gi::Scene s = gi::loadScene(path);
+  expectSaneScene(s);
+  ASSERT_EQ(s.meshes.size(), 6u);
+  EXPECT_EQ(s.sourcePath, path);
+
+  // Vertex (0,0,0) scaled by 2 then moved; (0,0,0) of the rotated ones stays; check a corner.
+  expectVec(worldOfFirstVertex(s, 0), {1, 2, 3});
+  EXPECT_EQ(s.nodes[s.roots[0]].name, "moved");
+  EXPECT_EQ(s.nodes[s.roots[1]].name, "tri");  // defaults to the file's stem
+  // Second vertex (1,0,0): Euler 90 deg about y -> (0,0,-1); quaternion 90 deg about z after
+  // scaling y by 3 -> (0,1,0).
+  auto worldOf = [&](int mesh, int vertex) {
+    for (const gi::Node& n : s.nodes)
+      for (int m : n.meshes)
+        if (m == mesh)
+          return glm::vec3(n.world * glm::vec4(s.meshes[m].vertices[vertex].position, 1));
+    return glm::vec3(NAN);
+  };
+  expectVec(worldOf(1, 1), {0, 0, -1});
+  expectVec(worldOf(2, 1), {0, 1, 0});
+  // Primitives: a sphere with its material, a box of the given size, a plane.
+  const gi::Material& glow = s.materials[s.meshes[3].material];
+  EXPECT_EQ(glow.name, "glow");
+  EXPECT_EQ(glow.emission, glm::vec3(2));
+  expectVec(s.meshes[3].boundsMax, {0.5f, 0.5f, 0.5f});
+  expectVec(s.meshes[4].boundsMax, {0.5f, 1.0f, 1.5f});
+  expectVec(s.meshes[5].boundsMax, {2.0f, 0.0f, 1.0f});
+  EXPECT_EQ(s.meshes[4].triangleCount(), 12u);
+
+  // The JSON camera is the active one.
+  gi::CameraView view = gi::activeCamera(s, 1.0f);
+  expectVec(view.position, {0, 1, 5});
+  expectVec(glm::vec3(view.view * glm::vec4(0, 1, 0, 1)), {0, 0, -5});
+  EXPECT_NEAR(view.yfov, glm::radians(60.0f), 1e-5f);
+  EXPECT_FLOAT_EQ(view.znear, 0.5f);
+
+  ASSERT_EQ(s.lights.size(), 3u);  // no default sun added
+  EXPECT_EQ(s.lights[0].type, gi::LightType::Point);
+  EXPECT_FLOAT_EQ(s.lights[0].intensity, 7.0f);
+  EXPECT_FLOAT_EQ(s.lights[0].range, 9.0f);
+  EXPECT_EQ(s.lights[1].type, gi::LightType::Spot);
+  EXPECT_NEAR(s.lights[1].outerConeAngle, glm::radians(20.0f), 1e-6f);
+  EXPECT_FALSE(s.lights[1].castsShadows);
+  EXPECT_TRUE(s.lights[2].castsShadows);
+  for (const gi::Node& n : s.nodes) {
+    if (n.light == 1) {  // a spot pointing along -z from (1, 1, 1)
+      expectVec(glm::vec3(n.world[3]), {1, 1, 1});
+      expectVec(glm::vec3(n.world * glm::vec4(0, 0, -1, 0)), {0, 0, -1});
+    }
+    if (n.light == 2) expectVec(glm::vec3(n.world * glm::vec4(0, 0, -1, 0)), {0, -1, 0});
+  }
+  EXPECT_EQ(s.environment.kind, gi::Environment::Kind::Constant);
+  expectVec(s.environment.constantColor, {0.1f, 0.2f, 0.3f});
+  EXPECT_FLOAT_EQ(s.environment.intensity, 2.0f);
+  ASSERT_EQ(s.effects.size(), 2u);
+  EXPECT_EQ(s.effects[0].name, "ssao");
+  EXPECT_TRUE(s.effects[0].settings.empty());
+  EXPECT_EQ(s.effects[1].name, "ssdo");
+  EXPECT_EQ(s.effects[1].settings["radius"], 0.5);
+  EXPECT_EQ(s.effects[1].settings["bounce"], true);
+}
+
+TEST(SceneIo, JsonDefaultSceneAndDefaults) {
+  TempDir dir;
+  gi::Scene base = gi::makeDefaultScene();
+  gi::Scene s = gi::loadScene(
+      dir.write("s.json", R"({"include_default_scene": true, "models": [{"primitive": "box"}]})"));
+  EXPECT_EQ(s.meshes.size(), base.meshes.size() + 1);
+  EXPECT_EQ(s.lights.size(), base.lights.size());
+  EXPECT_EQ(s.nodes[s.activeCameraNode].name, "camera");  // the default scene's camera
+
+  // A bare model: framed camera and a sun are added.
+  dir.write("t.obj", kTriangleObj);
+  gi::Scene bare = gi::loadScene(dir.write("b.json", R"({"models": [{"file": "t.obj"}]})"));
+  EXPECT_EQ(bare.cameras.size(), 1u);
+  ASSERT_EQ(bare.lights.size(), 1u);
+  EXPECT_EQ(bare.lights[0].type, gi::LightType::Directional);
+  expectSaneScene(bare);
+}
+
+TEST(SceneIo, JsonPathVariables) {
+  TempDir dir;
+  const std::string engine =
+      gi::test::assimpModel("glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb");
+  if (fs::exists(engine)) {
+    gi::Scene s = gi::loadScene(dir.write(
+        "a.json",
+        R"({"models": [{"file": "${ASSIMP_MODELS}/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb"}]})"));
+    EXPECT_GT(s.triangleCount(), 1000u);
+  }
+  // ${GI_SHARED_ASSETS} from the environment variable.
+  dir.write("assets/t.obj", kTriangleObj);
+  ::setenv("GI_SHARED_ASSETS", dir.path("assets").c_str(), 1);
+  gi::Scene s =
+      gi::loadScene(dir.write("s.json", R"({"models": [{"file": "${GI_SHARED_ASSETS}/t.obj"}]})"));
+  ::unsetenv("GI_SHARED_ASSETS");
+  EXPECT_EQ(s.triangleCount(), 1u);
+  // ... and from a shared/assets folder above the scene file.
+  dir.write("shared/assets/u.obj", kTriangleObj);
+  gi::Scene u = gi::loadScene(
+      dir.write("deep/er/s.json", R"({"models": [{"file": "${GI_SHARED_ASSETS}/u.obj"}]})"));
+  EXPECT_EQ(u.triangleCount(), 1u);
+  const std::string bad = dir.write("v.json", R"({"models": [{"file": "${NOPE}/u.obj"}]})");
+  expectError([&] { gi::loadScene(bad); }, gi::ErrorKind::Schema, bad, "NOPE");
+}
+
+TEST(SceneIo, JsonErrors) {
+  TempDir dir;
+  using K = gi::ErrorKind;
+  dir.write("t.obj", kTriangleObj);
+  dir.write("broken.obj", "v 0 0 0\nf 1 2 3\n");
+  struct Case {
+    const char* name;
+    const char* json;
+    K kind;
+    const char* fragment;
+  };
+  const Case cases[] = {
+      {"unknown_top", R"({"model": []})", K::Schema, "model: unknown key"},
+      {"unknown_light",
+       R"({"lights": [{"type": "point", "position": [0, 0, 0], "colour": [1, 1, 1]}]})", K::Schema,
+       "lights[0].colour: unknown key"},
+      {"unknown_model_key", R"({"models": [{"file": "t.obj", "scal": 2}]})", K::Schema,
+       "models[0].scal: unknown key"},
+      {"unknown_effect_key", R"({"effects": [{"name": "ssao", "setting": {}}]})", K::Schema,
+       "effects[0].setting"},
+      {"wrong_type_intensity",
+       R"({"lights": [{"type": "point", "position": [0, 0, 0], "intensity": "bright"}]})",
+       K::Schema, "lights[0].intensity: expected a number"},
+      {"wrong_type_models", R"({"models": {"file": "t.obj"}})", K::Schema, "models"},
+      {"wrong_type_top", R"([1, 2])", K::Schema, "expected an object"},
+      {"wrong_length", R"({"camera": {"position": [0, 0], "target": [0, 0, 1]}})", K::Schema,
+       "camera.position"},
+      {"wrong_elem", R"({"camera": {"position": [0, "a", 0], "target": [0, 0, 1]}})", K::Schema,
+       "camera.position[1]"},
+      {"wrong_bool", R"({"include_default_scene": 1})", K::Schema, "include_default_scene"},
+      {"missing_key", R"({"camera": {"target": [0, 0, 1]}})", K::Schema,
+       "camera.position: missing required key"},
+      {"light_type", R"({"lights": [{"type": "area", "position": [0, 0, 0]}]})", K::Schema,
+       "lights[0].type"},
+      {"point_direction",
+       R"({"lights": [{"type": "point", "position": [0, 0, 0], "direction": [0, -1, 0]}]})",
+       K::Schema, "lights[0].direction"},
+      {"file_and_primitive", R"({"models": [{"file": "t.obj", "primitive": "box"}]})", K::Schema,
+       "models[0]"},
+      {"primitive_kind", R"({"models": [{"primitive": "torus"}]})", K::Schema, "torus"},
+      {"primitive_key", R"({"models": [{"primitive": "box", "radius": 1}]})", K::Schema,
+       "models[0].radius"},
+      {"env_key", R"({"environment": {"type": "sky", "color": [1, 1, 1]}})", K::Schema,
+       "environment.color"},
+      {"effect_type", R"({"effects": [3]})", K::Schema, "effects[0]"},
+      {"yfov", R"({"camera": {"position": [0, 0, 0], "target": [0, 0, 1], "yfov_deg": 0}})",
+       K::InvalidData, "camera.yfov_deg"},
+      {"same_target", R"({"camera": {"position": [0, 0, 0], "target": [0, 0, 0]}})", K::InvalidData,
+       "camera.target"},
+      {"negative_intensity",
+       R"({"lights": [{"type": "point", "position": [0, 0, 0], "intensity": -1}]})", K::InvalidData,
+       "lights[0].intensity"},
+      {"zero_scale", R"({"models": [{"file": "t.obj", "scale": [1, 0, 1]}]})", K::InvalidData,
+       "models[0].scale"},
+      {"nested_scene", R"({"models": [{"file": "other.json"}]})", K::MissingResource, "other.json"},
+      {"fbx", R"({"models": [{"file": "t.fbx"}]})", K::MissingResource, "t.fbx"},
+      {"invalid_json", "{\"models\": [\n  {\"file\": }\n]}", K::Parse, "line 2"},
+      {"trailing_comma", R"({"models": [],})", K::Parse, "line 1"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    const std::string path = dir.write(std::string(c.name) + ".json", c.json);
+    expectError([&] { gi::loadScene(path); }, c.kind, path, c.fragment);
+  }
+
+  // A model file that is missing: named along with the scene file.
+  std::string p = dir.write("missing_model.json", R"({"models": [{"file": "gone/none.obj"}]})");
+  expectError([&] { gi::loadScene(p); }, K::MissingResource, p, "none.obj");
+  // A model that exists but is not a model format.
+  dir.write("x.fbx", "data");
+  p = dir.write("fbx2.json", R"({"models": [{"file": "x.fbx"}]})");
+  expectError([&] { gi::loadScene(p); }, K::Unsupported, p, "x.fbx");
+  // A broken model keeps its own error kind and file, and names the scene too.
+  p = dir.write("broken_model.json", R"({"models": [{"file": "broken.obj"}]})");
+  expectError([&] { gi::loadScene(p); }, K::IndexOutOfRange, dir.path("broken.obj"),
+              "broken_model.json");
+  // Empty and missing scene files.
+  p = dir.write("empty.json", "");
+  expectError([&] { gi::loadScene(p); }, K::EmptyFile, p);
+  p = dir.write("blank.json", " \n\t\n");
+  expectError([&] { gi::loadScene(p); }, K::EmptyFile, p);
+  p = dir.path("nowhere.json");
+  expectError([&] { gi::loadScene(p); }, K::FileNotFound, p);
+  expectError([&] { gi::loadSceneJson(p); }, K::FileNotFound, p);
+}
+
+// The example scenes shipped in assets/scenes load and contain what they promise.
+TEST(SceneIo, ExampleScenes) {
+  const fs::path scenes = fs::path(GI_SOURCE_DIR) / "assets" / "scenes";
+  {
+    GI_REQUIRE_SHARED_ASSET(obj, "cornell_box/cornell_box.obj");
+    gi::Scene s = gi::loadScene((scenes / "cornell_box.json").string());
+    expectSaneScene(s);
+    EXPECT_EQ(s.triangleCount(), objTriangles(obj));
+    bool emissive = false;
+    for (const gi::Mesh& m : s.meshes) emissive |= s.materials[m.material].emission.x > 0.0f;
+    EXPECT_TRUE(emissive);
+    glm::vec3 bmin, bmax;
+    s.worldBounds(bmin, bmax);
+    EXPECT_NEAR(bmax.x, 5.56f, 1e-3f);  // scaled from millimetres
+  }
+  {
+    GI_REQUIRE_SHARED_ASSET(ply, "stanford_bunny/reconstruction/bun_zipper.ply");
+    gi::Scene s = gi::loadScene((scenes / "bunny_on_plane.json").string());
+    expectSaneScene(s);
+    EXPECT_EQ(s.triangleCount(), plyHeaderFaces(ply) + 2);  // + the ground plane
+    glm::vec3 bmin, bmax;
+    s.worldBounds(bmin, bmax);
+    EXPECT_NEAR(bmin.y, 0.0f, 1e-2f);  // the bunny stands on the plane
+  }
+  const std::string glb =
+      gi::test::assimpModel("glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb");
+  if (!fs::exists(glb)) GTEST_SKIP() << "assimp test models absent: " << glb;
+  gi::Scene s = gi::loadScene((scenes / "engine.json").string());
+  expectSaneScene(s);
+  EXPECT_GT(s.triangleCount(), 60000u);
 }
 
 }  // namespace

@@ -29,7 +29,9 @@ int addMeshNode(Scene& s, const std::string& name, Mesh mesh, int material,
   return node;
 }
 
-glm::mat4 translate(glm::vec3 t) { return glm::translate(glm::mat4(1.0f), t); }
+glm::mat4 translate(glm::vec3 t) {
+  return glm::translate(glm::mat4(1.0f), t);
+}
 glm::mat4 rotate(float degrees, glm::vec3 axis) {
   return glm::rotate(glm::mat4(1.0f), glm::radians(degrees), axis);
 }

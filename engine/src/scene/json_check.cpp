@@ -14,15 +14,22 @@ namespace {
 
 const char* typeName(const json& v) {
   switch (v.type()) {
-    case json::value_t::null: return "null";
-    case json::value_t::object: return "an object";
-    case json::value_t::array: return "an array";
-    case json::value_t::string: return "a string";
-    case json::value_t::boolean: return "a boolean";
+    case json::value_t::null:
+      return "null";
+    case json::value_t::object:
+      return "an object";
+    case json::value_t::array:
+      return "an array";
+    case json::value_t::string:
+      return "a string";
+    case json::value_t::boolean:
+      return "a boolean";
     case json::value_t::number_integer:
     case json::value_t::number_unsigned:
-    case json::value_t::number_float: return "a number";
-    default: return "an unsupported value";
+    case json::value_t::number_float:
+      return "a number";
+    default:
+      return "an unsupported value";
   }
 }
 
@@ -50,8 +57,8 @@ void JsonObject::invalid(const std::string& key, const std::string& problem) con
 
 void JsonObject::allowOnly(std::initializer_list<const char*> allowed) const {
   for (const auto& item : value_.items()) {
-    bool known = std::any_of(allowed.begin(), allowed.end(),
-                             [&](const char* k) { return item.key() == k; });
+    bool known =
+        std::any_of(allowed.begin(), allowed.end(), [&](const char* k) { return item.key() == k; });
     if (!known) {
       std::string list;
       for (const char* k : allowed) list += (list.empty() ? "" : ", ") + std::string(k);

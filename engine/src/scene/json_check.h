@@ -32,7 +32,8 @@ class JsonObject {
   std::optional<int> integer(const char* key) const;
   std::optional<glm::vec3> vec3(const char* key) const;  // [x, y, z]
   // A list of 1..4 numbers; `sizes` names the accepted lengths for the message.
-  std::optional<std::vector<float>> numbers(const char* key, std::initializer_list<size_t> sizes) const;
+  std::optional<std::vector<float>> numbers(const char* key,
+                                            std::initializer_list<size_t> sizes) const;
 
   // Required variants: Schema error "<path>: missing required key" when absent.
   std::string requireString(const char* key) const;

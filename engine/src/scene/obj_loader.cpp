@@ -83,15 +83,18 @@ glm::vec<N, float> readVec(const std::vector<std::string_view>& tok, const LineE
   glm::vec<N, float> v(0.0f);
   // Messages are built with append: GCC 12 warns falsely (-Wrestrict) on "'" + string + ...
   if (static_cast<int>(tok.size()) - 1 < required)
-    err.fail(ErrorKind::Parse, std::string(tok[0]).append(" needs ")
-                                   .append(std::to_string(required)).append(" numbers"));
+    err.fail(
+        ErrorKind::Parse,
+        std::string(tok[0]).append(" needs ").append(std::to_string(required)).append(" numbers"));
   for (int i = 0; i < N && i + 1 < static_cast<int>(tok.size()); ++i)
     if (!parseFloat(tok[i + 1], v[i]))
       err.fail(ErrorKind::Parse, std::string(tok[i + 1]).append(" is not a number"));
   return v;
 }
 
-bool nonZero(const glm::vec3& v) { return v.x > 0.0f || v.y > 0.0f || v.z > 0.0f; }
+bool nonZero(const glm::vec3& v) {
+  return v.x > 0.0f || v.y > 0.0f || v.z > 0.0f;
+}
 
 std::string lower(std::string s) {
   std::transform(s.begin(), s.end(), s.begin(),
@@ -167,7 +170,8 @@ Material toMaterial(const MtlEntry& e) {
       m.emission = e.ka;
   }
   // Blinn-Phong exponent -> GGX-style roughness (the usual sqrt(2 / (Ns + 2)) mapping).
-  if (e.hasNs) m.roughness = std::clamp(std::sqrt(2.0f / (std::max(e.ns, 0.0f) + 2.0f)), 0.02f, 1.0f);
+  if (e.hasNs)
+    m.roughness = std::clamp(std::sqrt(2.0f / (std::max(e.ns, 0.0f) + 2.0f)), 0.02f, 1.0f);
   return m;
 }
 
@@ -243,8 +247,8 @@ class ObjReader {
   // Resolves an OBJ index (1-based, or negative relative to the end) against `count` items.
   long resolve(std::string_view s, size_t count, const char* what, const LineError& err) {
     long i = 0;
-    if (!parseInt(s, i)) err.fail(ErrorKind::Parse, "bad " + std::string(what) + " index '" +
-                                                        std::string(s) + "'");
+    if (!parseInt(s, i))
+      err.fail(ErrorKind::Parse, "bad " + std::string(what) + " index '" + std::string(s) + "'");
     long resolved = i > 0 ? i - 1 : static_cast<long>(count) + i;
     if (i == 0 || resolved < 0 || resolved >= static_cast<long>(count))
       err.fail(ErrorKind::IndexOutOfRange, std::string(what) + " index " + std::to_string(i) +
@@ -358,6 +362,8 @@ class ObjReader {
 
 }  // namespace
 
-MeshFileData readObj(const std::string& path) { return ObjReader(path).read(); }
+MeshFileData readObj(const std::string& path) {
+  return ObjReader(path).read();
+}
 
 }  // namespace gi::detail

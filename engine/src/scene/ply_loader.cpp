@@ -46,8 +46,8 @@ struct PlyHeader {
 size_t scalarSize(const std::string& type) {
   if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
   if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
-  if (type == "int" || type == "uint" || type == "float" || type == "int32" ||
-      type == "uint32" || type == "float32")
+  if (type == "int" || type == "uint" || type == "float" || type == "int32" || type == "uint32" ||
+      type == "float32")
     return 4;
   if (type == "double" || type == "float64") return 8;
   return 0;
@@ -116,7 +116,8 @@ PlyHeader readHeader(const std::string& path) {
   if (!ended) throw Error(ErrorKind::Parse, path, "PLY header has no end_header line");
   if (!sawFormat) throw Error(ErrorKind::Parse, path, "PLY header has no format line");
   if (h.faceCount == 0)
-    throw Error(ErrorKind::InvalidData, path, "PLY has no faces (a point cloud cannot be rendered)");
+    throw Error(ErrorKind::InvalidData, path,
+                "PLY has no faces (a point cloud cannot be rendered)");
   return h;
 }
 
@@ -172,8 +173,8 @@ void checkAsciiBody(const std::string& path, const PlyHeader& h) {
         }
         const double n = next(e, i, true);
         if (n < 0 || n > 1e6)
-          throw Error(ErrorKind::Parse, path, "bad list length in " + e.name + " " +
-                                                  std::to_string(i));
+          throw Error(ErrorKind::Parse, path,
+                      "bad list length in " + e.name + " " + std::to_string(i));
         for (size_t k = 0; k < static_cast<size_t>(n); ++k) next(e, i, false);
       }
     }
@@ -260,17 +261,20 @@ MeshFileData readPly(const std::string& path) {
                 "face " + std::to_string(importer.badFace) + " uses vertex index " +
                     std::to_string(importer.badIndex) + " but there are only " +
                     std::to_string(importer.vertices) + " vertices");
-  if (!ok) throw Error(ErrorKind::Parse, path, "OpenMesh cannot read it" + (why.empty() ? "" : ": " + why));
+  if (!ok)
+    throw Error(ErrorKind::Parse, path,
+                "OpenMesh cannot read it" + (why.empty() ? "" : ": " + why));
   if (importer.vertices < header.vertexCount || importer.facesSeen < header.faceCount)
     throw Error(ErrorKind::Parse, path,
                 "file ends early: read " + std::to_string(importer.vertices) + " of " +
                     std::to_string(header.vertexCount) + " vertices and " +
-                    std::to_string(importer.facesSeen) + " of " +
-                    std::to_string(header.faceCount) + " faces");
+                    std::to_string(importer.facesSeen) + " of " + std::to_string(header.faceCount) +
+                    " faces");
   if (importer.shortFaces)
     throw Error(ErrorKind::Parse, path,
-                std::to_string(importer.shortFaces) + " faces have fewer than 3 vertices "
-                                                      "(malformed face data)");
+                std::to_string(importer.shortFaces) +
+                    " faces have fewer than 3 vertices "
+                    "(malformed face data)");
 
   MeshFileData data;
   Mesh mesh;

@@ -68,8 +68,10 @@ Mesh makeSphere(float radius, int segments, int rings) {
     const float theta = glm::pi<float>() * static_cast<float>(r) / static_cast<float>(rings);
     for (int s = 0; s <= segments; ++s) {
       const float phi = glm::two_pi<float>() * static_cast<float>(s) / static_cast<float>(segments);
-      glm::vec3 n(std::sin(theta) * std::cos(phi), std::cos(theta), std::sin(theta) * std::sin(phi));
-      m.vertices.push_back(Vertex{radius * n, n,
+      glm::vec3 n(std::sin(theta) * std::cos(phi), std::cos(theta),
+                  std::sin(theta) * std::sin(phi));
+      m.vertices.push_back(Vertex{radius * n,
+                                  n,
                                   {static_cast<float>(s) / static_cast<float>(segments),
                                    static_cast<float>(r) / static_cast<float>(rings)}});
     }
@@ -78,8 +80,8 @@ Mesh makeSphere(float radius, int segments, int rings) {
   for (int r = 0; r < rings; ++r) {
     for (int s = 0; s < segments; ++s) {
       const uint32_t a = at(r, s), b = at(r, s + 1), c = at(r + 1, s + 1), d = at(r + 1, s);
-      const glm::vec3 out = m.vertices[a].normal + m.vertices[b].normal +
-                            m.vertices[c].normal + m.vertices[d].normal;
+      const glm::vec3 out =
+          m.vertices[a].normal + m.vertices[b].normal + m.vertices[c].normal + m.vertices[d].normal;
       if (r > 0) addTriangle(m, a, b, c, out);          // the top row's is degenerate (pole)
       if (r + 1 < rings) addTriangle(m, a, c, d, out);  // the bottom row's likewise
     }

@@ -27,8 +27,7 @@ MeshFileData readPly(const std::string& path);
 // Runs processMesh over every mesh (reporting repairs as scene warnings), removes meshes left
 // without triangles, and places one root node per mesh. Throws NonFinite/InvalidData (naming
 // `path`) when no triangle survives. Does not add cameras or lights.
-void addProcessedMeshes(Scene& scene, std::vector<Mesh> meshes, const std::string& path,
-                        bool weld);
+void addProcessedMeshes(Scene& scene, std::vector<Mesh> meshes, const std::string& path, bool weld);
 
 // loadMeshFile without the default camera and light (for models placed by a JSON scene).
 Scene loadMeshFileOnly(const std::string& path);
@@ -39,8 +38,8 @@ Scene loadMeshFileOnly(const std::string& path);
 void mergeScene(Scene& scene, Scene model, const std::string& name, const glm::mat4& transform);
 
 // Built-in primitives (object space, y up, outward normals, uv in [0,1]), already processed.
-Mesh makePlane(float sizeX, float sizeZ);           // in y = 0, facing +y, centred
-Mesh makeBox(const glm::vec3& size);                // centred at the origin
+Mesh makePlane(float sizeX, float sizeZ);                // in y = 0, facing +y, centred
+Mesh makeBox(const glm::vec3& size);                     // centred at the origin
 Mesh makeSphere(float radius, int segments, int rings);  // UV sphere centred at the origin
 
 }  // namespace gi::detail

@@ -8,7 +8,8 @@
 //   "include_default_scene": false,        // start from the built-in Cornell-box room
 //   "models": [                            // each becomes a root node with this transform
 //     { "file": "model.gltf",              // .gltf .glb .obj .ply; relative to this file's folder,
-//                                          // or starting with ${GI_SHARED_ASSETS} / ${ASSIMP_MODELS}
+//                                          // or starting with ${GI_SHARED_ASSETS} /
+//                                          ${ASSIMP_MODELS}
 //       "name": "engine",
 //       "translation": [0, 0, 0],
 //       "rotation": [0, 0, 0, 1],          // quaternion [x, y, z, w], or Euler degrees [x, y, z]
@@ -76,13 +77,14 @@ fs::path expandModelPath(const std::string& file, const fs::path& sceneDir, cons
   const std::string var = file.substr(2, close - 2);
   std::string rest = file.substr(close + 1);
   while (!rest.empty() && (rest.front() == '/' || rest.front() == '\\')) rest.erase(0, 1);
-  if (const char* env = std::getenv(var.c_str()); env && *env && (var == "GI_SHARED_ASSETS" ||
-                                                                   var == "ASSIMP_MODELS"))
+  if (const char* env = std::getenv(var.c_str());
+      env && *env && (var == "GI_SHARED_ASSETS" || var == "ASSIMP_MODELS"))
     return fs::path(env) / rest;
   if (var == "ASSIMP_MODELS") return fs::path("/usr/share/assimp/models") / rest;
   if (var == "GI_SHARED_ASSETS") {
     std::error_code ec;
-    for (fs::path dir = fs::absolute(sceneDir, ec); !dir.empty(); dir = dir.parent_path()) {
+    const fs::path start = fs::weakly_canonical(sceneDir.empty() ? fs::path(".") : sceneDir, ec);
+    for (fs::path dir = start; !dir.empty(); dir = dir.parent_path()) {
       if (fs::is_directory(dir / "shared" / "assets", ec)) return dir / "shared" / "assets" / rest;
       if (dir == dir.parent_path()) break;
     }
@@ -91,8 +93,8 @@ fs::path expandModelPath(const std::string& file, const fs::path& sceneDir, cons
                     "': no shared/assets folder above the scene file and GI_SHARED_ASSETS is "
                     "not set");
   }
-  o.schemaError("file", "unknown variable '${" + var +
-                            "}' (known: ${GI_SHARED_ASSETS}, ${ASSIMP_MODELS})");
+  o.schemaError("file",
+                "unknown variable '${" + var + "}' (known: ${GI_SHARED_ASSETS}, ${ASSIMP_MODELS})");
 }
 
 glm::mat4 readTransform(const JsonObject& o) {
@@ -391,7 +393,9 @@ class SceneJsonLoader {
 
 }  // namespace
 
-Scene loadSceneJson(const std::string& path) { return SceneJsonLoader(path).load(); }
+Scene loadSceneJson(const std::string& path) {
+  return SceneJsonLoader(path).load();
+}
 
 Scene loadScene(const std::string& pathOrDefault) {
   if (pathOrDefault == "default") return makeDefaultScene();
@@ -407,8 +411,9 @@ Scene loadScene(const std::string& pathOrDefault) {
     return s;
   }
   throw Error(ErrorKind::Unsupported, pathOrDefault,
-              "unsupported scene format '" + ext + "' (.json, .gltf, .glb, .obj, .ply or "
-                                                   "\"default\")");
+              "unsupported scene format '" + ext +
+                  "' (.json, .gltf, .glb, .obj, .ply or "
+                  "\"default\")");
 }
 
 }  // namespace gi
