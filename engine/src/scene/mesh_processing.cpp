@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <iterator>
 #include <limits>
 #include <unordered_map>
 
@@ -71,7 +72,8 @@ void compactVertices(Mesh& mesh) {
 size_t weldVertices(Mesh& mesh) {
   struct Key {
     float v[8];
-    bool operator==(const Key& o) const { return std::memcmp(v, o.v, sizeof(v)) == 0; }
+    // Values are finite and -0 is folded into +0, so equal values have equal bits (hash).
+    bool operator==(const Key& o) const { return std::equal(std::begin(v), std::end(v), o.v); }
   };
   struct KeyHash {
     size_t operator()(const Key& k) const {
@@ -156,7 +158,11 @@ MeshFixReport processMesh(Mesh& mesh, bool weld) {
       OmMesh::FaceHandle fh = om.add_face(handles[idx[0]], handles[idx[1]], handles[idx[2]]);
       if (!fh.is_valid()) {
         OmMesh::VertexHandle copies[3];
-        for (int k = 0; k < 3; ++k) copies[k] = om.add_vertex(om.point(handles[idx[k]]));
+        for (int k = 0; k < 3; ++k) {
+          // Copy first: add_vertex may grow the point array that om.point() refers into.
+          const OmMesh::Point p = om.point(handles[idx[k]]);
+          copies[k] = om.add_vertex(p);
+        }
         fh = om.add_face(copies[0], copies[1], copies[2]);
       }
       faces[t] = fh;
