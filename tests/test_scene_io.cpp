@@ -86,6 +86,8 @@ void expectSaneScene(const gi::Scene& s) {
   EXPECT_FALSE(s.lights.empty());
 }
 
+const char* kTriangleObj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+
 // Triangles a fan triangulation makes of the OBJ's faces, counted from the text.
 size_t objTriangles(const std::string& path) {
   std::ifstream in(path);
@@ -253,6 +255,18 @@ TEST(SceneIo, ObjNaNTrianglesDroppedWithWarning) {
   expectSaneScene(s);
 }
 
+TEST(SceneIo, ObjNormalWarningsOnlyForInvalidNormals) {
+  TempDir dir;
+  // Absent normals are computed silently; a NaN normal is repaired with a warning.
+  gi::Scene quiet = gi::loadMeshFile(dir.write("a.obj", kTriangleObj));
+  EXPECT_TRUE(quiet.warnings.empty());
+  gi::Scene loud = gi::loadMeshFile(
+      dir.write("b.obj", std::string(kTriangleObj) + "vn nan 0 0\nvn 0 0 1\nf 1//1 2//2 3//2\n"));
+  ASSERT_EQ(loud.warnings.size(), 1u);
+  EXPECT_NE(loud.warnings[0].find("1 invalid"), std::string::npos) << loud.warnings[0];
+  expectSaneScene(loud);
+}
+
 std::string plyHeader(int vertices, int faces) {
   return "ply\nformat ascii 1.0\ncomment test\nelement vertex " + std::to_string(vertices) +
          "\nproperty float x\nproperty float y\nproperty float z\nelement face " +
@@ -387,8 +401,6 @@ TEST(SceneIo, UnsupportedAndMissing) {
 
 // ---------------------------------------------------------------------------------------------
 // JSON scenes
-
-const char* kTriangleObj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
 
 // World position of the model's first vertex (the node holding mesh `mesh`).
 glm::vec3 worldOfFirstVertex(const gi::Scene& s, int mesh) {

@@ -39,6 +39,10 @@ void addProcessedMeshes(Scene& scene, std::vector<Mesh> meshes, const std::strin
                         bool weld) {
   size_t kept = 0, nonFinite = 0;
   for (Mesh& mesh : meshes) {
+    // Readers mark absent normals as (0,0,0): computing those is routine, not worth a warning.
+    const size_t absentNormals = static_cast<size_t>(
+        std::count_if(mesh.vertices.begin(), mesh.vertices.end(),
+                      [](const Vertex& v) { return v.normal == glm::vec3(0.0f); }));
     MeshFixReport r = processMesh(mesh, weld);
     nonFinite += r.droppedNonFiniteTriangles;
     const std::string who = path + ": mesh '" + mesh.name + "': ";
@@ -48,9 +52,10 @@ void addProcessedMeshes(Scene& scene, std::vector<Mesh> meshes, const std::strin
     if (r.droppedDegenerateTriangles)
       scene.warnings.push_back(who + "dropped " + std::to_string(r.droppedDegenerateTriangles) +
                                " degenerate triangles");
-    if (r.recomputedNormals)
-      scene.warnings.push_back(who + "computed " + std::to_string(r.recomputedNormals) +
-                               " missing or invalid vertex normals");
+    if (r.recomputedNormals > absentNormals)
+      scene.warnings.push_back(who + "recomputed " +
+                               std::to_string(r.recomputedNormals - absentNormals) +
+                               " invalid (NaN/Inf) vertex normals");
     if (mesh.triangleCount() == 0) {
       scene.warnings.push_back(who + "no usable triangles left, mesh skipped");
       continue;
