@@ -16,7 +16,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string render(const std::string& scene, const std::string& out, const std::string& extra = "") {
+std::string render(const std::string& scene, const std::string& out,
+                   const std::string& extra = "") {
   return test::binPath("gi-render") + " --validation --width 160 --height 120 --scene '" + scene +
          "' --out '" + out + "' " + extra;
 }
@@ -29,7 +30,8 @@ TEST(Cli, DefaultSceneRendersDeterministically) {
   ASSERT_EQ(b.exitCode, 0) << b.output;
   EXPECT_EQ(a.output.find("validation"), std::string::npos) << a.output;
   for (const char* pass : {"gbuffer", "lighting", "tonemap", "floor"})
-    EXPECT_NE(a.output.find(pass), std::string::npos) << "timing table lacks " << pass << "\n" << a.output;
+    EXPECT_NE(a.output.find(pass), std::string::npos) << "timing table lacks " << pass << "\n"
+                                                      << a.output;
   ImageRGBA8 ia = readPng(dir + "/a.png"), ib = readPng(dir + "/b.png");
   ASSERT_EQ(ia.width, 160);
   ASSERT_EQ(ia.height, 120);
@@ -118,7 +120,8 @@ TEST(Cli, BadNormalsAreRepairedNotNaN) {
 
 TEST(Cli, InfinitePositionsNeverRenderNaN) {
   const std::string dir = test::makeTempDir("cli-infinites");
-  const std::string model = test::assimpModel("glTF2/BoxWithInfinites-glTF-Binary/BoxWithInfinites.glb");
+  const std::string model =
+      test::assimpModel("glTF2/BoxWithInfinites-glTF-Binary/BoxWithInfinites.glb");
   auto r = test::runCommand(render(model, dir + "/lit.pfm"));
   if (r.exitCode != 0) {  // rejected: then with a clear message and no output
     EXPECT_NE(r.output.find("BoxWithInfinites"), std::string::npos) << r.output;

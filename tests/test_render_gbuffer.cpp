@@ -20,7 +20,8 @@ Mesh makeQuad(float half) {
   Mesh m;
   m.name = "quad";
   for (auto [x, y] : {std::pair{-1.f, -1.f}, {1.f, -1.f}, {1.f, 1.f}, {-1.f, 1.f}})
-    m.vertices.push_back({glm::vec3(x * half, y * half, 0), glm::vec3(0, 0, 1), glm::vec2(x, y) * 0.5f + 0.5f});
+    m.vertices.push_back(
+        {glm::vec3(x * half, y * half, 0), glm::vec3(0, 0, 1), glm::vec2(x, y) * 0.5f + 0.5f});
   m.indices = {0, 1, 2, 0, 2, 3};
   m.boundsMin = glm::vec3(-half, -half, 0);
   m.boundsMax = glm::vec3(half, half, 0);
@@ -147,8 +148,8 @@ TEST_F(GBufferTest, NoNanAtGrazingAngleAndExtremeClipPlanes) {
   rs.height = 120;
   Renderer r(ctx(), scene, rs);
   r.renderFrame();
-  for (Target t : {Target::Depth, Target::Normal, Target::Albedo, Target::Material, Target::Emission,
-                   Target::Motion, Target::Lit, Target::Output})
+  for (Target t : {Target::Depth, Target::Normal, Target::Albedo, Target::Material,
+                   Target::Emission, Target::Motion, Target::Lit, Target::Output})
     EXPECT_TRUE(allFinite(r.readTarget(t))) << "target " << int(t);
 }
 

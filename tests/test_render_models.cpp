@@ -28,7 +28,8 @@ class ModelRenderTest : public test::VulkanTest {
     r.renderFrame();
     Coverage c;
     ImageRGBA32F normal = r.readTarget(Target::Normal);
-    for (size_t i = 0; i < normal.pixels.size(); i += 4) c.geometryPixels += normal.pixels[i + 3] > 0.5f;
+    for (size_t i = 0; i < normal.pixels.size(); i += 4)
+      c.geometryPixels += normal.pixels[i + 3] > 0.5f;
     c.totalPixels = normal.pixels.size() / 4;
     for (Target t : {Target::Depth, Target::Normal, Target::Lit})
       for (float v : r.readTarget(t).pixels) c.finite = c.finite && std::isfinite(v);
@@ -69,7 +70,9 @@ TEST_F(ModelRenderTest, StanfordBunnyPly) {
   expectRenders(path);
 }
 
-TEST_F(ModelRenderTest, DefaultScene) { expectRenders("default"); }
+TEST_F(ModelRenderTest, DefaultScene) {
+  expectRenders("default");
+}
 
 TEST_F(ModelRenderTest, BoxTexturedShowsItsTexture) {
   Scene scene = loadScene(test::assimpModel("glTF2/BoxTextured-glTF/BoxTextured.gltf"));
@@ -85,10 +88,13 @@ TEST_F(ModelRenderTest, BoxTexturedShowsItsTexture) {
   std::set<int> texturedColours, plainColours;
   for (size_t i = 0; i < textured.pixels.size(); i += 4) {
     if (plain.pixels[i + 3] == 0.0f) continue;
-    float d = std::abs(textured.pixels[i] - plain.pixels[i]) + std::abs(textured.pixels[i + 1] - plain.pixels[i + 1]) +
+    float d = std::abs(textured.pixels[i] - plain.pixels[i]) +
+              std::abs(textured.pixels[i + 1] - plain.pixels[i + 1]) +
               std::abs(textured.pixels[i + 2] - plain.pixels[i + 2]);
     differing += d > 0.05f;
-    auto key = [](const float* p) { return int(p[0] * 31) << 10 | int(p[1] * 31) << 5 | int(p[2] * 31); };
+    auto key = [](const float* p) {
+      return int(p[0] * 31) << 10 | int(p[1] * 31) << 5 | int(p[2] * 31);
+    };
     texturedColours.insert(key(&textured.pixels[i]));
     plainColours.insert(key(&plain.pixels[i]));
   }

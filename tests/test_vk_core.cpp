@@ -77,7 +77,8 @@ TEST_F(VkCoreTest, RuntimeGlslCompilesEngineShaders) {
 }
 
 TEST_F(VkCoreTest, RuntimeGlslErrorNamesSourceAndLine) {
-  const std::string bad = "#version 460\nlayout(local_size_x = 1) in;\nvoid main() { undefinedThing = 1; }\n";
+  const std::string bad =
+      "#version 460\nlayout(local_size_x = 1) in;\nvoid main() { undefinedThing = 1; }\n";
   try {
     vk::compileGlsl(bad, VK_SHADER_STAGE_COMPUTE_BIT, "broken.comp");
     FAIL() << "expected a compilation error";
@@ -125,7 +126,10 @@ TEST(PipelineCache, WrittenToDiskAndReloaded) {
     EXPECT_GE(header.headerSize, 32u);
   }
   // A corrupt cache file is ignored, not trusted.
-  { std::ofstream(path, std::ios::binary) << "garbage that is not a pipeline cache header at all......"; }
+  {
+    std::ofstream(path, std::ios::binary)
+        << "garbage that is not a pipeline cache header at all......";
+  }
   auto ctx = makeContext();
   EXPECT_EQ(ctx->validationErrors(), 0u);
   std::filesystem::remove(path);

@@ -33,7 +33,8 @@ const char* kUsage =
     "  --time T               animation clock in seconds (default 0)\n"
     "  --timings              print the median GPU time of each pass and peak memory\n"
     "  --view TARGET          write a raw target instead of the final image:\n"
-    "                         output, lit, depth, normal, albedo, material, emission, motion, floor\n"
+    "                         output, lit, depth, normal, albedo, material, emission, motion, "
+    "floor\n"
     "  --exposure E           exposure before tonemapping (default 1)\n"
     "  --validation           enable Vulkan validation layers (also GI_VALIDATION=1)\n"
     "  --device NAME          pick the Vulkan device by name or index (also GI_DEVICE)\n";
@@ -72,19 +73,32 @@ Options parseArgs(int argc, char** argv) {
     if (a == "--help" || a == "-h") {
       std::fputs(kUsage, stdout);
       std::exit(0);
-    } else if (a == "--scene") o.scene = value();
-    else if (a == "--out") o.out = value();
-    else if (a == "--width") o.width = uint32_t(parseNumber(a, value(), 1, 16384));
-    else if (a == "--height") o.height = uint32_t(parseNumber(a, value(), 1, 16384));
-    else if (a == "--frames") o.frames = int(parseNumber(a, value(), 1, 100000));
-    else if (a == "--time") o.time = parseNumber(a, value(), -1e9, 1e9);
-    else if (a == "--exposure") o.exposure = float(parseNumber(a, value(), 0, 1e6));
-    else if (a == "--view") o.view = value();
-    else if (a == "--device") o.device = value();
-    else if (a == "--timings") o.timings = true;
-    else if (a == "--validation") o.validation = true;
-    else if (a == "--window") o.window = true;
-    else usageError("unknown argument '" + a + "'");
+    } else if (a == "--scene")
+      o.scene = value();
+    else if (a == "--out")
+      o.out = value();
+    else if (a == "--width")
+      o.width = uint32_t(parseNumber(a, value(), 1, 16384));
+    else if (a == "--height")
+      o.height = uint32_t(parseNumber(a, value(), 1, 16384));
+    else if (a == "--frames")
+      o.frames = int(parseNumber(a, value(), 1, 100000));
+    else if (a == "--time")
+      o.time = parseNumber(a, value(), -1e9, 1e9);
+    else if (a == "--exposure")
+      o.exposure = float(parseNumber(a, value(), 0, 1e6));
+    else if (a == "--view")
+      o.view = value();
+    else if (a == "--device")
+      o.device = value();
+    else if (a == "--timings")
+      o.timings = true;
+    else if (a == "--validation")
+      o.validation = true;
+    else if (a == "--window")
+      o.window = true;
+    else
+      usageError("unknown argument '" + a + "'");
   }
   if (o.scene.empty()) usageError("--scene is required");
   if (o.out.empty() && !o.window) usageError("--out is required (or --window)");
@@ -93,9 +107,11 @@ Options parseArgs(int argc, char** argv) {
 
 gi::Target parseView(const std::string& v) {
   static const std::map<std::string, gi::Target> views = {
-      {"output", gi::Target::Output}, {"lit", gi::Target::Lit},         {"depth", gi::Target::Depth},
-      {"normal", gi::Target::Normal}, {"albedo", gi::Target::Albedo},   {"material", gi::Target::Material},
-      {"emission", gi::Target::Emission}, {"motion", gi::Target::Motion}, {"floor", gi::Target::Floor}};
+      {"output", gi::Target::Output},     {"lit", gi::Target::Lit},
+      {"depth", gi::Target::Depth},       {"normal", gi::Target::Normal},
+      {"albedo", gi::Target::Albedo},     {"material", gi::Target::Material},
+      {"emission", gi::Target::Emission}, {"motion", gi::Target::Motion},
+      {"floor", gi::Target::Floor}};
   auto it = views.find(v);
   if (it == views.end()) usageError("unknown --view '" + v + "'");
   return it->second;
@@ -130,7 +146,8 @@ int run(const Options& o) {
   const gi::Target view = parseView(o.view);
   // Load (and validate) the scene before any Vulkan work, so bad input fails fast.
   gi::Scene scene = gi::loadScene(o.scene);
-  for (const std::string& w : scene.warnings) std::fprintf(stderr, "gi-render: warning: %s\n", w.c_str());
+  for (const std::string& w : scene.warnings)
+    std::fprintf(stderr, "gi-render: warning: %s\n", w.c_str());
 
   gi::vk::ContextOptions ctxOptions = gi::vk::ContextOptions::fromEnvironment();
   ctxOptions.validation = o.validation;
@@ -164,8 +181,8 @@ int run(const Options& o) {
   if (rendered > 0 && !o.out.empty()) writeImage(o.out, view, renderer);
 
   if (o.timings && rendered > 0) {
-    std::printf("scene %s, %ux%u, %zu triangles, %d frame(s), device %s\n", o.scene.c_str(), o.width,
-                o.height, scene.triangleCount(), rendered, ctx.deviceName().c_str());
+    std::printf("scene %s, %ux%u, %zu triangles, %d frame(s), device %s\n", o.scene.c_str(),
+                o.width, o.height, scene.triangleCount(), rendered, ctx.deviceName().c_str());
     std::printf("%-12s %12s\n", "pass", "median ms");
     double total = 0;
     for (const std::string& name : renderer.passNames()) {
@@ -181,7 +198,8 @@ int run(const Options& o) {
     std::printf("peak memory %.1f MiB\n", usage.ru_maxrss / 1024.0);
   }
   if (ctx.validationErrors() > 0) {
-    std::fprintf(stderr, "gi-render: error: %u Vulkan validation error(s)\n", ctx.validationErrors());
+    std::fprintf(stderr, "gi-render: error: %u Vulkan validation error(s)\n",
+                 ctx.validationErrors());
     return 3;
   }
   if (rendered > 0 && !o.out.empty()) std::printf("wrote %s\n", o.out.c_str());

@@ -17,7 +17,8 @@ std::string binPath(const std::string& name);
 }  // namespace gi::test
 
 // Skips the current test with a printed reason when ../shared/assets is missing.
-#define GI_REQUIRE_SHARED_ASSET(var, rel)                                               \
-  const std::string var = ::gi::test::sharedAsset(rel);                                 \
-  if (var.empty()) GTEST_SKIP() << "shared assets folder absent (" GI_SHARED_ASSETS     \
-                                   "): skipping test that needs " rel;
+#define GI_REQUIRE_SHARED_ASSET(var, rel)                            \
+  const std::string var = ::gi::test::sharedAsset(rel);              \
+  if (var.empty())                                                   \
+    GTEST_SKIP() << "shared assets folder absent (" GI_SHARED_ASSETS \
+                    "): skipping test that needs " rel;

@@ -16,12 +16,17 @@ void VulkanTest::SetUpTestSuite() {
   context_ = std::make_unique<vk::Context>(options);
 }
 
-void VulkanTest::TearDownTestSuite() { context_.reset(); }
+void VulkanTest::TearDownTestSuite() {
+  context_.reset();
+}
 
-void VulkanTest::SetUp() { errorsBefore_ = context_->validationErrors(); }
+void VulkanTest::SetUp() {
+  errorsBefore_ = context_->validationErrors();
+}
 
 void VulkanTest::TearDown() {
-  EXPECT_EQ(context_->validationErrors(), errorsBefore_) << "Vulkan validation errors during the test";
+  EXPECT_EQ(context_->validationErrors(), errorsBefore_)
+      << "Vulkan validation errors during the test";
 }
 
 }  // namespace gi::test

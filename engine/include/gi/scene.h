@@ -38,8 +38,8 @@ struct Texture {
 struct Material {
   std::string name;
   glm::vec4 baseColor{0.8f, 0.8f, 0.8f, 1.0f};  // linear
-  int baseColorTexture = -1;                     // index into Scene::textures
-  glm::vec3 emission{0.0f};                      // linear radiance added on top of lighting
+  int baseColorTexture = -1;                    // index into Scene::textures
+  glm::vec3 emission{0.0f};                     // linear radiance added on top of lighting
   float roughness = 0.8f;
   float metallic = 0.0f;
 };
@@ -101,8 +101,8 @@ struct Scene {
   std::vector<Camera> cameras;
   std::vector<Light> lights;
   std::vector<Node> nodes;
-  std::vector<int> roots;       // top-level nodes
-  int activeCameraNode = -1;    // node carrying the camera used for rendering, -1: frame bounds
+  std::vector<int> roots;     // top-level nodes
+  int activeCameraNode = -1;  // node carrying the camera used for rendering, -1: frame bounds
   Environment environment;
   std::vector<EffectRequest> effects;
   std::vector<std::string> warnings;  // things sanitised while loading (e.g. recomputed normals)

@@ -25,12 +25,15 @@ void commitFile(const std::string& tmp, const std::string& path) {
     throw Error(ErrorKind::FileNotFound, path, "cannot write output file");
   }
 }
-std::string tempName(const std::string& path) { return path + ".partial"; }
+std::string tempName(const std::string& path) {
+  return path + ".partial";
+}
 }  // namespace
 
 void writePng(const std::string& path, const ImageRGBA8& image) {
   const std::string tmp = tempName(path);
-  if (!stbi_write_png(tmp.c_str(), image.width, image.height, 4, image.pixels.data(), image.width * 4)) {
+  if (!stbi_write_png(tmp.c_str(), image.width, image.height, 4, image.pixels.data(),
+                      image.width * 4)) {
     std::error_code ec;
     std::filesystem::remove(tmp, ec);
     throw Error(ErrorKind::FileNotFound, path, "cannot write PNG (does the folder exist?)");
@@ -43,7 +46,8 @@ ImageRGBA8 readPng(const std::string& path) {
   int channels = 0;
   std::unique_ptr<stbi_uc, decltype(&stbi_image_free)> data(
       stbi_load(path.c_str(), &img.width, &img.height, &channels, 4), &stbi_image_free);
-  if (!data) throw Error(ErrorKind::Parse, path, std::string("cannot read image: ") + stbi_failure_reason());
+  if (!data)
+    throw Error(ErrorKind::Parse, path, std::string("cannot read image: ") + stbi_failure_reason());
   img.pixels.assign(data.get(), data.get() + size_t(img.width) * img.height * 4);
   return img;
 }
@@ -52,13 +56,16 @@ void writePfm(const std::string& path, const ImageRGBA32F& image) {
   const std::string tmp = tempName(path);
   {
     std::ofstream out(tmp, std::ios::binary);
-    if (!out) throw Error(ErrorKind::FileNotFound, path, "cannot write PFM (does the folder exist?)");
+    if (!out)
+      throw Error(ErrorKind::FileNotFound, path, "cannot write PFM (does the folder exist?)");
     out << "PF\n" << image.width << " " << image.height << "\n-1.0\n";  // -1: little-endian
     std::vector<float> row(size_t(image.width) * 3);
     for (int y = image.height - 1; y >= 0; --y) {
       for (int x = 0; x < image.width; ++x)
-        for (int c = 0; c < 3; ++c) row[x * 3 + c] = image.pixels[(size_t(y) * image.width + x) * 4 + c];
-      out.write(reinterpret_cast<const char*>(row.data()), std::streamsize(row.size() * sizeof(float)));
+        for (int c = 0; c < 3; ++c)
+          row[x * 3 + c] = image.pixels[(size_t(y) * image.width + x) * 4 + c];
+      out.write(reinterpret_cast<const char*>(row.data()),
+                std::streamsize(row.size() * sizeof(float)));
     }
     if (!out) {
       out.close();

@@ -36,7 +36,9 @@ glm::mat4 normalMatrixOf(const glm::mat4& m) {
   return glm::mat4(cof);
 }
 
-uint32_t groups(uint32_t n) { return (n + 7) / 8; }
+uint32_t groups(uint32_t n) {
+  return (n + 7) / 8;
+}
 
 }  // namespace
 
@@ -73,7 +75,8 @@ struct Renderer::Impl {
 
   Impl(Context& c, const Scene& s, const RenderSettings& rs)
       : ctx(c), settings(rs), scene(s), descriptors(c), timer(c) {
-    if (settings.width == 0 || settings.height == 0 || settings.width > 16384 || settings.height > 16384)
+    if (settings.width == 0 || settings.height == 0 || settings.width > 16384 ||
+        settings.height > 16384)
       throw Error(ErrorKind::Usage, "", "image size must be between 1x1 and 16384x16384");
     cameraView = activeCamera(scene, float(settings.width) / float(settings.height));
     uploadScene();
@@ -106,14 +109,17 @@ struct Renderer::Impl {
     };
     std::vector<Range> ranges;
     for (const Mesh& m : scene.meshes) {
-      ranges.push_back({uint32_t(indices.size()), uint32_t(m.indices.size()), int32_t(vertices.size())});
+      ranges.push_back(
+          {uint32_t(indices.size()), uint32_t(m.indices.size()), int32_t(vertices.size())});
       vertices.insert(vertices.end(), m.vertices.begin(), m.vertices.end());
       indices.insert(indices.end(), m.indices.begin(), m.indices.end());
     }
-    vertexBuffer = createDeviceBuffer(ctx, vertices.data(), vertices.size() * sizeof(Vertex),
-                                      VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-    indexBuffer = createDeviceBuffer(ctx, indices.data(), indices.size() * sizeof(uint32_t),
-                                     VK_BUFFER_USAGE_INDEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    vertexBuffer =
+        createDeviceBuffer(ctx, vertices.data(), vertices.size() * sizeof(Vertex),
+                           VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    indexBuffer =
+        createDeviceBuffer(ctx, indices.data(), indices.size() * sizeof(uint32_t),
+                           VK_BUFFER_USAGE_INDEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
 
     std::vector<gpu::Instance> instances;
     for (const Node& node : scene.nodes) {
@@ -123,7 +129,8 @@ struct Renderer::Impl {
         gpu::Instance inst;
         inst.model = inst.prevModel = node.world;
         inst.normalMatrix = normalMatrixOf(node.world);
-        const uint32_t materialIndex = std::min<uint32_t>(mesh.material, uint32_t(sceneMaterials.size() - 1));
+        const uint32_t materialIndex =
+            std::min<uint32_t>(mesh.material, uint32_t(sceneMaterials.size() - 1));
         inst.material = glm::uvec4(materialIndex, 0, 0, 0);
         draws.push_back({ranges[m].firstIndex, ranges[m].indexCount, ranges[m].vertexOffset,
                          uint32_t(instances.size()), materialIndex});
@@ -131,19 +138,24 @@ struct Renderer::Impl {
       }
     }
     // Grouped by material so each material's descriptor set is bound once.
-    std::stable_sort(draws.begin(), draws.end(), [](const Draw& a, const Draw& b) { return a.material < b.material; });
+    std::stable_sort(draws.begin(), draws.end(),
+                     [](const Draw& a, const Draw& b) { return a.material < b.material; });
     if (instances.empty()) instances.emplace_back();  // keep the buffer non-empty
-    instanceBuffer = createDeviceBuffer(ctx, instances.data(), instances.size() * sizeof(gpu::Instance),
-                                        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    instanceBuffer =
+        createDeviceBuffer(ctx, instances.data(), instances.size() * sizeof(gpu::Instance),
+                           VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
 
     std::vector<gpu::Material> materials;
     for (const Material& m : sceneMaterials) {
-      int tex = m.baseColorTexture >= 0 && m.baseColorTexture < int(scene.textures.size()) ? m.baseColorTexture : -1;
+      int tex = m.baseColorTexture >= 0 && m.baseColorTexture < int(scene.textures.size())
+                    ? m.baseColorTexture
+                    : -1;
       materials.push_back({m.baseColor, glm::vec4(m.emission, 0.0f),
                            glm::vec4(m.roughness, m.metallic, float(tex), 0.0f)});
     }
-    materialBuffer = createDeviceBuffer(ctx, materials.data(), materials.size() * sizeof(gpu::Material),
-                                        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    materialBuffer =
+        createDeviceBuffer(ctx, materials.data(), materials.size() * sizeof(gpu::Material),
+                           VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
 
     for (const Texture& t : scene.textures) {
       bool valid = t.width > 0 && t.height > 0 && t.rgba8.size() == size_t(t.width) * t.height * 4;
@@ -175,7 +187,9 @@ struct Renderer::Impl {
       gpu::Light g{};
       glm::vec3 pos = glm::vec3(cameraView.view * node.world * glm::vec4(0, 0, 0, 1));
       glm::vec3 dir = glm::vec3(cameraView.view * node.world * glm::vec4(0, 0, -1, 0));
-      float type = l.type == LightType::Directional ? 0.0f : l.type == LightType::Point ? 1.0f : 2.0f;
+      float type = l.type == LightType::Directional ? 0.0f
+                   : l.type == LightType::Point     ? 1.0f
+                                                    : 2.0f;
       g.positionRange = glm::vec4(pos, std::max(l.range, 0.0f));
       g.directionType = glm::vec4(dir, type);
       g.radiance = glm::vec4(l.color * std::max(l.intensity, 0.0f), 0.0f);
@@ -213,7 +227,8 @@ struct Renderer::Impl {
 
   void createPipelines() {
     const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-               tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+               tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+               img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
     GraphicsDesc g;
     g.vertex = loadSpirv("gbuffer.vert");
     g.fragment = loadSpirv("gbuffer.frag");
@@ -223,14 +238,16 @@ struct Renderer::Impl {
     g.vertexLayout.attributes = {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, position)},
                                  {1, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, normal)},
                                  {2, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(Vertex, uv)}};
-    g.colorFormats = {normal.image.desc().format, albedo.image.desc().format, material.image.desc().format,
-                      emission.image.desc().format, motion.image.desc().format};
+    g.colorFormats = {normal.image.desc().format, albedo.image.desc().format,
+                      material.image.desc().format, emission.image.desc().format,
+                      motion.image.desc().format};
     g.depthFormat = kDepthFormat;
     gbufferPipeline = Pipeline::graphics(ctx, g);
     lightingPipeline = Pipeline::compute(
         ctx, loadSpirv("lighting.comp"),
         {{0, ubo}, {1, tex}, {2, tex}, {3, tex}, {4, tex}, {5, tex}, {6, ssbo}, {7, img}});
-    tonemapPipeline = Pipeline::compute(ctx, loadSpirv("tonemap.comp"), {{0, ubo}, {1, tex}, {2, img}});
+    tonemapPipeline =
+        Pipeline::compute(ctx, loadSpirv("tonemap.comp"), {{0, ubo}, {1, tex}, {2, img}});
     floorPipeline = Pipeline::compute(ctx, loadSpirv("floor.comp"), {{0, ubo}, {1, tex}, {2, img}});
   }
 
@@ -243,7 +260,8 @@ struct Renderer::Impl {
     f.invView = glm::inverse(c.view);
     f.invProj = glm::inverse(c.proj);
     f.prevViewProj = f.viewProj;  // static camera until animation exists
-    f.viewport = glm::vec4(settings.width, settings.height, 1.0f / settings.width, 1.0f / settings.height);
+    f.viewport =
+        glm::vec4(settings.width, settings.height, 1.0f / settings.width, 1.0f / settings.height);
     f.cameraPos = glm::vec4(c.position, 1.0f);
     const Environment& e = scene.environment;
     const bool constant = e.kind == Environment::Kind::Constant;
@@ -255,9 +273,11 @@ struct Renderer::Impl {
   }
 
   // Moves a target to `layout` for the given use (all earlier work must be visible).
-  void transition(TargetImage& t, VkImageLayout layout, VkPipelineStageFlags2 dstStage, VkAccessFlags2 dstAccess) {
+  void transition(TargetImage& t, VkImageLayout layout, VkPipelineStageFlags2 dstStage,
+                  VkAccessFlags2 dstAccess) {
     imageBarrier(cmd, t.image.handle(), t.image.aspect(), t.layout, layout,
-                 VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT, dstStage, dstAccess);
+                 VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT, dstStage,
+                 dstAccess);
     t.layout = layout;
   }
 
@@ -276,9 +296,11 @@ struct Renderer::Impl {
         .buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frameBuffer.handle())
         .buffer(1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, instanceBuffer.handle())
         .buffer(2, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, materialBuffer.handle())
-        .sampled(3, textured ? textures[m.baseColorTexture].view() : whiteTexture.view(), linearSampler.handle())
+        .sampled(3, textured ? textures[m.baseColorTexture].view() : whiteTexture.view(),
+                 linearSampler.handle())
         .update(ctx.device(), set);
-    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, gbufferPipeline.layout(), 0, 1, &set, 0, nullptr);
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, gbufferPipeline.layout(), 0, 1,
+                            &set, 0, nullptr);
   }
 
   void gbufferPass() {
@@ -291,9 +313,11 @@ struct Renderer::Impl {
       transition(*t, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, colorStage, colorWrite);
     }
     depth.layout = VK_IMAGE_LAYOUT_UNDEFINED;
-    transition(depth, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-               VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-               VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
+    transition(
+        depth, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+        VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
+        VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
+            VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
 
     std::array<VkRenderingAttachmentInfo, 5> attachments{};
     for (size_t i = 0; i < colors.size(); ++i) {
@@ -334,7 +358,8 @@ struct Renderer::Impl {
           bindMaterialSet(d.material);
           boundMaterial = d.material;
         }
-        vkCmdPushConstants(cmd, gbufferPipeline.layout(), VK_SHADER_STAGE_ALL, 0, sizeof(uint32_t), &d.instance);
+        vkCmdPushConstants(cmd, gbufferPipeline.layout(), VK_SHADER_STAGE_ALL, 0, sizeof(uint32_t),
+                           &d.instance);
         vkCmdDrawIndexed(cmd, d.indexCount, 1, d.firstIndex, d.vertexOffset, 0);
       }
     }
@@ -429,15 +454,24 @@ struct Renderer::Impl {
 
   TargetImage& target(Target t) {
     switch (t) {
-      case Target::Depth: return depth;
-      case Target::Normal: return normal;
-      case Target::Albedo: return albedo;
-      case Target::Material: return material;
-      case Target::Emission: return emission;
-      case Target::Motion: return motion;
-      case Target::Lit: return lit;
-      case Target::Output: return output;
-      case Target::Floor: return floorTarget;
+      case Target::Depth:
+        return depth;
+      case Target::Normal:
+        return normal;
+      case Target::Albedo:
+        return albedo;
+      case Target::Material:
+        return material;
+      case Target::Emission:
+        return emission;
+      case Target::Motion:
+        return motion;
+      case Target::Lit:
+        return lit;
+      case Target::Output:
+        return output;
+      case Target::Floor:
+        return floorTarget;
     }
     return output;
   }
@@ -450,15 +484,18 @@ struct Renderer::Impl {
     const size_t bytes = size_t(d.width) * d.height * formatBytesPerPixel(d.format);
     Buffer staging(ctx, bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
     ctx.submitAndWait([&](VkCommandBuffer c) {
-      imageBarrier(c, t.image.handle(), t.image.aspect(), t.layout, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                   VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
-                   VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
+      imageBarrier(c, t.image.handle(), t.image.aspect(), t.layout,
+                   VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+                   VK_ACCESS_2_MEMORY_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT,
+                   VK_ACCESS_2_TRANSFER_READ_BIT);
       VkBufferImageCopy copy{};
       copy.imageSubresource = {t.image.aspect(), 0, 0, 1};
       copy.imageExtent = {d.width, d.height, 1};
-      vkCmdCopyImageToBuffer(c, t.image.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, staging.handle(), 1, &copy);
-      imageBarrier(c, t.image.handle(), t.image.aspect(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, t.layout,
-                   VK_PIPELINE_STAGE_2_COPY_BIT, 0, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, 0);
+      vkCmdCopyImageToBuffer(c, t.image.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                             staging.handle(), 1, &copy);
+      imageBarrier(c, t.image.handle(), t.image.aspect(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                   t.layout, VK_PIPELINE_STAGE_2_COPY_BIT, 0, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+                   0);
     });
     const auto* p = static_cast<const uint8_t*>(staging.mapped());
     return {p, p + bytes};
@@ -499,7 +536,8 @@ struct Renderer::Impl {
           o[3] = 1.0f;
           break;
         case VK_FORMAT_R8G8B8A8_SRGB:
-          for (int c = 0; c < 4; ++c) o[c] = c < 3 ? srgbToLinear(raw[i * 4 + c] / 255.0f) : raw[i * 4 + c] / 255.0f;
+          for (int c = 0; c < 4; ++c)
+            o[c] = c < 3 ? srgbToLinear(raw[i * 4 + c] / 255.0f) : raw[i * 4 + c] / 255.0f;
           break;
         default:  // 8-bit UNORM
           for (int c = 0; c < 4; ++c) o[c] = raw[i * 4 + c] / 255.0f;
@@ -512,13 +550,27 @@ struct Renderer::Impl {
 Renderer::Renderer(Context& ctx, const Scene& scene, const RenderSettings& settings)
     : impl_(std::make_unique<Impl>(ctx, scene, settings)) {}
 Renderer::~Renderer() = default;
-void Renderer::renderFrame() { impl_->renderFrame(); }
-const std::vector<PassTiming>& Renderer::lastTimings() const { return impl_->timings; }
-std::vector<std::string> Renderer::passNames() const { return impl_->executed; }
-const CameraView& Renderer::camera() const { return impl_->cameraView; }
-ImageRGBA32F Renderer::readTarget(Target target) { return impl_->readTarget(target); }
-VkImage Renderer::outputImage() const { return impl_->output.image.handle(); }
-VkExtent2D Renderer::outputExtent() const { return {impl_->settings.width, impl_->settings.height}; }
+void Renderer::renderFrame() {
+  impl_->renderFrame();
+}
+const std::vector<PassTiming>& Renderer::lastTimings() const {
+  return impl_->timings;
+}
+std::vector<std::string> Renderer::passNames() const {
+  return impl_->executed;
+}
+const CameraView& Renderer::camera() const {
+  return impl_->cameraView;
+}
+ImageRGBA32F Renderer::readTarget(Target target) {
+  return impl_->readTarget(target);
+}
+VkImage Renderer::outputImage() const {
+  return impl_->output.image.handle();
+}
+VkExtent2D Renderer::outputExtent() const {
+  return {impl_->settings.width, impl_->settings.height};
+}
 
 ImageRGBA8 Renderer::readOutput() {
   std::vector<uint8_t> raw = impl_->readRaw(impl_->output);

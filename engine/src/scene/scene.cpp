@@ -130,18 +130,30 @@ CameraView activeCamera(const Scene& scene, float aspect) {
 
 const char* errorKindName(ErrorKind kind) {
   switch (kind) {
-    case ErrorKind::FileNotFound: return "file not found";
-    case ErrorKind::EmptyFile: return "empty file";
-    case ErrorKind::Parse: return "parse error";
-    case ErrorKind::Schema: return "schema error";
-    case ErrorKind::IndexOutOfRange: return "index out of range";
-    case ErrorKind::MissingResource: return "missing resource";
-    case ErrorKind::NonFinite: return "non-finite data";
-    case ErrorKind::Cycle: return "cyclic node hierarchy";
-    case ErrorKind::InvalidData: return "invalid data";
-    case ErrorKind::Unsupported: return "unsupported";
-    case ErrorKind::Vulkan: return "vulkan error";
-    case ErrorKind::Usage: return "usage error";
+    case ErrorKind::FileNotFound:
+      return "file not found";
+    case ErrorKind::EmptyFile:
+      return "empty file";
+    case ErrorKind::Parse:
+      return "parse error";
+    case ErrorKind::Schema:
+      return "schema error";
+    case ErrorKind::IndexOutOfRange:
+      return "index out of range";
+    case ErrorKind::MissingResource:
+      return "missing resource";
+    case ErrorKind::NonFinite:
+      return "non-finite data";
+    case ErrorKind::Cycle:
+      return "cyclic node hierarchy";
+    case ErrorKind::InvalidData:
+      return "invalid data";
+    case ErrorKind::Unsupported:
+      return "unsupported";
+    case ErrorKind::Vulkan:
+      return "vulkan error";
+    case ErrorKind::Usage:
+      return "usage error";
   }
   return "error";
 }

@@ -14,16 +14,42 @@ namespace gi::vk {
 
 const char* resultName(VkResult r) {
   switch (r) {
-#define GI_CASE(x) case x: return #x;
-    GI_CASE(VK_SUCCESS) GI_CASE(VK_NOT_READY) GI_CASE(VK_TIMEOUT) GI_CASE(VK_INCOMPLETE)
-    GI_CASE(VK_ERROR_OUT_OF_HOST_MEMORY) GI_CASE(VK_ERROR_OUT_OF_DEVICE_MEMORY)
-    GI_CASE(VK_ERROR_INITIALIZATION_FAILED) GI_CASE(VK_ERROR_DEVICE_LOST)
-    GI_CASE(VK_ERROR_MEMORY_MAP_FAILED) GI_CASE(VK_ERROR_LAYER_NOT_PRESENT)
-    GI_CASE(VK_ERROR_EXTENSION_NOT_PRESENT) GI_CASE(VK_ERROR_FEATURE_NOT_PRESENT)
-    GI_CASE(VK_ERROR_INCOMPATIBLE_DRIVER) GI_CASE(VK_ERROR_FORMAT_NOT_SUPPORTED)
-    GI_CASE(VK_ERROR_OUT_OF_DATE_KHR) GI_CASE(VK_SUBOPTIMAL_KHR) GI_CASE(VK_ERROR_SURFACE_LOST_KHR)
-#undef GI_CASE
-    default: return "VkResult(unknown)";
+    case VK_SUCCESS:
+      return "VK_SUCCESS";
+    case VK_NOT_READY:
+      return "VK_NOT_READY";
+    case VK_TIMEOUT:
+      return "VK_TIMEOUT";
+    case VK_INCOMPLETE:
+      return "VK_INCOMPLETE";
+    case VK_ERROR_OUT_OF_HOST_MEMORY:
+      return "VK_ERROR_OUT_OF_HOST_MEMORY";
+    case VK_ERROR_OUT_OF_DEVICE_MEMORY:
+      return "VK_ERROR_OUT_OF_DEVICE_MEMORY";
+    case VK_ERROR_INITIALIZATION_FAILED:
+      return "VK_ERROR_INITIALIZATION_FAILED";
+    case VK_ERROR_DEVICE_LOST:
+      return "VK_ERROR_DEVICE_LOST";
+    case VK_ERROR_MEMORY_MAP_FAILED:
+      return "VK_ERROR_MEMORY_MAP_FAILED";
+    case VK_ERROR_LAYER_NOT_PRESENT:
+      return "VK_ERROR_LAYER_NOT_PRESENT";
+    case VK_ERROR_EXTENSION_NOT_PRESENT:
+      return "VK_ERROR_EXTENSION_NOT_PRESENT";
+    case VK_ERROR_FEATURE_NOT_PRESENT:
+      return "VK_ERROR_FEATURE_NOT_PRESENT";
+    case VK_ERROR_INCOMPATIBLE_DRIVER:
+      return "VK_ERROR_INCOMPATIBLE_DRIVER";
+    case VK_ERROR_FORMAT_NOT_SUPPORTED:
+      return "VK_ERROR_FORMAT_NOT_SUPPORTED";
+    case VK_ERROR_OUT_OF_DATE_KHR:
+      return "VK_ERROR_OUT_OF_DATE_KHR";
+    case VK_SUBOPTIMAL_KHR:
+      return "VK_SUBOPTIMAL_KHR";
+    case VK_ERROR_SURFACE_LOST_KHR:
+      return "VK_ERROR_SURFACE_LOST_KHR";
+    default:
+      return "VkResult(unknown)";
   }
 }
 
@@ -79,7 +105,8 @@ VKAPI_ATTR VkBool32 VKAPI_CALL Context::debugCallback(
   } else {
     return VK_FALSE;
   }
-  std::string msg = std::string("[validation ") + level + "] " + (data->pMessage ? data->pMessage : "");
+  std::string msg =
+      std::string("[validation ") + level + "] " + (data->pMessage ? data->pMessage : "");
   std::fprintf(stderr, "%s\n", msg.c_str());
   std::lock_guard lock(self->messagesMutex_);
   self->messages_.push_back(std::move(msg));
@@ -151,11 +178,16 @@ void Context::pickPhysicalDevice(const std::string& wanted) {
 
   auto rank = [](VkPhysicalDeviceType t) {
     switch (t) {
-      case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return 0;
-      case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return 1;
-      case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return 2;
-      case VK_PHYSICAL_DEVICE_TYPE_CPU: return 3;
-      default: return 4;
+      case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
+        return 0;
+      case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
+        return 1;
+      case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
+        return 2;
+      case VK_PHYSICAL_DEVICE_TYPE_CPU:
+        return 3;
+      default:
+        return 4;
     }
   };
   int best = -1;
@@ -166,7 +198,8 @@ void Context::pickPhysicalDevice(const std::string& wanted) {
     names += std::string(names.empty() ? "" : ", ") + std::to_string(i) + ": " + p.deviceName;
     if (p.apiVersion < VK_API_VERSION_1_3) continue;
     if (!wanted.empty()) {
-      if (wanted == std::to_string(i) || std::strstr(p.deviceName, wanted.c_str())) best = static_cast<int>(i);
+      if (wanted == std::to_string(i) || std::strstr(p.deviceName, wanted.c_str()))
+        best = static_cast<int>(i);
       continue;
     }
     if (best < 0) {
@@ -313,7 +346,8 @@ void Context::loadPipelineCache() {
 void Context::savePipelineCache() const {
   if (pipelineCachePath_.empty() || !pipelineCache_) return;
   size_t size = 0;
-  if (vkGetPipelineCacheData(device_, pipelineCache_, &size, nullptr) != VK_SUCCESS || size == 0) return;
+  if (vkGetPipelineCacheData(device_, pipelineCache_, &size, nullptr) != VK_SUCCESS || size == 0)
+    return;
   std::vector<char> data(size);
   if (vkGetPipelineCacheData(device_, pipelineCache_, &size, data.data()) != VK_SUCCESS) return;
   std::error_code ec;

@@ -12,7 +12,9 @@ GpuTimer::GpuTimer(Context& ctx, uint32_t maxScopes) : ctx_(ctx), maxScopes_(max
   check(vkCreateQueryPool(ctx.device(), &info, nullptr, &pool_), "vkCreateQueryPool");
 }
 
-GpuTimer::~GpuTimer() { vkDestroyQueryPool(ctx_.device(), pool_, nullptr); }
+GpuTimer::~GpuTimer() {
+  vkDestroyQueryPool(ctx_.device(), pool_, nullptr);
+}
 
 void GpuTimer::beginFrame(VkCommandBuffer cmd) {
   names_.clear();

@@ -9,10 +9,14 @@
 namespace gi::vk {
 
 namespace {
-VkDeviceSize alignUp(VkDeviceSize v, VkDeviceSize a) { return (v + a - 1) / a * a; }
+VkDeviceSize alignUp(VkDeviceSize v, VkDeviceSize a) {
+  return (v + a - 1) / a * a;
+}
 }  // namespace
 
-FreeList::FreeList(VkDeviceSize size) : capacity_(size) { free_[0] = size; }
+FreeList::FreeList(VkDeviceSize size) : capacity_(size) {
+  free_[0] = size;
+}
 
 std::optional<VkDeviceSize> FreeList::allocate(VkDeviceSize size, VkDeviceSize alignment) {
   if (size == 0) size = 1;
@@ -78,7 +82,8 @@ Allocation MemoryAllocator::allocate(const VkMemoryRequirements& req,
   if (type == UINT32_MAX) type = findMemoryType(req.memoryTypeBits, required);
   if (type == UINT32_MAX)
     throw Error(ErrorKind::Vulkan, "", "no memory type fits the resource's requirements");
-  const bool hostVisible = props_.memoryTypes[type].propertyFlags & VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT;
+  const bool hostVisible =
+      props_.memoryTypes[type].propertyFlags & VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT;
   // Aligning to bufferImageGranularity keeps linear and optimal resources from sharing a page.
   const VkDeviceSize alignment = std::max(req.alignment, granularity_);
   const VkDeviceSize size = alignUp(req.size, granularity_);
@@ -89,8 +94,8 @@ Allocation MemoryAllocator::allocate(const VkMemoryRequirements& req,
     if (!b.memory) continue;
     if (auto offset = b.ranges->allocate(size, alignment)) {
       ++liveAllocations_;
-      return {b.memory, *offset, size,
-              b.mapped ? static_cast<char*>(b.mapped) + *offset : nullptr, type, i};
+      return {b.memory, *offset, size, b.mapped ? static_cast<char*>(b.mapped) + *offset : nullptr,
+              type,     i};
     }
   }
   // New block: large enough for this request (big resources get a block of their own size).
@@ -100,7 +105,8 @@ Allocation MemoryAllocator::allocate(const VkMemoryRequirements& req,
   info.allocationSize = blockSize;
   info.memoryTypeIndex = type;
   check(vkAllocateMemory(device_, &info, nullptr, &b.memory), "vkAllocateMemory");
-  if (hostVisible) check(vkMapMemory(device_, b.memory, 0, VK_WHOLE_SIZE, 0, &b.mapped), "vkMapMemory");
+  if (hostVisible)
+    check(vkMapMemory(device_, b.memory, 0, VK_WHOLE_SIZE, 0, &b.mapped), "vkMapMemory");
   b.ranges = std::make_unique<FreeList>(blockSize);
   auto offset = b.ranges->allocate(size, alignment);
   uint32_t index = static_cast<uint32_t>(perType.size());
@@ -110,8 +116,9 @@ Allocation MemoryAllocator::allocate(const VkMemoryRequirements& req,
   perType[index] = std::move(b);
   ++liveAllocations_;
   Block& placed = perType[index];
-  return {placed.memory, *offset, size,
-          placed.mapped ? static_cast<char*>(placed.mapped) + *offset : nullptr, type, index};
+  return {placed.memory, *offset,
+          size,          placed.mapped ? static_cast<char*>(placed.mapped) + *offset : nullptr,
+          type,          index};
 }
 
 void MemoryAllocator::free(const Allocation& a) {

@@ -48,7 +48,8 @@ Pipeline Pipeline::compute(Context& ctx, const std::vector<uint32_t>& spirv,
   info.stage.module = module;
   info.stage.pName = "main";
   info.layout = p.layout_;
-  VkResult r = vkCreateComputePipelines(ctx.device(), ctx.pipelineCache(), 1, &info, nullptr, &p.pipeline_);
+  VkResult r =
+      vkCreateComputePipelines(ctx.device(), ctx.pipelineCache(), 1, &info, nullptr, &p.pipeline_);
   vkDestroyShaderModule(ctx.device(), module, nullptr);
   check(r, "vkCreateComputePipelines");
   return p;
@@ -63,36 +64,45 @@ Pipeline Pipeline::graphics(Context& ctx, const GraphicsDesc& d) {
   VkShaderModule vs = createModule(ctx.device(), d.vertex);
   VkShaderModule fs = createModule(ctx.device(), d.fragment);
   VkPipelineShaderStageCreateInfo stages[2] = {
-      {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_VERTEX_BIT, vs, "main", nullptr},
-      {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_FRAGMENT_BIT, fs, "main", nullptr}};
+      {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_VERTEX_BIT,
+       vs, "main", nullptr},
+      {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0,
+       VK_SHADER_STAGE_FRAGMENT_BIT, fs, "main", nullptr}};
 
   VkVertexInputBindingDescription vbinding{0, d.vertexLayout.stride, VK_VERTEX_INPUT_RATE_VERTEX};
-  VkPipelineVertexInputStateCreateInfo vertexInput{VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
+  VkPipelineVertexInputStateCreateInfo vertexInput{
+      VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO};
   if (d.vertexLayout.stride) {
     vertexInput.vertexBindingDescriptionCount = 1;
     vertexInput.pVertexBindingDescriptions = &vbinding;
-    vertexInput.vertexAttributeDescriptionCount = static_cast<uint32_t>(d.vertexLayout.attributes.size());
+    vertexInput.vertexAttributeDescriptionCount =
+        static_cast<uint32_t>(d.vertexLayout.attributes.size());
     vertexInput.pVertexAttributeDescriptions = d.vertexLayout.attributes.data();
   }
-  VkPipelineInputAssemblyStateCreateInfo assembly{VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
+  VkPipelineInputAssemblyStateCreateInfo assembly{
+      VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
   assembly.topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
   VkPipelineViewportStateCreateInfo viewport{VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO};
   viewport.viewportCount = 1;
   viewport.scissorCount = 1;
-  VkPipelineRasterizationStateCreateInfo raster{VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
+  VkPipelineRasterizationStateCreateInfo raster{
+      VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
   raster.polygonMode = VK_POLYGON_MODE_FILL;
   raster.cullMode = d.cullMode;
   raster.frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE;
   raster.lineWidth = 1.0f;
-  VkPipelineMultisampleStateCreateInfo msaa{VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
+  VkPipelineMultisampleStateCreateInfo msaa{
+      VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO};
   msaa.rasterizationSamples = VK_SAMPLE_COUNT_1_BIT;
-  VkPipelineDepthStencilStateCreateInfo depth{VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
+  VkPipelineDepthStencilStateCreateInfo depth{
+      VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO};
   depth.depthTestEnable = d.depthFormat != VK_FORMAT_UNDEFINED;
   depth.depthWriteEnable = d.depthWrite;
   depth.depthCompareOp = d.depthCompare;
   std::vector<VkPipelineColorBlendAttachmentState> blends(d.colorFormats.size());
   for (auto& b : blends) b.colorWriteMask = 0xF;
-  VkPipelineColorBlendStateCreateInfo blend{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
+  VkPipelineColorBlendStateCreateInfo blend{
+      VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
   blend.attachmentCount = static_cast<uint32_t>(blends.size());
   blend.pAttachments = blends.data();
   VkDynamicState dynamicStates[] = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
@@ -117,7 +127,8 @@ Pipeline Pipeline::graphics(Context& ctx, const GraphicsDesc& d) {
   info.pColorBlendState = &blend;
   info.pDynamicState = &dynamic;
   info.layout = p.layout_;
-  VkResult r = vkCreateGraphicsPipelines(ctx.device(), ctx.pipelineCache(), 1, &info, nullptr, &p.pipeline_);
+  VkResult r =
+      vkCreateGraphicsPipelines(ctx.device(), ctx.pipelineCache(), 1, &info, nullptr, &p.pipeline_);
   vkDestroyShaderModule(ctx.device(), vs, nullptr);
   vkDestroyShaderModule(ctx.device(), fs, nullptr);
   check(r, "vkCreateGraphicsPipelines");
@@ -155,8 +166,8 @@ DescriptorArena::~DescriptorArena() {
 VkDescriptorPool DescriptorArena::newPool() {
   const VkDescriptorPoolSize sizes[] = {
       {VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 512}, {VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 128},
-      {VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 128}, {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 128},
-      {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, 128}, {VK_DESCRIPTOR_TYPE_SAMPLER, 32}};
+      {VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 128},         {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 128},
+      {VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, 128},          {VK_DESCRIPTOR_TYPE_SAMPLER, 32}};
   VkDescriptorPoolCreateInfo info{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
   info.maxSets = 128;
   info.poolSizeCount = static_cast<uint32_t>(std::size(sizes));
@@ -177,7 +188,8 @@ VkDescriptorSet DescriptorArena::allocate(VkDescriptorSetLayout layout) {
     VkDescriptorSet set;
     VkResult r = vkAllocateDescriptorSets(ctx_->device(), &info, &set);
     if (r == VK_SUCCESS) return set;
-    if (r != VK_ERROR_OUT_OF_POOL_MEMORY && r != VK_ERROR_FRAGMENTED_POOL) check(r, "vkAllocateDescriptorSets");
+    if (r != VK_ERROR_OUT_OF_POOL_MEMORY && r != VK_ERROR_FRAGMENTED_POOL)
+      check(r, "vkAllocateDescriptorSets");
     ++current_;  // this pool is full: move on to the next (created on demand)
   }
 }
@@ -190,7 +202,8 @@ void DescriptorArena::reset() {
 DescriptorWriter& DescriptorWriter::sampled(uint32_t binding, VkImageView view, VkSampler sampler,
                                             VkImageLayout layout, uint32_t element) {
   images_.push_back({sampler, view, layout});
-  pending_.push_back({binding, element, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, images_.size() - 1});
+  pending_.push_back(
+      {binding, element, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, images_.size() - 1});
   return *this;
 }
 

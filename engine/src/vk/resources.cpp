@@ -16,11 +16,11 @@ Buffer::Buffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, bool h
   check(vkCreateBuffer(ctx.device(), &info, nullptr, &buffer_), "vkCreateBuffer");
   VkMemoryRequirements req;
   vkGetBufferMemoryRequirements(ctx.device(), buffer_, &req);
-  alloc_ = hostVisible
-               ? ctx.allocator().allocate(req, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT |
-                                                   VK_MEMORY_PROPERTY_HOST_COHERENT_BIT)
-               : ctx.allocator().allocate(req, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-  check(vkBindBufferMemory(ctx.device(), buffer_, alloc_.memory, alloc_.offset), "vkBindBufferMemory");
+  alloc_ = hostVisible ? ctx.allocator().allocate(req, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT |
+                                                           VK_MEMORY_PROPERTY_HOST_COHERENT_BIT)
+                       : ctx.allocator().allocate(req, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+  check(vkBindBufferMemory(ctx.device(), buffer_, alloc_.memory, alloc_.offset),
+        "vkBindBufferMemory");
 }
 
 Buffer& Buffer::operator=(Buffer&& o) noexcept {
@@ -43,7 +43,8 @@ void Buffer::reset() {
   alloc_ = {};
 }
 
-Buffer createDeviceBuffer(Context& ctx, const void* data, VkDeviceSize size, VkBufferUsageFlags usage) {
+Buffer createDeviceBuffer(Context& ctx, const void* data, VkDeviceSize size,
+                          VkBufferUsageFlags usage) {
   Buffer buffer(ctx, size, usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false);
   if (size == 0 || data == nullptr) return buffer;
   Buffer staging(ctx, size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true);
@@ -56,25 +57,32 @@ Buffer createDeviceBuffer(Context& ctx, const void* data, VkDeviceSize size, VkB
 }
 
 bool isDepthFormat(VkFormat f) {
-  return f == VK_FORMAT_D32_SFLOAT || f == VK_FORMAT_D16_UNORM || f == VK_FORMAT_D24_UNORM_S8_UINT ||
-         f == VK_FORMAT_D32_SFLOAT_S8_UINT;
+  return f == VK_FORMAT_D32_SFLOAT || f == VK_FORMAT_D16_UNORM ||
+         f == VK_FORMAT_D24_UNORM_S8_UINT || f == VK_FORMAT_D32_SFLOAT_S8_UINT;
 }
 
 uint32_t formatBytesPerPixel(VkFormat f) {
   switch (f) {
-    case VK_FORMAT_R8_UNORM: return 1;
-    case VK_FORMAT_R16_SFLOAT: return 2;
+    case VK_FORMAT_R8_UNORM:
+      return 1;
+    case VK_FORMAT_R16_SFLOAT:
+      return 2;
     case VK_FORMAT_R8G8B8A8_UNORM:
     case VK_FORMAT_R8G8B8A8_SRGB:
     case VK_FORMAT_B8G8R8A8_UNORM:
     case VK_FORMAT_B8G8R8A8_SRGB:
     case VK_FORMAT_R32_SFLOAT:
     case VK_FORMAT_D32_SFLOAT:
-    case VK_FORMAT_R16G16_SFLOAT: return 4;
+    case VK_FORMAT_R16G16_SFLOAT:
+      return 4;
     case VK_FORMAT_R16G16B16A16_SFLOAT:
-    case VK_FORMAT_R32G32_SFLOAT: return 8;
-    case VK_FORMAT_R32G32B32A32_SFLOAT: return 16;
-    default: throw Error(ErrorKind::Unsupported, "", "unknown pixel size for VkFormat " + std::to_string(f));
+    case VK_FORMAT_R32G32_SFLOAT:
+      return 8;
+    case VK_FORMAT_R32G32B32A32_SFLOAT:
+      return 16;
+    default:
+      throw Error(ErrorKind::Unsupported, "",
+                  "unknown pixel size for VkFormat " + std::to_string(f));
   }
 }
 
@@ -132,9 +140,9 @@ VkImageAspectFlags Image::aspect() const {
 }
 
 void imageBarrier(VkCommandBuffer cmd, VkImage image, VkImageAspectFlags aspect,
-                  VkImageLayout oldLayout, VkImageLayout newLayout,
-                  VkPipelineStageFlags2 srcStage, VkAccessFlags2 srcAccess,
-                  VkPipelineStageFlags2 dstStage, VkAccessFlags2 dstAccess) {
+                  VkImageLayout oldLayout, VkImageLayout newLayout, VkPipelineStageFlags2 srcStage,
+                  VkAccessFlags2 srcAccess, VkPipelineStageFlags2 dstStage,
+                  VkAccessFlags2 dstAccess) {
   VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
   b.srcStageMask = srcStage;
   b.srcAccessMask = srcAccess;
@@ -175,7 +183,8 @@ Sampler::Sampler(Context& ctx, VkFilter filter, VkSamplerAddressMode address) : 
   VkSamplerCreateInfo info{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
   info.magFilter = filter;
   info.minFilter = filter;
-  info.mipmapMode = filter == VK_FILTER_LINEAR ? VK_SAMPLER_MIPMAP_MODE_LINEAR : VK_SAMPLER_MIPMAP_MODE_NEAREST;
+  info.mipmapMode =
+      filter == VK_FILTER_LINEAR ? VK_SAMPLER_MIPMAP_MODE_LINEAR : VK_SAMPLER_MIPMAP_MODE_NEAREST;
   info.addressModeU = info.addressModeV = info.addressModeW = address;
   info.maxLod = VK_LOD_CLAMP_NONE;
   check(vkCreateSampler(ctx.device(), &info, nullptr, &sampler_), "vkCreateSampler");

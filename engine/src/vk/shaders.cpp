@@ -25,7 +25,8 @@ std::string shaderDirectory() {
 std::vector<uint32_t> loadSpirv(const std::string& name) {
   const std::string path = shaderDirectory() + "/" + name + ".spv";
   std::ifstream in(path, std::ios::binary | std::ios::ate);
-  if (!in) throw Error(ErrorKind::FileNotFound, path, "SPIR-V shader not found (is the build complete?)");
+  if (!in)
+    throw Error(ErrorKind::FileNotFound, path, "SPIR-V shader not found (is the build complete?)");
   const auto size = static_cast<size_t>(in.tellg());
   if (size == 0 || size % 4 != 0) throw Error(ErrorKind::InvalidData, path, "not a SPIR-V module");
   std::vector<uint32_t> code(size / 4);
@@ -42,7 +43,8 @@ class FileIncluder : public glslang::TShader::Includer {
  public:
   explicit FileIncluder(std::vector<std::string> dirs) : dirs_(std::move(dirs)) {}
   IncludeResult* includeLocal(const char* requested, const char* includer, size_t) override {
-    std::vector<std::filesystem::path> candidates{std::filesystem::path(includer).parent_path() / requested};
+    std::vector<std::filesystem::path> candidates{std::filesystem::path(includer).parent_path() /
+                                                  requested};
     for (const auto& d : dirs_) candidates.push_back(std::filesystem::path(d) / requested);
     for (const auto& c : candidates) {
       std::ifstream in(c);
@@ -69,10 +71,14 @@ class FileIncluder : public glslang::TShader::Includer {
 
 EShLanguage languageOf(VkShaderStageFlagBits stage) {
   switch (stage) {
-    case VK_SHADER_STAGE_VERTEX_BIT: return EShLangVertex;
-    case VK_SHADER_STAGE_FRAGMENT_BIT: return EShLangFragment;
-    case VK_SHADER_STAGE_GEOMETRY_BIT: return EShLangGeometry;
-    default: return EShLangCompute;
+    case VK_SHADER_STAGE_VERTEX_BIT:
+      return EShLangVertex;
+    case VK_SHADER_STAGE_FRAGMENT_BIT:
+      return EShLangFragment;
+    case VK_SHADER_STAGE_GEOMETRY_BIT:
+      return EShLangGeometry;
+    default:
+      return EShLangCompute;
   }
 }
 
@@ -94,11 +100,13 @@ std::vector<uint32_t> compileGlsl(const std::string& source, VkShaderStageFlagBi
   FileIncluder includer(includeDirs);
   const auto messages = static_cast<EShMessages>(EShMsgSpvRules | EShMsgVulkanRules);
   if (!shader.parse(GetDefaultResources(), 460, false, messages, includer))
-    throw Error(ErrorKind::Parse, sourceName, std::string("GLSL compilation failed:\n") + shader.getInfoLog());
+    throw Error(ErrorKind::Parse, sourceName,
+                std::string("GLSL compilation failed:\n") + shader.getInfoLog());
   glslang::TProgram program;
   program.addShader(&shader);
   if (!program.link(messages))
-    throw Error(ErrorKind::Parse, sourceName, std::string("GLSL link failed:\n") + program.getInfoLog());
+    throw Error(ErrorKind::Parse, sourceName,
+                std::string("GLSL link failed:\n") + program.getInfoLog());
   std::vector<uint32_t> spirv;
   glslang::SpvOptions options;
   options.disableOptimizer = false;
@@ -106,7 +114,8 @@ std::vector<uint32_t> compileGlsl(const std::string& source, VkShaderStageFlagBi
   return spirv;
 }
 
-std::vector<uint32_t> compileGlslFile(const std::string& path, const std::vector<std::string>& includeDirs) {
+std::vector<uint32_t> compileGlslFile(const std::string& path,
+                                      const std::vector<std::string>& includeDirs) {
   std::ifstream in(path);
   if (!in) throw Error(ErrorKind::FileNotFound, path, "shader source not found");
   std::stringstream ss;

@@ -53,8 +53,8 @@ class MemoryAllocator {
                       VkMemoryPropertyFlags preferred = 0);
   void free(const Allocation& allocation);
 
-  size_t blockCount() const;                  // live VkDeviceMemory objects
-  VkDeviceSize bytesInUse() const;            // sum of live sub-allocations
+  size_t blockCount() const;        // live VkDeviceMemory objects
+  VkDeviceSize bytesInUse() const;  // sum of live sub-allocations
   uint64_t allocationCount() const { return liveAllocations_; }
 
  private:

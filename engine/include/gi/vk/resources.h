@@ -39,7 +39,8 @@ class Buffer {
 };
 
 // Device-local buffer filled through a staging copy.
-Buffer createDeviceBuffer(Context& ctx, const void* data, VkDeviceSize size, VkBufferUsageFlags usage);
+Buffer createDeviceBuffer(Context& ctx, const void* data, VkDeviceSize size,
+                          VkBufferUsageFlags usage);
 
 struct ImageDesc {
   VkFormat format = VK_FORMAT_R8G8B8A8_UNORM;
@@ -82,9 +83,9 @@ void uploadImage(Context& ctx, Image& image, const void* pixels, size_t bytes);
 
 // One image memory barrier (synchronization2) for the whole image.
 void imageBarrier(VkCommandBuffer cmd, VkImage image, VkImageAspectFlags aspect,
-                  VkImageLayout oldLayout, VkImageLayout newLayout,
-                  VkPipelineStageFlags2 srcStage, VkAccessFlags2 srcAccess,
-                  VkPipelineStageFlags2 dstStage, VkAccessFlags2 dstAccess);
+                  VkImageLayout oldLayout, VkImageLayout newLayout, VkPipelineStageFlags2 srcStage,
+                  VkAccessFlags2 srcAccess, VkPipelineStageFlags2 dstStage,
+                  VkAccessFlags2 dstAccess);
 
 class Sampler {
  public:
