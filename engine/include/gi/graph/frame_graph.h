@@ -1,0 +1,165 @@
+// The frame graph: passes declare what they read and write through typed, versioned handles;
+// compile() culls every pass whose results do not reach a marked output, allocates transient
+// images and buffers (aliasing memory between resources whose lifetimes do not overlap) and
+// derives synchronization2 barriers from the declared usage; execute() records the kept
+// passes, each timed with timestamp queries.
+#pragma once
+
+#include <vulkan/vulkan.h>
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "gi/graph/handles.h"
+#include "gi/vk/context.h"
+
+namespace gi::vk {
+class GpuTimer;
+class DescriptorArena;
+}  // namespace gi::vk
+
+namespace gi {
+
+class FrameGraph;
+
+// Given to a pass's execute callback: the command buffer and the real Vulkan objects behind
+// the handles it declared.
+class PassContext {
+ public:
+  VkCommandBuffer cmd() const { return cmd_; }
+  vk::Context& context() const { return *ctx_; }
+  vk::DescriptorArena& descriptors() const { return *descriptors_; }
+  VkImage image(TextureHandle h) const;
+  VkImageView view(TextureHandle h) const;
+  VkExtent2D extent(TextureHandle h) const;
+  VkFormat format(TextureHandle h) const;
+  VkBuffer buffer(BufferHandle h) const;
+  VkDeviceSize bufferSize(BufferHandle h) const;
+  VkExtent2D outputExtent() const;
+
+ private:
+  friend class FrameGraph;
+  const FrameGraph* graph_ = nullptr;
+  vk::Context* ctx_ = nullptr;
+  vk::DescriptorArena* descriptors_ = nullptr;
+  VkCommandBuffer cmd_ = VK_NULL_HANDLE;
+};
+
+using PassExecute = std::function<void(PassContext&)>;
+
+// Given to a pass's setup callback: declares resources and their use.
+class PassBuilder {
+ public:
+  TextureHandle create(const std::string& name, const TextureDesc& desc);
+  BufferHandle create(const std::string& name, const BufferDesc& desc);
+  // Declares a read of the current version of a resource. Throws on a stale handle.
+  TextureHandle read(TextureHandle h, TextureUsage usage = TextureUsage::Sampled);
+  BufferHandle read(BufferHandle h, BufferUsage usage = BufferUsage::StorageRead);
+  // Declares a write; the returned handle names the new version (use it from now on).
+  [[nodiscard]] TextureHandle write(TextureHandle h, TextureUsage usage);
+  [[nodiscard]] BufferHandle write(BufferHandle h, BufferUsage usage);
+  // Never culled (e.g. a pass that reads back to the host).
+  void sideEffect();
+
+ private:
+  friend class FrameGraph;
+  PassBuilder(FrameGraph& g, uint32_t pass) : graph_(g), pass_(pass) {}
+  FrameGraph& graph_;
+  uint32_t pass_;
+};
+
+// Named handles shared between passes and effects ("depth", "normal", "ao", ...): the one
+// place where well-known resources are published and looked up.
+class Blackboard {
+ public:
+  void put(const std::string& name, TextureHandle h) { textures_[name] = h; }
+  void put(const std::string& name, BufferHandle h) { buffers_[name] = h; }
+  TextureHandle texture(const std::string& name) const;  // invalid handle if absent
+  BufferHandle buffer(const std::string& name) const;
+  bool has(const std::string& name) const { return textures_.count(name) || buffers_.count(name); }
+  std::vector<std::string> names() const;
+  void clear();
+
+ private:
+  std::unordered_map<std::string, TextureHandle> textures_;
+  std::unordered_map<std::string, BufferHandle> buffers_;
+};
+
+struct GraphStats {
+  size_t transientTextures = 0, transientBuffers = 0;
+  VkDeviceSize transientBytesRequested = 0;  // sum of all transient resources
+  VkDeviceSize transientBytesAllocated = 0;  // after aliasing
+};
+
+class FrameGraph {
+ public:
+  FrameGraph(vk::Context& ctx, VkExtent2D outputExtent);
+  ~FrameGraph();
+  FrameGraph(const FrameGraph&) = delete;
+  FrameGraph& operator=(const FrameGraph&) = delete;
+
+  // Adds a pass: `setup` declares resources now, `execute` records commands later. Passes must
+  // be added in an order where every read refers to an earlier write (setup order).
+  void addPass(const std::string& name, const std::function<void(PassBuilder&)>& setup,
+               PassExecute execute);
+
+  // External resources (created and owned elsewhere). `finalLayout` is the layout the image
+  // is left in after execute() (UNDEFINED: wherever its last use left it).
+  TextureHandle importTexture(const std::string& name, VkImage image, VkImageView view,
+                              const TextureDesc& desc, VkImageLayout currentLayout,
+                              VkImageLayout finalLayout = VK_IMAGE_LAYOUT_UNDEFINED);
+  BufferHandle importBuffer(const std::string& name, VkBuffer buffer, VkDeviceSize size);
+
+  // Marks a resource version as a result of the frame: culling walks back from these.
+  void markOutput(TextureHandle h);
+  void markOutput(BufferHandle h);
+
+  Blackboard& blackboard() { return blackboard_; }
+  VkExtent2D outputExtent() const { return outputExtent_; }
+
+  void compile();
+  // Records every kept pass into `cmd` (after compile()); timer may be null.
+  void execute(VkCommandBuffer cmd, vk::DescriptorArena& descriptors, vk::GpuTimer* timer);
+  // Drops all passes and resources declared so far and frees transient memory.
+  void reset();
+
+  std::vector<std::string> executedPasses() const;
+  std::vector<std::string> culledPasses() const;
+  std::string toDot() const;     // Graphviz: kept passes solid, culled passes dashed
+  std::string describe() const;  // human-readable listing (gi-render --print-graph)
+  const GraphStats& stats() const { return stats_; }
+  bool compiled() const { return compiled_; }
+  // The layout an imported texture was left in by the last execute().
+  VkImageLayout layoutAfterExecute(TextureHandle h) const;
+
+ private:
+  friend class PassBuilder;
+  friend class PassContext;
+  struct Resource;
+  struct Pass;
+  struct Access;
+  struct Transient;
+  struct Slot;
+
+  uint32_t addResource(const std::string& name, bool texture);
+  void checkCurrent(uint32_t id, uint32_t version, const char* what) const;
+  VkExtent2D resolveExtent(uint32_t id) const;
+  void allocateTransients();
+  const Resource& resource(uint32_t id) const;
+
+  vk::Context& ctx_;
+  VkExtent2D outputExtent_;
+  std::vector<std::unique_ptr<Resource>> resources_;
+  std::vector<std::unique_ptr<Pass>> passes_;
+  std::vector<std::pair<uint32_t, uint32_t>> outputs_;  // (resource, version)
+  std::vector<std::unique_ptr<Transient>> pool_;        // transient images and buffers
+  std::vector<Slot> slots_;                             // their (aliased) memory
+  Blackboard blackboard_;
+  GraphStats stats_;
+  bool compiled_ = false;
+};
+
+}  // namespace gi
