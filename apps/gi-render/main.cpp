@@ -8,11 +8,13 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "gi/effect_config.h"
 #include "gi/errors.h"
 #include "gi/image_io.h"
 #include "gi/renderer.h"
@@ -32,15 +34,23 @@ const char* kUsage =
     "                         (default 1; with --window: until the window is closed)\n"
     "  --time T               animation clock in seconds (default 0)\n"
     "  --timings              print the median GPU time of each pass and peak memory\n"
-    "  --view TARGET          write a raw target instead of the final image:\n"
-    "                         output, lit, depth, normal, albedo, material, emission, motion, "
-    "floor\n"
+    "  --view NAME            write a raw resource instead of the final image: output, lit,\n"
+    "                         depth, normal, albedo, material, emission, motion, floor, or an\n"
+    "                         effect's name for its debug view (e.g. ssao)\n"
+    "  --effects A,B          effects to run, replacing the scene's list ('' for none)\n"
+    "  --preset NAME|FILE     quality preset (assets/presets): settings for the effects\n"
+    "  --set EFFECT.KEY=V     override one setting (after preset and scene; repeatable)\n"
+    "  --list-effects         list the effect plugins found, with their settings, and exit\n"
+    "  --print-graph          print the compiled frame graph (executed and culled passes)\n"
+    "  --graph-dot FILE       write the frame graph as Graphviz dot\n"
     "  --exposure E           exposure before tonemapping (default 1)\n"
     "  --validation           enable Vulkan validation layers (also GI_VALIDATION=1)\n"
     "  --device NAME          pick the Vulkan device by name or index (also GI_DEVICE)\n";
 
 struct Options {
-  std::string scene, out, view = "output", device;
+  std::string scene, out, view = "output", device, preset, graphDot;
+  gi::EffectOverrides overrides;
+  bool listEffects = false, printGraph = false;
   uint32_t width = 640, height = 480;
   int frames = 0;  // 0: not given (one frame, or until the window closes)
   double time = 0.0;
@@ -97,57 +107,89 @@ Options parseArgs(int argc, char** argv) {
       o.validation = true;
     else if (a == "--window")
       o.window = true;
+    else if (a == "--effects")
+      o.overrides.effects = gi::splitEffectList(value());
+    else if (a == "--preset")
+      o.preset = value();
+    else if (a == "--set")
+      o.overrides.sets.push_back(value());
+    else if (a == "--list-effects")
+      o.listEffects = true;
+    else if (a == "--print-graph")
+      o.printGraph = true;
+    else if (a == "--graph-dot")
+      o.graphDot = value();
     else
       usageError("unknown argument '" + a + "'");
   }
+  if (o.listEffects) return o;
   if (o.scene.empty()) usageError("--scene is required");
   if (o.out.empty() && !o.window) usageError("--out is required (or --window)");
   return o;
 }
 
-gi::Target parseView(const std::string& v) {
-  static const std::map<std::string, gi::Target> views = {
-      {"output", gi::Target::Output},     {"lit", gi::Target::Lit},
-      {"depth", gi::Target::Depth},       {"normal", gi::Target::Normal},
-      {"albedo", gi::Target::Albedo},     {"material", gi::Target::Material},
-      {"emission", gi::Target::Emission}, {"motion", gi::Target::Motion},
-      {"floor", gi::Target::Floor}};
-  auto it = views.find(v);
-  if (it == views.end()) usageError("unknown --view '" + v + "'");
-  return it->second;
-}
-
-// Float target -> 8-bit preview (values clamped to [0,1]; normals/motion shifted to be visible).
-gi::ImageRGBA8 toPreview(const gi::ImageRGBA32F& img, gi::Target t) {
+// Float target -> 8-bit preview (values clamped to [0,1]; normals/motion shifted to be visible,
+// depth and single-channel targets shown as grey).
+gi::ImageRGBA8 toPreview(const gi::ImageRGBA32F& img, const std::string& view) {
+  const bool signedData = view == gi::resources::kNormal || view == gi::resources::kMotion;
+  const bool grey = view == gi::resources::kDepth || view == gi::resources::kAO;
   gi::ImageRGBA8 out{img.width, img.height, std::vector<uint8_t>(img.pixels.size())};
   for (size_t i = 0; i < img.pixels.size(); ++i) {
-    float v = img.pixels[i];
-    if ((t == gi::Target::Normal || t == gi::Target::Motion) && i % 4 != 3) v = v * 0.5f + 0.5f;
-    if (t == gi::Target::Depth && i % 4 != 3) v = img.pixels[i - i % 4];
+    float v = grey ? img.pixels[i - i % 4] : img.pixels[i];
+    if (signedData) v = v * 0.5f + 0.5f;
     if (i % 4 == 3) v = 1.0f;
     out.pixels[i] = uint8_t(std::clamp(v, 0.0f, 1.0f) * 255.0f + 0.5f);
   }
   return out;
 }
 
-void writeImage(const std::string& path, gi::Target view, gi::Renderer& renderer) {
+void writeImage(const std::string& path, const std::string& view, gi::Renderer& renderer) {
+  const bool output = view == gi::resources::kOutput;
   if (std::filesystem::path(path).extension() == ".pfm")
-    gi::writePfm(path, renderer.readTarget(view == gi::Target::Output ? gi::Target::Lit : view));
-  else if (view == gi::Target::Output)
+    gi::writePfm(path, renderer.readTarget(output ? gi::resources::kLit : view));
+  else if (output)
     gi::writePng(path, renderer.readOutput());
   else
     gi::writePng(path, toPreview(renderer.readTarget(view), view));
 }
 
+// Writes `text` to `path` through a temporary file (no partial output on failure).
+void writeText(const std::string& path, const std::string& text) {
+  const std::string tmp = path + ".partial";
+  {
+    std::ofstream out(tmp);
+    out << text;
+    if (!out) throw gi::Error(gi::ErrorKind::FileNotFound, path, "cannot write file");
+  }
+  std::filesystem::rename(tmp, path);
+}
+
+int listEffects() {
+  gi::EffectRegistry registry;
+  registry.scanDefaultLocations();
+  std::printf("%s", registry.describe().c_str());
+  return 0;
+}
+
 int run(const Options& o) {
+  if (o.listEffects) return listEffects();
   const std::string ext = std::filesystem::path(o.out).extension().string();
   if (!o.out.empty() && ext != ".png" && ext != ".pfm")
     throw gi::Error(gi::ErrorKind::Usage, o.out, "output must end in .png or .pfm");
-  const gi::Target view = parseView(o.view);
-  // Load (and validate) the scene before any Vulkan work, so bad input fails fast.
+  // Load and validate everything (scene, effects, preset, settings) before any Vulkan work,
+  // so bad input fails fast.
   gi::Scene scene = gi::loadScene(o.scene);
   for (const std::string& w : scene.warnings)
     std::fprintf(stderr, "gi-render: warning: %s\n", w.c_str());
+  gi::EffectRegistry registry;
+  registry.scanDefaultLocations();
+  std::optional<gi::Preset> preset;
+  if (!o.preset.empty()) preset = gi::loadPreset(o.preset);
+  std::vector<gi::EffectConfig> effects =
+      gi::resolveEffects(scene, preset ? &*preset : nullptr, o.overrides, registry);
+  // An effect's name as a view means its debug view.
+  std::string view = o.view;
+  if (registry.has(view)) view = registry.info(view).debugView;
 
   gi::vk::ContextOptions ctxOptions = gi::vk::ContextOptions::fromEnvironment();
   ctxOptions.validation = o.validation;
@@ -164,8 +206,12 @@ int run(const Options& o) {
   settings.width = o.width;
   settings.height = o.height;
   settings.exposure = o.exposure;
-  settings.floorPass = o.timings || view == gi::Target::Floor;
-  gi::Renderer renderer(ctx, scene, settings);
+  settings.floorPass = o.timings;
+  settings.view = view;
+  settings.effects = effects;
+  gi::Renderer renderer(ctx, scene, settings, &registry);
+  if (o.printGraph) std::printf("%s", renderer.graphDescription().c_str());
+  if (!o.graphDot.empty()) writeText(o.graphDot, renderer.graphDot());
   std::optional<gi::vk::Swapchain> swapchain;
   if (window) swapchain.emplace(ctx, window->handle());
 
@@ -193,6 +239,10 @@ int run(const Options& o) {
       std::printf("%-12s %12.3f\n", name.c_str(), median);
     }
     std::printf("%-12s %12.3f\n", "total", total);
+    std::string culled;
+    for (const std::string& c : renderer.culledPassNames()) culled += " " + c;
+    std::printf("culled passes:%s\n", culled.empty() ? " none" : culled.c_str());
+    std::printf("frame graph compile %.3f ms (CPU)\n", renderer.lastCompileMs());
     rusage usage{};
     getrusage(RUSAGE_SELF, &usage);
     std::printf("peak memory %.1f MiB\n", usage.ru_maxrss / 1024.0);

@@ -21,6 +21,9 @@ layout(set = 0, binding = 4) uniform sampler2D gMaterial;
 layout(set = 0, binding = 5) uniform sampler2D gEmission;
 layout(set = 0, binding = 6, std430) readonly buffer Lights { Light lights[]; };
 layout(set = 0, binding = 7, rgba16f) uniform writeonly image2D outLit;
+// Ambient occlusion of the environment term (any resolution; a 1x1 white texture when no
+// effect produces AO, so lighting works either way).
+layout(set = 0, binding = 8) uniform sampler2D aoTexture;
 
 const float PI = 3.14159265358979;
 // Guard: squared light distance is clamped so a light on the surface stays finite.
@@ -81,6 +84,7 @@ void main() {
     color += brdf * light.radiance.rgb * attenuation * ndl;
   }
   vec3 nWorld = mat3(frame.invView) * n;
-  color += diffuseColor * environmentIrradianceOverPi(frame, nWorld);
+  float ao = clamp(texture(aoTexture, uv).r, 0.0, 1.0);
+  color += diffuseColor * environmentIrradianceOverPi(frame, nWorld) * ao;
   imageStore(outLit, p, vec4(color, 1.0));
 }

@@ -1,26 +1,34 @@
-// The built-in frame: G-buffer -> direct lighting -> tonemap, plus the floor pass used as the
-// cost baseline. Renders headless into offscreen targets that can be read back.
+// The frame: the engine's G-buffer, lighting, tonemap and floor passes plus the effects the
+// scene asks for, assembled into a frame graph that keeps only what reaches the requested
+// view. Renders headless into offscreen targets that can be read back.
 #pragma once
 
 #include <memory>
 #include <string>
-#include <utility>
 #include <vector>
 
+#include "gi/effect_registry.h"
 #include "gi/image_io.h"
 #include "gi/scene.h"
+#include "gi/settings.h"
 #include "gi/vk/context.h"
 
 namespace gi {
 
+// One requested effect with its resolved settings.
+struct EffectConfig {
+  std::string name;
+  SettingValues settings;
+};
+
 struct RenderSettings {
   uint32_t width = 640, height = 480;
   float exposure = 1.0f;
-  bool floorPass = false;  // also run the floor pass (for timing baselines)
+  bool floorPass = false;  // also keep the floor pass (for timing baselines)
+  std::string view =
+      "output";  // the resource the frame delivers (a G-buffer channel, an effect's view)
+  std::vector<EffectConfig> effects;
 };
-
-// Offscreen targets that can be read back (tests, debug views).
-enum class Target { Depth, Normal, Albedo, Material, Emission, Motion, Lit, Output, Floor };
 
 struct PassTiming {
   std::string name;
@@ -29,7 +37,9 @@ struct PassTiming {
 
 class Renderer {
  public:
-  Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& settings);
+  // `registry` must outlive the renderer when effects are requested.
+  Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& settings,
+           const EffectRegistry* registry = nullptr);
   ~Renderer();
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
@@ -37,10 +47,20 @@ class Renderer {
   // Records, submits and waits for one frame; per-pass GPU times end up in lastTimings().
   void renderFrame();
   const std::vector<PassTiming>& lastTimings() const;
-  std::vector<std::string> passNames() const;  // passes the last frame executed, in order
+  std::vector<std::string> passNames() const;        // passes the graph executes, in order
+  std::vector<std::string> culledPassNames() const;  // passes declared but culled
+  std::string graphDescription() const;              // gi-render --print-graph
+  std::string graphDot() const;                      // Graphviz
+  double lastCompileMs() const;                      // CPU time of the last graph build + compile
 
-  ImageRGBA8 readOutput();                 // tonemapped 8-bit image
-  ImageRGBA32F readTarget(Target target);  // any target as float RGBA (depth in r)
+  // Changes one effect's settings: uniform-only changes apply next frame; a change of a
+  // setting marked `changesGraph` re-prepares the effect and recompiles the graph.
+  void setEffectSettings(const std::string& effect, const SettingValues& values);
+  bool graphRecompiledByLastChange() const;
+
+  ImageRGBA8 readOutput();                           // tonemapped 8-bit image (view "output")
+  ImageRGBA32F readTarget(const std::string& name);  // any produced resource as float RGBA
+  std::vector<std::string> viewNames() const;        // resources that can be viewed / read
   const CameraView& camera() const;
   // The tonemapped RGBA8 image; after renderFrame() it is in VK_IMAGE_LAYOUT_GENERAL and all
   // writes are complete (a presenter copies it into a swapchain image).

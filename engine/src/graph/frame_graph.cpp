@@ -622,8 +622,13 @@ void FrameGraph::execute(VkCommandBuffer cmd, vk::DescriptorArena& descriptors,
   }
 }
 
-VkImageLayout FrameGraph::layoutAfterExecute(TextureHandle h) const {
-  return resource(h.id).state.layout;
+FrameGraph::TextureState FrameGraph::textureState(TextureHandle h) const {
+  const Resource& r = resource(h.id);
+  if (!r.texture || !r.image)
+    throw Error(ErrorKind::Usage, "",
+                "frame graph: '" + r.name + "' was not produced (its passes were culled)");
+  return {r.image, r.view, r.textureDesc.format, r.imported ? resolveExtent(h.id) : r.extent,
+          r.state.layout};
 }
 
 std::vector<std::string> FrameGraph::executedPasses() const {

@@ -2,10 +2,13 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 
+#include "gi/effect.h"
 #include "gi/errors.h"
+#include "gi/graph/frame_graph.h"
 #include "gi/vk/common.h"
 #include "gi/vk/gpu_timer.h"
 #include "gi/vk/pipeline.h"
@@ -15,16 +18,9 @@
 namespace gi {
 
 using namespace gi::vk;
+namespace res = gi::resources;
 
 namespace {
-
-constexpr VkFormat kDepthFormat = VK_FORMAT_D32_SFLOAT;
-
-// A render target and the layout it was left in.
-struct TargetImage {
-  Image image;
-  VkImageLayout layout = VK_IMAGE_LAYOUT_UNDEFINED;
-};
 
 // Cofactor of the upper 3x3 (columns b x c, c x a, a x b), signed by the determinant: transforms
 // normals like the inverse transpose but stays finite when the matrix is singular.
@@ -40,12 +36,17 @@ uint32_t groups(uint32_t n) {
   return (n + 7) / 8;
 }
 
+TextureDesc outputRelative(VkFormat format) {
+  return TextureDesc{format};
+}
+
 }  // namespace
 
-struct Renderer::Impl {
+struct Renderer::Impl : EffectContext {
   Context& ctx;
   RenderSettings settings;
   const Scene& scene;
+  const EffectRegistry* registry;
   CameraView cameraView;
 
   // Scene data on the GPU.
@@ -58,30 +59,50 @@ struct Renderer::Impl {
   std::vector<Draw> draws;
   std::vector<Material> sceneMaterials;
   std::vector<Image> textures;
-  Image whiteTexture;
-  Sampler linearSampler, nearestSampler;
+  Image whiteTexture, neutralAO, output;
+  Sampler linearRepeat, linearClamp, nearestClamp;
   uint32_t lightCount = 0;
 
-  // Targets.
-  TargetImage depth, normal, albedo, material, emission, motion, lit, output, floorTarget;
-
   Pipeline gbufferPipeline, lightingPipeline, tonemapPipeline, floorPipeline;
+  struct ActiveEffect {
+    std::unique_ptr<Effect> effect;
+    EffectInfo info;
+    SettingValues settings;
+  };
+  std::vector<ActiveEffect> effects;
+
+  FrameGraph graph;
+  TextureHandle outputHandle;
+  bool graphDirty = true, recompiledByLastChange = false;
+  double compileMs = 0.0;
   DescriptorArena descriptors;
   GpuTimer timer;
   VkCommandBuffer cmd = VK_NULL_HANDLE;
   VkFence fence = VK_NULL_HANDLE;
   std::vector<PassTiming> timings;
-  std::vector<std::string> executed;
 
-  Impl(Context& c, const Scene& s, const RenderSettings& rs)
-      : ctx(c), settings(rs), scene(s), descriptors(c), timer(c) {
+  Impl(Context& c, const Scene& s, const RenderSettings& rs, const EffectRegistry* reg)
+      : ctx(c),
+        settings(rs),
+        scene(s),
+        registry(reg),
+        graph(c, {rs.width, rs.height}),
+        descriptors(c),
+        timer(c) {
     if (settings.width == 0 || settings.height == 0 || settings.width > 16384 ||
         settings.height > 16384)
       throw Error(ErrorKind::Usage, "", "image size must be between 1x1 and 16384x16384");
     cameraView = activeCamera(scene, float(settings.width) / float(settings.height));
     uploadScene();
-    createTargets();
     createPipelines();
+    for (const EffectConfig& e : settings.effects) {
+      if (!registry)
+        throw Error(ErrorKind::Usage, "",
+                    "effect '" + e.name + "' requested but no registry given");
+      ActiveEffect a{registry->create(e.name), registry->info(e.name), e.settings};
+      a.effect->prepare(*this, a.settings);
+      effects.push_back(std::move(a));
+    }
     VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
     alloc.commandPool = ctx.commandPool();
     alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
@@ -89,12 +110,33 @@ struct Renderer::Impl {
     check(vkAllocateCommandBuffers(ctx.device(), &alloc, &cmd), "vkAllocateCommandBuffers");
     VkFenceCreateInfo fenceInfo{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
     check(vkCreateFence(ctx.device(), &fenceInfo, nullptr, &fence), "vkCreateFence");
+    buildGraph();
   }
 
-  ~Impl() {
+  ~Impl() override {
     vkDeviceWaitIdle(ctx.device());
+    graph.reset();
+    effects.clear();
     vkDestroyFence(ctx.device(), fence, nullptr);
     vkFreeCommandBuffers(ctx.device(), ctx.commandPool(), 1, &cmd);
+  }
+
+  // EffectContext
+  vk::Context& vulkan() override { return ctx; }
+  VkBuffer frameUniforms() override { return frameBuffer.handle(); }
+  VkSampler nearestSampler() override { return nearestClamp.handle(); }
+  VkSampler linearSampler() override { return linearClamp.handle(); }
+  VkExtent2D outputExtent() override { return {settings.width, settings.height}; }
+
+  Image makeTexture(VkFormat format, uint32_t w, uint32_t h, const void* pixels, size_t bytes) {
+    ImageDesc desc;
+    desc.format = format;
+    desc.width = w;
+    desc.height = h;
+    desc.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+    Image img(ctx, desc);
+    uploadImage(ctx, img, pixels, bytes);
+    return img;
   }
 
   void uploadScene() {
@@ -157,28 +199,20 @@ struct Renderer::Impl {
         createDeviceBuffer(ctx, materials.data(), materials.size() * sizeof(gpu::Material),
                            VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
 
+    const uint8_t white[4] = {255, 255, 255, 255};
     for (const Texture& t : scene.textures) {
       bool valid = t.width > 0 && t.height > 0 && t.rgba8.size() == size_t(t.width) * t.height * 4;
-      const uint8_t white[4] = {255, 255, 255, 255};
-      ImageDesc desc;
-      desc.format = VK_FORMAT_R8G8B8A8_SRGB;
-      desc.width = valid ? uint32_t(t.width) : 1;
-      desc.height = valid ? uint32_t(t.height) : 1;
-      desc.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
-      Image img(ctx, desc);
-      uploadImage(ctx, img, valid ? t.rgba8.data() : white, valid ? t.rgba8.size() : 4);
-      textures.push_back(std::move(img));
+      textures.push_back(valid ? makeTexture(VK_FORMAT_R8G8B8A8_SRGB, t.width, t.height,
+                                             t.rgba8.data(), t.rgba8.size())
+                               : makeTexture(VK_FORMAT_R8G8B8A8_SRGB, 1, 1, white, 4));
     }
-    {  // bound for materials without a texture (the binding must always be valid)
-      const uint8_t white[4] = {255, 255, 255, 255};
-      ImageDesc desc;
-      desc.format = VK_FORMAT_R8G8B8A8_SRGB;
-      desc.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
-      whiteTexture = Image(ctx, desc);
-      uploadImage(ctx, whiteTexture, white, 4);
-    }
-    linearSampler = Sampler(ctx, VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_REPEAT);
-    nearestSampler = Sampler(ctx, VK_FILTER_NEAREST, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE);
+    // Bound for materials without a texture (the binding must always be valid).
+    whiteTexture = makeTexture(VK_FORMAT_R8G8B8A8_SRGB, 1, 1, white, 4);
+    // The neutral AO (1 everywhere) that lighting samples when no effect produces AO.
+    neutralAO = makeTexture(VK_FORMAT_R8G8B8A8_UNORM, 1, 1, white, 4);
+    linearRepeat = Sampler(ctx, VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_REPEAT);
+    linearClamp = Sampler(ctx, VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE);
+    nearestClamp = Sampler(ctx, VK_FILTER_NEAREST, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE);
 
     std::vector<gpu::Light> lights;
     for (const Node& node : scene.nodes) {
@@ -201,28 +235,14 @@ struct Renderer::Impl {
     lightBuffer = createDeviceBuffer(ctx, lights.data(), lights.size() * sizeof(gpu::Light),
                                      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
     frameBuffer = Buffer(ctx, sizeof(gpu::FrameUniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true);
-  }
 
-  TargetImage makeTarget(VkFormat format, VkImageUsageFlags usage) {
-    ImageDesc d;
-    d.format = format;
-    d.width = settings.width;
-    d.height = settings.height;
-    d.usage = usage | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
-    return {Image(ctx, d), VK_IMAGE_LAYOUT_UNDEFINED};
-  }
-
-  void createTargets() {
-    const VkImageUsageFlags color = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT;
-    depth = makeTarget(kDepthFormat, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT);
-    normal = makeTarget(VK_FORMAT_R16G16B16A16_SFLOAT, color);
-    albedo = makeTarget(VK_FORMAT_R8G8B8A8_SRGB, color);
-    material = makeTarget(VK_FORMAT_R8G8B8A8_UNORM, color);
-    emission = makeTarget(VK_FORMAT_R16G16B16A16_SFLOAT, color);
-    motion = makeTarget(VK_FORMAT_R16G16_SFLOAT, color);
-    lit = makeTarget(VK_FORMAT_R16G16B16A16_SFLOAT, VK_IMAGE_USAGE_STORAGE_BIT);
-    output = makeTarget(VK_FORMAT_R8G8B8A8_UNORM, VK_IMAGE_USAGE_STORAGE_BIT);
-    floorTarget = makeTarget(VK_FORMAT_R8G8B8A8_UNORM, VK_IMAGE_USAGE_STORAGE_BIT);
+    ImageDesc od;
+    od.format = VK_FORMAT_R8G8B8A8_UNORM;
+    od.width = settings.width;
+    od.height = settings.height;
+    od.usage =
+        VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+    output = Image(ctx, od);
   }
 
   void createPipelines() {
@@ -238,18 +258,245 @@ struct Renderer::Impl {
     g.vertexLayout.attributes = {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, position)},
                                  {1, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, normal)},
                                  {2, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(Vertex, uv)}};
-    g.colorFormats = {normal.image.desc().format, albedo.image.desc().format,
-                      material.image.desc().format, emission.image.desc().format,
-                      motion.image.desc().format};
-    g.depthFormat = kDepthFormat;
+    g.colorFormats = {VK_FORMAT_R16G16B16A16_SFLOAT, VK_FORMAT_R8G8B8A8_SRGB,
+                      VK_FORMAT_R8G8B8A8_UNORM, VK_FORMAT_R16G16B16A16_SFLOAT,
+                      VK_FORMAT_R16G16_SFLOAT};
+    g.depthFormat = VK_FORMAT_D32_SFLOAT;
     gbufferPipeline = Pipeline::graphics(ctx, g);
-    lightingPipeline = Pipeline::compute(
-        ctx, loadSpirv("lighting.comp"),
-        {{0, ubo}, {1, tex}, {2, tex}, {3, tex}, {4, tex}, {5, tex}, {6, ssbo}, {7, img}});
+    lightingPipeline = Pipeline::compute(ctx, loadSpirv("lighting.comp"),
+                                         {{0, ubo},
+                                          {1, tex},
+                                          {2, tex},
+                                          {3, tex},
+                                          {4, tex},
+                                          {5, tex},
+                                          {6, ssbo},
+                                          {7, img},
+                                          {8, tex}});
     tonemapPipeline =
         Pipeline::compute(ctx, loadSpirv("tonemap.comp"), {{0, ubo}, {1, tex}, {2, img}});
     floorPipeline = Pipeline::compute(ctx, loadSpirv("floor.comp"), {{0, ubo}, {1, tex}, {2, img}});
   }
+
+  // ---- the frame graph ------------------------------------------------------------------
+
+  void buildGraph() {
+    const auto start = std::chrono::steady_clock::now();
+    graph.reset();
+    Blackboard& bb = graph.blackboard();
+    TextureDesc outDesc{VK_FORMAT_R8G8B8A8_UNORM};
+    // GENERAL at the end of every frame: presenters and read-back expect it.
+    outputHandle = graph.importTexture(res::kOutput, output.handle(), output.view(), outDesc,
+                                       VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL);
+    addGBufferPass(bb);
+    addEffects(EffectStage::BeforeLighting);
+    addLightingPass(bb);
+    addEffects(EffectStage::AfterLighting);
+    addTonemapPass(bb);
+    addFloorPass(bb);
+    if (!bb.has(settings.view)) {
+      std::string names;
+      for (const std::string& n : bb.names()) names += (names.empty() ? "" : ", ") + n;
+      throw Error(ErrorKind::Usage, "",
+                  "unknown view '" + settings.view + "' (available: " + names + ")");
+    }
+    graph.markOutput(bb.texture(settings.view));
+    if (settings.floorPass) graph.markOutput(bb.texture(res::kFloor));
+    graph.compile();
+    graphDirty = false;
+    compileMs =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  }
+
+  void addEffects(EffectStage stage) {
+    for (ActiveEffect& a : effects)
+      if (a.info.stage == stage) a.effect->addPasses(graph, *this, a.settings);
+  }
+
+  void bind(VkCommandBuffer c, const Pipeline& p, DescriptorWriter& writer) {
+    VkDescriptorSet set = descriptors.allocate(p.setLayout());
+    writer.update(ctx.device(), set);
+    vkCmdBindPipeline(c, p.bindPoint(), p.handle());
+    vkCmdBindDescriptorSets(c, p.bindPoint(), p.layout(), 0, 1, &set, 0, nullptr);
+  }
+
+  void addGBufferPass(Blackboard& bb) {
+    struct Targets {
+      TextureHandle depth, normal, albedo, material, emission, motion;
+    };
+    auto t = std::make_shared<Targets>();
+    graph.addPass(
+        "gbuffer",
+        [&](PassBuilder& b) {
+          t->depth = b.write(b.create(res::kDepth, outputRelative(VK_FORMAT_D32_SFLOAT)),
+                             TextureUsage::DepthAttachment);
+          t->normal = b.write(b.create(res::kNormal, outputRelative(VK_FORMAT_R16G16B16A16_SFLOAT)),
+                              TextureUsage::ColorAttachment);
+          t->albedo = b.write(b.create(res::kAlbedo, outputRelative(VK_FORMAT_R8G8B8A8_SRGB)),
+                              TextureUsage::ColorAttachment);
+          t->material = b.write(b.create(res::kMaterial, outputRelative(VK_FORMAT_R8G8B8A8_UNORM)),
+                                TextureUsage::ColorAttachment);
+          t->emission =
+              b.write(b.create(res::kEmission, outputRelative(VK_FORMAT_R16G16B16A16_SFLOAT)),
+                      TextureUsage::ColorAttachment);
+          t->motion = b.write(b.create(res::kMotion, outputRelative(VK_FORMAT_R16G16_SFLOAT)),
+                              TextureUsage::ColorAttachment);
+        },
+        [this, t](PassContext& pc) { recordGBuffer(pc, *t); });
+    bb.put(res::kDepth, t->depth);
+    bb.put(res::kNormal, t->normal);
+    bb.put(res::kAlbedo, t->albedo);
+    bb.put(res::kMaterial, t->material);
+    bb.put(res::kEmission, t->emission);
+    bb.put(res::kMotion, t->motion);
+  }
+
+  template <class Targets>
+  void recordGBuffer(PassContext& pc, const Targets& t) {
+    VkCommandBuffer c = pc.cmd();
+    std::array<TextureHandle, 5> colors = {t.normal, t.albedo, t.material, t.emission, t.motion};
+    std::array<VkRenderingAttachmentInfo, 5> attachments{};
+    for (size_t i = 0; i < colors.size(); ++i) {
+      attachments[i] = {VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+      attachments[i].imageView = pc.view(colors[i]);
+      attachments[i].imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+      attachments[i].loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+      attachments[i].storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+      attachments[i].clearValue.color = {{0.0f, 0.0f, 0.0f, 0.0f}};
+    }
+    VkRenderingAttachmentInfo depthAttachment{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+    depthAttachment.imageView = pc.view(t.depth);
+    depthAttachment.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
+    depthAttachment.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+    depthAttachment.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+    depthAttachment.clearValue.depthStencil = {0.0f, 0};  // reverse-Z: 0 is the far plane
+    VkRenderingInfo info{VK_STRUCTURE_TYPE_RENDERING_INFO};
+    info.renderArea = {{0, 0}, {settings.width, settings.height}};
+    info.layerCount = 1;
+    info.colorAttachmentCount = uint32_t(attachments.size());
+    info.pColorAttachments = attachments.data();
+    info.pDepthAttachment = &depthAttachment;
+    vkCmdBeginRendering(c, &info);
+    vkCmdBindPipeline(c, VK_PIPELINE_BIND_POINT_GRAPHICS, gbufferPipeline.handle());
+    VkViewport viewport{0, 0, float(settings.width), float(settings.height), 0.0f, 1.0f};
+    VkRect2D scissor{{0, 0}, {settings.width, settings.height}};
+    vkCmdSetViewport(c, 0, 1, &viewport);
+    vkCmdSetScissor(c, 0, 1, &scissor);
+    if (!draws.empty()) {
+      VkDeviceSize offset = 0;
+      VkBuffer vb = vertexBuffer.handle();
+      vkCmdBindVertexBuffers(c, 0, 1, &vb, &offset);
+      vkCmdBindIndexBuffer(c, indexBuffer.handle(), 0, VK_INDEX_TYPE_UINT32);
+      uint32_t boundMaterial = UINT32_MAX;
+      for (const Draw& d : draws) {
+        if (d.material != boundMaterial) {
+          bindMaterialSet(c, d.material);
+          boundMaterial = d.material;
+        }
+        vkCmdPushConstants(c, gbufferPipeline.layout(), VK_SHADER_STAGE_ALL, 0, sizeof(uint32_t),
+                           &d.instance);
+        vkCmdDrawIndexed(c, d.indexCount, 1, d.firstIndex, d.vertexOffset, 0);
+      }
+    }
+    vkCmdEndRendering(c);
+  }
+
+  void bindMaterialSet(VkCommandBuffer c, uint32_t materialIndex) {
+    const Material& m = sceneMaterials[materialIndex];
+    const bool textured = m.baseColorTexture >= 0 && m.baseColorTexture < int(textures.size());
+    VkDescriptorSet set = descriptors.allocate(gbufferPipeline.setLayout());
+    DescriptorWriter()
+        .buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frameBuffer.handle())
+        .buffer(1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, instanceBuffer.handle())
+        .buffer(2, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, materialBuffer.handle())
+        .sampled(3, textured ? textures[m.baseColorTexture].view() : whiteTexture.view(),
+                 linearRepeat.handle())
+        .update(ctx.device(), set);
+    vkCmdBindDescriptorSets(c, VK_PIPELINE_BIND_POINT_GRAPHICS, gbufferPipeline.layout(), 0, 1,
+                            &set, 0, nullptr);
+  }
+
+  void addLightingPass(Blackboard& bb) {
+    struct Io {
+      TextureHandle depth, normal, albedo, material, emission, ao, lit;
+    };
+    auto io = std::make_shared<Io>();
+    // Optional input: AO from whichever effect published it, else the neutral white texture.
+    TextureHandle ao = bb.texture(res::kAO);
+    if (!ao.valid())
+      ao =
+          graph.importTexture("ao_neutral", neutralAO.handle(), neutralAO.view(),
+                              {VK_FORMAT_R8G8B8A8_UNORM}, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+    graph.addPass(
+        "lighting",
+        [&](PassBuilder& b) {
+          io->depth = b.read(bb.texture(res::kDepth));
+          io->normal = b.read(bb.texture(res::kNormal));
+          io->albedo = b.read(bb.texture(res::kAlbedo));
+          io->material = b.read(bb.texture(res::kMaterial));
+          io->emission = b.read(bb.texture(res::kEmission));
+          io->ao = b.read(ao);
+          io->lit = b.write(b.create(res::kLit, outputRelative(VK_FORMAT_R16G16B16A16_SFLOAT)),
+                            TextureUsage::StorageWrite);
+        },
+        [this, io](PassContext& pc) {
+          DescriptorWriter w;
+          w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frameBuffer.handle())
+              .sampled(1, pc.view(io->depth), nearestClamp.handle())
+              .sampled(2, pc.view(io->normal), nearestClamp.handle())
+              .sampled(3, pc.view(io->albedo), nearestClamp.handle())
+              .sampled(4, pc.view(io->material), nearestClamp.handle())
+              .sampled(5, pc.view(io->emission), nearestClamp.handle())
+              .buffer(6, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, lightBuffer.handle())
+              .storageImage(7, pc.view(io->lit))
+              .sampled(8, pc.view(io->ao), linearClamp.handle());
+          bind(pc.cmd(), lightingPipeline, w);
+          vkCmdDispatch(pc.cmd(), groups(settings.width), groups(settings.height), 1);
+        });
+    bb.put(res::kLit, io->lit);
+  }
+
+  void addTonemapPass(Blackboard& bb) {
+    auto io = std::make_shared<std::pair<TextureHandle, TextureHandle>>();
+    graph.addPass(
+        "tonemap",
+        [&](PassBuilder& b) {
+          io->first = b.read(bb.texture(res::kLit));
+          io->second = b.write(outputHandle, TextureUsage::StorageWrite);
+        },
+        [this, io](PassContext& pc) {
+          DescriptorWriter w;
+          w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frameBuffer.handle())
+              .sampled(1, pc.view(io->first), nearestClamp.handle())
+              .storageImage(2, pc.view(io->second));
+          bind(pc.cmd(), tonemapPipeline, w);
+          vkCmdDispatch(pc.cmd(), groups(settings.width), groups(settings.height), 1);
+        });
+    outputHandle = io->second;
+    bb.put(res::kOutput, outputHandle);
+  }
+
+  void addFloorPass(Blackboard& bb) {
+    auto io = std::make_shared<std::pair<TextureHandle, TextureHandle>>();
+    graph.addPass(
+        "floor",
+        [&](PassBuilder& b) {
+          io->first = b.read(bb.texture(res::kNormal));
+          io->second = b.write(b.create(res::kFloor, outputRelative(VK_FORMAT_R8G8B8A8_UNORM)),
+                               TextureUsage::StorageWrite);
+        },
+        [this, io](PassContext& pc) {
+          DescriptorWriter w;
+          w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frameBuffer.handle())
+              .sampled(1, pc.view(io->first), nearestClamp.handle())
+              .storageImage(2, pc.view(io->second));
+          bind(pc.cmd(), floorPipeline, w);
+          vkCmdDispatch(pc.cmd(), groups(settings.width), groups(settings.height), 1);
+        });
+    bb.put(res::kFloor, io->second);
+  }
+
+  // ---- frames ---------------------------------------------------------------------------
 
   void updateFrameUniforms() {
     gpu::FrameUniforms f{};
@@ -272,172 +519,16 @@ struct Renderer::Impl {
     frameBuffer.write(&f, sizeof f);
   }
 
-  // Moves a target to `layout` for the given use (all earlier work must be visible).
-  void transition(TargetImage& t, VkImageLayout layout, VkPipelineStageFlags2 dstStage,
-                  VkAccessFlags2 dstAccess) {
-    imageBarrier(cmd, t.image.handle(), t.image.aspect(), t.layout, layout,
-                 VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT, dstStage,
-                 dstAccess);
-    t.layout = layout;
-  }
-
-  void bind(const Pipeline& p, DescriptorWriter& writer) {
-    VkDescriptorSet set = descriptors.allocate(p.setLayout());
-    writer.update(ctx.device(), set);
-    vkCmdBindPipeline(cmd, p.bindPoint(), p.handle());
-    vkCmdBindDescriptorSets(cmd, p.bindPoint(), p.layout(), 0, 1, &set, 0, nullptr);
-  }
-
-  void bindMaterialSet(uint32_t materialIndex) {
-    const Material& m = sceneMaterials[materialIndex];
-    const bool textured = m.baseColorTexture >= 0 && m.baseColorTexture < int(textures.size());
-    VkDescriptorSet set = descriptors.allocate(gbufferPipeline.setLayout());
-    DescriptorWriter()
-        .buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frameBuffer.handle())
-        .buffer(1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, instanceBuffer.handle())
-        .buffer(2, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, materialBuffer.handle())
-        .sampled(3, textured ? textures[m.baseColorTexture].view() : whiteTexture.view(),
-                 linearSampler.handle())
-        .update(ctx.device(), set);
-    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, gbufferPipeline.layout(), 0, 1,
-                            &set, 0, nullptr);
-  }
-
-  void gbufferPass() {
-    timer.begin(cmd, "gbuffer");
-    const auto colorStage = VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT;
-    const auto colorWrite = VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT;
-    std::array<TargetImage*, 5> colors = {&normal, &albedo, &material, &emission, &motion};
-    for (TargetImage* t : colors) {
-      t->layout = VK_IMAGE_LAYOUT_UNDEFINED;  // contents are rewritten every frame
-      transition(*t, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, colorStage, colorWrite);
-    }
-    depth.layout = VK_IMAGE_LAYOUT_UNDEFINED;
-    transition(
-        depth, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-        VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-        VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
-            VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
-
-    std::array<VkRenderingAttachmentInfo, 5> attachments{};
-    for (size_t i = 0; i < colors.size(); ++i) {
-      attachments[i] = {VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-      attachments[i].imageView = colors[i]->image.view();
-      attachments[i].imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
-      attachments[i].loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
-      attachments[i].storeOp = VK_ATTACHMENT_STORE_OP_STORE;
-      attachments[i].clearValue.color = {{0.0f, 0.0f, 0.0f, 0.0f}};
-    }
-    VkRenderingAttachmentInfo depthAttachment{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-    depthAttachment.imageView = depth.image.view();
-    depthAttachment.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
-    depthAttachment.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
-    depthAttachment.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
-    depthAttachment.clearValue.depthStencil = {0.0f, 0};  // reverse-Z: 0 is the far plane
-    VkRenderingInfo info{VK_STRUCTURE_TYPE_RENDERING_INFO};
-    info.renderArea = {{0, 0}, {settings.width, settings.height}};
-    info.layerCount = 1;
-    info.colorAttachmentCount = uint32_t(attachments.size());
-    info.pColorAttachments = attachments.data();
-    info.pDepthAttachment = &depthAttachment;
-    vkCmdBeginRendering(cmd, &info);
-
-    vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, gbufferPipeline.handle());
-    VkViewport viewport{0, 0, float(settings.width), float(settings.height), 0.0f, 1.0f};
-    VkRect2D scissor{{0, 0}, {settings.width, settings.height}};
-    vkCmdSetViewport(cmd, 0, 1, &viewport);
-    vkCmdSetScissor(cmd, 0, 1, &scissor);
-    if (!draws.empty()) {
-      VkDeviceSize offset = 0;
-      VkBuffer vb = vertexBuffer.handle();
-      vkCmdBindVertexBuffers(cmd, 0, 1, &vb, &offset);
-      vkCmdBindIndexBuffer(cmd, indexBuffer.handle(), 0, VK_INDEX_TYPE_UINT32);
-      uint32_t boundMaterial = UINT32_MAX;
-      for (const Draw& d : draws) {
-        if (d.material != boundMaterial) {
-          bindMaterialSet(d.material);
-          boundMaterial = d.material;
-        }
-        vkCmdPushConstants(cmd, gbufferPipeline.layout(), VK_SHADER_STAGE_ALL, 0, sizeof(uint32_t),
-                           &d.instance);
-        vkCmdDrawIndexed(cmd, d.indexCount, 1, d.firstIndex, d.vertexOffset, 0);
-      }
-    }
-    vkCmdEndRendering(cmd);
-    timer.end(cmd);
-    executed.push_back("gbuffer");
-  }
-
-  void readForCompute(TargetImage& t) {
-    transition(t, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-               VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
-  }
-  void writeFromCompute(TargetImage& t) {
-    t.layout = VK_IMAGE_LAYOUT_UNDEFINED;
-    transition(t, VK_IMAGE_LAYOUT_GENERAL, VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT,
-               VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT);
-  }
-
-  void lightingPass() {
-    for (TargetImage* t : {&depth, &normal, &albedo, &material, &emission}) readForCompute(*t);
-    writeFromCompute(lit);
-    timer.begin(cmd, "lighting");
-    DescriptorWriter w;
-    w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frameBuffer.handle())
-        .sampled(1, depth.image.view(), nearestSampler.handle())
-        .sampled(2, normal.image.view(), nearestSampler.handle())
-        .sampled(3, albedo.image.view(), nearestSampler.handle())
-        .sampled(4, material.image.view(), nearestSampler.handle())
-        .sampled(5, emission.image.view(), nearestSampler.handle())
-        .buffer(6, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, lightBuffer.handle())
-        .storageImage(7, lit.image.view());
-    bind(lightingPipeline, w);
-    vkCmdDispatch(cmd, groups(settings.width), groups(settings.height), 1);
-    timer.end(cmd);
-    executed.push_back("lighting");
-  }
-
-  void tonemapPass() {
-    readForCompute(lit);
-    writeFromCompute(output);
-    timer.begin(cmd, "tonemap");
-    DescriptorWriter w;
-    w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frameBuffer.handle())
-        .sampled(1, lit.image.view(), nearestSampler.handle())
-        .storageImage(2, output.image.view());
-    bind(tonemapPipeline, w);
-    vkCmdDispatch(cmd, groups(settings.width), groups(settings.height), 1);
-    timer.end(cmd);
-    executed.push_back("tonemap");
-  }
-
-  void floorPass() {
-    readForCompute(normal);
-    writeFromCompute(floorTarget);
-    timer.begin(cmd, "floor");
-    DescriptorWriter w;
-    w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frameBuffer.handle())
-        .sampled(1, normal.image.view(), nearestSampler.handle())
-        .storageImage(2, floorTarget.image.view());
-    bind(floorPipeline, w);
-    vkCmdDispatch(cmd, groups(settings.width), groups(settings.height), 1);
-    timer.end(cmd);
-    executed.push_back("floor");
-  }
-
   void renderFrame() {
+    if (graphDirty) buildGraph();
     updateFrameUniforms();
     descriptors.reset();
-    executed.clear();
     check(vkResetCommandBuffer(cmd, 0), "vkResetCommandBuffer");
     VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
     begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
     check(vkBeginCommandBuffer(cmd, &begin), "vkBeginCommandBuffer");
     timer.beginFrame(cmd);
-    gbufferPass();
-    lightingPass();
-    tonemapPass();
-    if (settings.floorPass) floorPass();
+    graph.execute(cmd, descriptors, &timer);
     check(vkEndCommandBuffer(cmd), "vkEndCommandBuffer");
 
     VkCommandBufferSubmitInfo cmdInfo{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
@@ -452,103 +543,114 @@ struct Renderer::Impl {
     for (auto& [name, ms] : timer.collect()) timings.push_back({name, ms});
   }
 
-  TargetImage& target(Target t) {
-    switch (t) {
-      case Target::Depth:
-        return depth;
-      case Target::Normal:
-        return normal;
-      case Target::Albedo:
-        return albedo;
-      case Target::Material:
-        return material;
-      case Target::Emission:
-        return emission;
-      case Target::Motion:
-        return motion;
-      case Target::Lit:
-        return lit;
-      case Target::Output:
-        return output;
-      case Target::Floor:
-        return floorTarget;
+  void setEffectSettings(const std::string& name, const SettingValues& values) {
+    for (ActiveEffect& a : effects) {
+      if (a.info.name != name) continue;
+      recompiledByLastChange = a.settings.graphDiffers(values);
+      a.settings = values;
+      if (recompiledByLastChange) {
+        vkDeviceWaitIdle(ctx.device());
+        graph.reset();  // the effect may replace pipelines the old graph's passes refer to
+        a.effect->prepare(*this, a.settings);
+        graphDirty = true;
+      }
+      return;
     }
-    return output;
+    throw Error(ErrorKind::Usage, "", "effect '" + name + "' is not active in this renderer");
   }
 
-  // Copies a target into host memory (raw texels, tightly packed).
-  std::vector<uint8_t> readRaw(TargetImage& t) {
+  // ---- read-back ------------------------------------------------------------------------
+
+  FrameGraph::TextureState stateOf(const std::string& name) {
+    TextureHandle h = graph.blackboard().texture(name);
+    if (!h.valid())
+      throw Error(ErrorKind::Usage, "", "no resource named '" + name + "' in this frame");
+    return graph.textureState(h);
+  }
+
+  // Copies a produced image into host memory (raw texels, tightly packed).
+  std::vector<uint8_t> readRaw(const FrameGraph::TextureState& t) {
     if (t.layout == VK_IMAGE_LAYOUT_UNDEFINED)
       throw Error(ErrorKind::Usage, "", "target read before any frame wrote it");
-    const ImageDesc& d = t.image.desc();
-    const size_t bytes = size_t(d.width) * d.height * formatBytesPerPixel(d.format);
+    const bool depth = isDepthFormat(t.format);
+    const VkImageAspectFlags aspect = depth ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT;
+    const size_t bytes = size_t(t.extent.width) * t.extent.height * formatBytesPerPixel(t.format);
     Buffer staging(ctx, bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
     ctx.submitAndWait([&](VkCommandBuffer c) {
-      imageBarrier(c, t.image.handle(), t.image.aspect(), t.layout,
-                   VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
-                   VK_ACCESS_2_MEMORY_WRITE_BIT, VK_PIPELINE_STAGE_2_COPY_BIT,
-                   VK_ACCESS_2_TRANSFER_READ_BIT);
+      imageBarrier(c, t.image, aspect, t.layout, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                   VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
+                   VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
       VkBufferImageCopy copy{};
-      copy.imageSubresource = {t.image.aspect(), 0, 0, 1};
-      copy.imageExtent = {d.width, d.height, 1};
-      vkCmdCopyImageToBuffer(c, t.image.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                             staging.handle(), 1, &copy);
-      imageBarrier(c, t.image.handle(), t.image.aspect(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                   t.layout, VK_PIPELINE_STAGE_2_COPY_BIT, 0, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
-                   0);
+      copy.imageSubresource = {aspect, 0, 0, 1};
+      copy.imageExtent = {t.extent.width, t.extent.height, 1};
+      vkCmdCopyImageToBuffer(c, t.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, staging.handle(), 1,
+                             &copy);
+      imageBarrier(c, t.image, aspect, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, t.layout,
+                   VK_PIPELINE_STAGE_2_COPY_BIT, 0, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, 0);
     });
     const auto* p = static_cast<const uint8_t*>(staging.mapped());
     return {p, p + bytes};
   }
 
-  ImageRGBA32F readTarget(Target which) {
-    TargetImage& t = target(which);
+  ImageRGBA32F readTarget(const std::string& name) {
+    const FrameGraph::TextureState t = stateOf(name);
     std::vector<uint8_t> raw = readRaw(t);
-    const ImageDesc& d = t.image.desc();
     ImageRGBA32F img;
-    img.width = int(d.width);
-    img.height = int(d.height);
-    const size_t n = size_t(d.width) * d.height;
+    img.width = int(t.extent.width);
+    img.height = int(t.extent.height);
+    const size_t n = size_t(t.extent.width) * t.extent.height;
     img.pixels.assign(n * 4, 0.0f);
     auto srgbToLinear = [](float c) {
       return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
     };
+    auto half = [&](size_t offset) {
+      uint16_t h;
+      std::memcpy(&h, &raw[offset], 2);
+      return halfToFloat(h);
+    };
     for (size_t i = 0; i < n; ++i) {
       float* o = &img.pixels[i * 4];
-      switch (d.format) {
+      switch (t.format) {
         case VK_FORMAT_D32_SFLOAT:
+        case VK_FORMAT_R32_SFLOAT:
           std::memcpy(&o[0], &raw[i * 4], 4);
           o[3] = 1.0f;
           break;
         case VK_FORMAT_R16G16B16A16_SFLOAT:
-          for (int c = 0; c < 4; ++c) {
-            uint16_t h;
-            std::memcpy(&h, &raw[i * 8 + c * 2], 2);
-            o[c] = halfToFloat(h);
-          }
+          for (int c = 0; c < 4; ++c) o[c] = half(i * 8 + c * 2);
           break;
         case VK_FORMAT_R16G16_SFLOAT:
-          for (int c = 0; c < 2; ++c) {
-            uint16_t h;
-            std::memcpy(&h, &raw[i * 4 + c * 2], 2);
-            o[c] = halfToFloat(h);
-          }
+          o[0] = half(i * 4);
+          o[1] = half(i * 4 + 2);
+          o[3] = 1.0f;
+          break;
+        case VK_FORMAT_R16_SFLOAT:
+          o[0] = half(i * 2);
+          o[3] = 1.0f;
+          break;
+        case VK_FORMAT_R8_UNORM:
+          o[0] = raw[i] / 255.0f;
           o[3] = 1.0f;
           break;
         case VK_FORMAT_R8G8B8A8_SRGB:
           for (int c = 0; c < 4; ++c)
             o[c] = c < 3 ? srgbToLinear(raw[i * 4 + c] / 255.0f) : raw[i * 4 + c] / 255.0f;
           break;
-        default:  // 8-bit UNORM
+        case VK_FORMAT_R8G8B8A8_UNORM:
           for (int c = 0; c < 4; ++c) o[c] = raw[i * 4 + c] / 255.0f;
+          break;
+        default:
+          throw Error(ErrorKind::Unsupported, "",
+                      "cannot read back '" + name + "': unsupported format");
       }
     }
     return img;
   }
 };
 
-Renderer::Renderer(Context& ctx, const Scene& scene, const RenderSettings& settings)
-    : impl_(std::make_unique<Impl>(ctx, scene, settings)) {}
+Renderer::Renderer(Context& ctx, const Scene& scene, const RenderSettings& settings,
+                   const EffectRegistry* registry)
+    : impl_(std::make_unique<Impl>(ctx, scene, settings, registry)) {}
 Renderer::~Renderer() = default;
 void Renderer::renderFrame() {
   impl_->renderFrame();
@@ -557,23 +659,44 @@ const std::vector<PassTiming>& Renderer::lastTimings() const {
   return impl_->timings;
 }
 std::vector<std::string> Renderer::passNames() const {
-  return impl_->executed;
+  return impl_->graph.executedPasses();
+}
+std::vector<std::string> Renderer::culledPassNames() const {
+  return impl_->graph.culledPasses();
+}
+std::string Renderer::graphDescription() const {
+  return impl_->graph.describe();
+}
+std::string Renderer::graphDot() const {
+  return impl_->graph.toDot();
+}
+double Renderer::lastCompileMs() const {
+  return impl_->compileMs;
+}
+void Renderer::setEffectSettings(const std::string& effect, const SettingValues& values) {
+  impl_->setEffectSettings(effect, values);
+}
+bool Renderer::graphRecompiledByLastChange() const {
+  return impl_->recompiledByLastChange;
 }
 const CameraView& Renderer::camera() const {
   return impl_->cameraView;
 }
-ImageRGBA32F Renderer::readTarget(Target target) {
-  return impl_->readTarget(target);
+ImageRGBA32F Renderer::readTarget(const std::string& name) {
+  return impl_->readTarget(name);
+}
+std::vector<std::string> Renderer::viewNames() const {
+  return impl_->graph.blackboard().names();
 }
 VkImage Renderer::outputImage() const {
-  return impl_->output.image.handle();
+  return impl_->output.handle();
 }
 VkExtent2D Renderer::outputExtent() const {
   return {impl_->settings.width, impl_->settings.height};
 }
 
 ImageRGBA8 Renderer::readOutput() {
-  std::vector<uint8_t> raw = impl_->readRaw(impl_->output);
+  std::vector<uint8_t> raw = impl_->readRaw(impl_->stateOf(res::kOutput));
   return {int(impl_->settings.width), int(impl_->settings.height), std::move(raw)};
 }
 

@@ -132,8 +132,16 @@ class FrameGraph {
   std::string describe() const;  // human-readable listing (gi-render --print-graph)
   const GraphStats& stats() const { return stats_; }
   bool compiled() const { return compiled_; }
-  // The layout an imported texture was left in by the last execute().
-  VkImageLayout layoutAfterExecute(TextureHandle h) const;
+  // The Vulkan image behind a handle and the layout the last execute() left it in (for
+  // read-back and presentation). Throws if the resource was culled (never allocated).
+  struct TextureState {
+    VkImage image;
+    VkImageView view;
+    VkFormat format;
+    VkExtent2D extent;
+    VkImageLayout layout;
+  };
+  TextureState textureState(TextureHandle h) const;
 
  private:
   friend class PassBuilder;

@@ -1,0 +1,187 @@
+#include "gi/effect_config.h"
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "gi/errors.h"
+
+namespace gi {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+std::vector<std::string> presetLocations() {
+  std::vector<std::string> dirs;
+  if (const char* env = std::getenv("GI_PRESET_PATH")) {
+    std::stringstream ss(env);
+    std::string d;
+    while (std::getline(ss, d, ':'))
+      if (!d.empty()) dirs.push_back(d);
+  }
+  std::error_code ec;
+  fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) dirs.push_back((exe.parent_path().parent_path() / "share" / "gi" / "presets").string());
+  return dirs;
+}
+
+namespace {
+
+std::string findPreset(const std::string& nameOrPath) {
+  if (nameOrPath.find('/') != std::string::npos || fs::path(nameOrPath).extension() == ".json")
+    return nameOrPath;
+  std::string searched;
+  for (const std::string& dir : presetLocations()) {
+    fs::path p = fs::path(dir) / (nameOrPath + ".json");
+    if (fs::exists(p)) return p.string();
+    searched += " " + dir;
+  }
+  throw Error(ErrorKind::FileNotFound, nameOrPath + ".json",
+              "no preset named '" + nameOrPath + "' (searched:" + searched + ")");
+}
+
+void onlyKeys(const json& j, const std::set<std::string>& allowed, const std::string& where,
+              const std::string& file) {
+  for (auto it = j.begin(); it != j.end(); ++it)
+    if (!allowed.count(it.key()))
+      throw Error(ErrorKind::Schema, file,
+                  (where.empty() ? "" : where + ".") + it.key() + ": unknown key");
+}
+
+}  // namespace
+
+Preset loadPreset(const std::string& nameOrPath) {
+  Preset p;
+  p.path = findPreset(nameOrPath);
+  std::ifstream in(p.path);
+  if (!in) throw Error(ErrorKind::FileNotFound, p.path, "cannot open preset");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  if (ss.str().find_first_not_of(" \t\r\n") == std::string::npos)
+    throw Error(ErrorKind::EmptyFile, p.path, "preset file is empty");
+  json j;
+  try {
+    j = json::parse(ss.str());
+  } catch (const json::parse_error& e) {
+    throw Error(ErrorKind::Parse, p.path, std::string("invalid JSON: ") + e.what());
+  }
+  if (!j.is_object()) throw Error(ErrorKind::Schema, p.path, "a preset must be a JSON object");
+  onlyKeys(j, {"name", "description", "platform", "target_ms", "reference_resolution", "effects"},
+           "", p.path);
+  auto str = [&](const char* key, std::string& out) {
+    if (!j.contains(key)) return;
+    if (!j[key].is_string())
+      throw Error(ErrorKind::Schema, p.path, std::string(key) + ": expected a string");
+    out = j[key];
+  };
+  str("name", p.name);
+  str("description", p.description);
+  str("platform", p.platform);
+  if (p.name.empty()) p.name = fs::path(p.path).stem().string();
+  if (j.contains("target_ms")) {
+    if (!j["target_ms"].is_number() || j["target_ms"].get<double>() <= 0)
+      throw Error(ErrorKind::Schema, p.path,
+                  "target_ms: expected a positive number of milliseconds");
+    p.targetMs = j["target_ms"];
+  }
+  if (j.contains("reference_resolution")) {
+    const json& r = j["reference_resolution"];
+    if (!r.is_array() || r.size() != 2 || !r[0].is_number_unsigned() ||
+        !r[1].is_number_unsigned() || r[0] == 0 || r[1] == 0)
+      throw Error(ErrorKind::Schema, p.path,
+                  "reference_resolution: expected [width, height] (positive integers)");
+    p.referenceWidth = r[0];
+    p.referenceHeight = r[1];
+  }
+  if (j.contains("effects")) {
+    if (!j["effects"].is_object())
+      throw Error(ErrorKind::Schema, p.path, "effects: expected an object");
+    for (auto it = j["effects"].begin(); it != j["effects"].end(); ++it) {
+      if (!it.value().is_object())
+        throw Error(ErrorKind::Schema, p.path,
+                    "effects." + it.key() + ": expected an object of settings");
+      p.effects[it.key()] = it.value();
+    }
+  }
+  return p;
+}
+
+void validatePreset(const Preset& preset, const EffectRegistry& registry) {
+  for (const auto& [effect, values] : preset.effects) {
+    if (!registry.has(effect)) {
+      try {
+        registry.info(effect);
+      } catch (const Error& e) {
+        throw Error(ErrorKind::Schema, preset.path, "effects." + effect + ": " + e.what());
+      }
+    }
+    SettingValues s = registry.defaultSettings(effect);
+    for (auto it = values.begin(); it != values.end(); ++it)
+      s.set(it.key(), it.value(), preset.path);
+  }
+}
+
+std::vector<std::string> splitEffectList(const std::string& text) {
+  std::vector<std::string> out;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ','))
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+std::vector<EffectConfig> resolveEffects(const Scene& scene, const Preset* preset,
+                                         const EffectOverrides& cli,
+                                         const EffectRegistry& registry) {
+  std::vector<std::string> names;
+  if (cli.effects) {
+    names = *cli.effects;
+  } else {
+    for (const EffectRequest& r : scene.effects) names.push_back(r.name);
+  }
+  std::vector<EffectConfig> configs;
+  for (const std::string& name : names) {
+    if (std::any_of(configs.begin(), configs.end(),
+                    [&](const EffectConfig& c) { return c.name == name; }))
+      throw Error(ErrorKind::Schema, cli.effects ? "--effects" : scene.sourcePath,
+                  "effect '" + name + "' listed twice");
+    try {
+      configs.push_back({name, registry.defaultSettings(name)});
+    } catch (const Error& e) {
+      throw Error(e.kind(), cli.effects ? "--effects" : scene.sourcePath, e.what());
+    }
+  }
+  if (preset) validatePreset(*preset, registry);
+  for (EffectConfig& c : configs) {
+    if (preset && preset->effects.count(c.name)) {
+      const json& values = preset->effects.at(c.name);
+      for (auto it = values.begin(); it != values.end(); ++it)
+        c.settings.set(it.key(), it.value(), preset->path);
+    }
+    for (const EffectRequest& r : scene.effects)
+      if (r.name == c.name)
+        for (auto it = r.settings.begin(); it != r.settings.end(); ++it)
+          c.settings.set(it.key(), it.value(), scene.sourcePath);
+  }
+  for (const std::string& s : cli.sets) {
+    const size_t dot = s.find('.'), eq = s.find('=');
+    if (dot == std::string::npos || eq == std::string::npos || dot > eq)
+      throw Error(ErrorKind::Usage, "--set", "'" + s + "': expected effect.setting=value");
+    const std::string effect = s.substr(0, dot), key = s.substr(dot + 1, eq - dot - 1),
+                      value = s.substr(eq + 1);
+    auto it = std::find_if(configs.begin(), configs.end(),
+                           [&](const EffectConfig& c) { return c.name == effect; });
+    if (it == configs.end()) {
+      registry.info(effect);  // unknown effect: names the known ones
+      throw Error(ErrorKind::Usage, "--set",
+                  "'" + s + "': effect '" + effect + "' is not enabled (scene or --effects)");
+    }
+    it->settings.setFromString(key, value, "--set");
+  }
+  return configs;
+}
+
+}  // namespace gi

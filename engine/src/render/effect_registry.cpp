@@ -1,0 +1,199 @@
+#include "gi/effect_registry.h"
+
+#include <dlfcn.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <sstream>
+
+#include "gi/errors.h"
+
+namespace gi {
+
+namespace fs = std::filesystem;
+
+namespace {
+// The module being loaded, so add() can name it as the origin of what it registers.
+thread_local const std::string* currentModule = nullptr;
+
+bool validName(const std::string& n) {
+  if (n.empty()) return false;
+  for (char c : n)
+    if (!((c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_')) return false;
+  return true;
+}
+}  // namespace
+
+void EffectRegistry::add(const Factory& factory, const std::string& origin) {
+  const std::string from = currentModule ? *currentModule : origin;
+  std::unique_ptr<Effect> probe = factory();
+  Entry e;
+  e.info = probe->info();
+  e.settings = probe->settings();
+  e.factory = factory;
+  e.origin = from;
+  if (!validName(e.info.name))
+    throw Error(ErrorKind::InvalidData, from,
+                "effect name '" + e.info.name + "' must be lower-case letters, digits and '_'");
+  if (has(e.info.name))
+    throw Error(ErrorKind::InvalidData, from,
+                "duplicate effect '" + e.info.name + "' (already registered by " +
+                    origin_or(e.info.name) + ")");
+  SettingValues check(e.info.name, e.settings);  // rejects duplicate setting names
+  for (const SettingDesc& d : e.settings)
+    if (d.type != SettingType::Bool &&
+        !(d.minValue <= d.defaultValue && d.defaultValue <= d.maxValue))
+      throw Error(
+          ErrorKind::InvalidData, from,
+          "effect '" + e.info.name + "': default of setting '" + d.name + "' is outside its range");
+  entries_.push_back(std::move(e));
+}
+
+std::string EffectRegistry::origin_or(const std::string& name) const {
+  return has(name) ? origin(name) : "?";
+}
+
+void EffectRegistry::loadModule(const std::string& path) {
+  const std::string canonical = fs::weakly_canonical(path).string();
+  if (std::find(loadedPaths_.begin(), loadedPaths_.end(), canonical) != loadedPaths_.end())
+    throw Error(ErrorKind::InvalidData, path, "module already loaded");
+  void* handle = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+  if (!handle)
+    throw Error(ErrorKind::InvalidData, path, std::string("cannot load module: ") + dlerror());
+  auto version = reinterpret_cast<GiEffectAbiVersionFn>(dlsym(handle, "gi_effect_abi_version"));
+  auto registerFn = reinterpret_cast<GiRegisterEffectsFn>(dlsym(handle, "gi_register_effects"));
+  if (!version || !registerFn) {
+    dlclose(handle);
+    throw Error(ErrorKind::InvalidData, path,
+                "not an effect module (gi_effect_abi_version / gi_register_effects missing)");
+  }
+  if (version() != GI_EFFECT_ABI_VERSION) {
+    const uint32_t theirs = version();
+    dlclose(handle);
+    throw Error(ErrorKind::Unsupported, path,
+                "effect ABI version " + std::to_string(theirs) + " does not match the engine's " +
+                    std::to_string(GI_EFFECT_ABI_VERSION) +
+                    "; rebuild the module against this engine");
+  }
+  // Register into a scratch registry first so a failing module adds nothing.
+  EffectRegistry scratch;
+  scratch.entries_ = entries_;
+  currentModule = &path;
+  try {
+    registerFn(scratch);
+  } catch (...) {
+    currentModule = nullptr;
+    throw;  // the handle stays open: code from it may still be referenced by the exception
+  }
+  currentModule = nullptr;
+  entries_ = std::move(scratch.entries_);
+  loadedPaths_.push_back(canonical);
+}
+
+void EffectRegistry::scanDirectory(const std::string& dir) {
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) return;
+  std::vector<fs::path> modules;
+  for (const auto& entry : fs::directory_iterator(dir, ec))
+    if (entry.is_regular_file() && entry.path().extension() == ".so")
+      modules.push_back(entry.path());
+  std::sort(modules.begin(),
+            modules.end());  // deterministic order, so duplicates resolve the same way
+  for (const fs::path& m : modules) {
+    try {
+      loadModule(m.string());
+    } catch (const Error& e) {
+      problems_.push_back(e.what());
+      std::fprintf(stderr, "gi: warning: effect module refused: %s\n", e.what());
+    }
+  }
+}
+
+std::vector<std::string> EffectRegistry::defaultLocations() {
+  std::vector<std::string> dirs;
+  std::error_code ec;
+  fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) dirs.push_back((exe.parent_path() / "plugins").string());
+  if (const char* env = std::getenv("GI_PLUGIN_PATH")) {
+    std::stringstream ss(env);
+    std::string dir;
+    while (std::getline(ss, dir, ':'))
+      if (!dir.empty()) dirs.push_back(dir);
+  }
+  return dirs;
+}
+
+void EffectRegistry::scanDefaultLocations() {
+  for (const std::string& d : defaultLocations()) scanDirectory(d);
+}
+
+bool EffectRegistry::has(const std::string& name) const {
+  return std::any_of(entries_.begin(), entries_.end(),
+                     [&](const Entry& e) { return e.info.name == name; });
+}
+
+std::vector<std::string> EffectRegistry::names() const {
+  std::vector<std::string> out;
+  for (const Entry& e : entries_) out.push_back(e.info.name);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+const EffectRegistry::Entry& EffectRegistry::entry(const std::string& name) const {
+  for (const Entry& e : entries_)
+    if (e.info.name == name) return e;
+  std::string known;
+  for (const std::string& n : names()) known += (known.empty() ? "" : ", ") + n;
+  throw Error(ErrorKind::Schema, "",
+              "unknown effect '" + name +
+                  "' (known: " + (known.empty() ? "none; no plugins found" : known) + ")");
+}
+
+const EffectInfo& EffectRegistry::info(const std::string& name) const {
+  return entry(name).info;
+}
+std::string EffectRegistry::origin(const std::string& name) const {
+  return entry(name).origin;
+}
+std::unique_ptr<Effect> EffectRegistry::create(const std::string& name) const {
+  return entry(name).factory();
+}
+SettingValues EffectRegistry::defaultSettings(const std::string& name) const {
+  const Entry& e = entry(name);
+  return SettingValues(e.info.name, e.settings);
+}
+
+std::string EffectRegistry::describe() const {
+  std::ostringstream s;
+  if (entries_.empty()) s << "no effects found (searched:";
+  if (entries_.empty())
+    for (const std::string& d : defaultLocations()) s << " " << d;
+  if (entries_.empty()) s << ")\n";
+  for (const std::string& name : names()) {
+    const Entry& e = entry(name);
+    s << e.info.name << " " << e.info.version << " - " << e.info.description << "\n";
+    s << "  module: " << e.origin << "\n";
+    s << "  stage: "
+      << (e.info.stage == EffectStage::BeforeLighting ? "before lighting" : "after lighting");
+    std::string reads, writes;
+    for (auto& r : e.info.reads) reads += " " + r;
+    for (auto& w : e.info.writes) writes += " " + w;
+    s << ", reads:" << (reads.empty() ? " -" : reads)
+      << ", writes:" << (writes.empty() ? " -" : writes) << ", debug view: " << e.info.debugView
+      << "\n";
+    for (const SettingDesc& d : e.settings) {
+      s << "  " << name << "." << d.name << " (" << settingTypeName(d.type) << ", default ";
+      if (d.type == SettingType::Bool)
+        s << (d.defaultValue != 0.0 ? "true" : "false");
+      else
+        s << d.defaultValue << ", range [" << d.minValue << ", " << d.maxValue << "]";
+      s << (d.changesGraph ? ", changes the graph" : ", uniform only") << "): " << d.help << "\n";
+    }
+  }
+  for (const std::string& p : problems_) s << "refused: " << p << "\n";
+  return s.str();
+}
+
+}  // namespace gi
