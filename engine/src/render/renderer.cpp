@@ -103,14 +103,18 @@ struct Renderer::Impl : EffectContext {
       a.effect->prepare(*this, a.settings);
       effects.push_back(std::move(a));
     }
+    buildGraph();
+    // Raw handles last: nothing after them may throw (~Impl does not run if the ctor throws).
     VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
     alloc.commandPool = ctx.commandPool();
     alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
     alloc.commandBufferCount = 1;
     check(vkAllocateCommandBuffers(ctx.device(), &alloc, &cmd), "vkAllocateCommandBuffers");
     VkFenceCreateInfo fenceInfo{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-    check(vkCreateFence(ctx.device(), &fenceInfo, nullptr, &fence), "vkCreateFence");
-    buildGraph();
+    if (VkResult r = vkCreateFence(ctx.device(), &fenceInfo, nullptr, &fence); r != VK_SUCCESS) {
+      vkFreeCommandBuffers(ctx.device(), ctx.commandPool(), 1, &cmd);
+      check(r, "vkCreateFence");
+    }
   }
 
   ~Impl() override {

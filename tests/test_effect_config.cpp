@@ -1,0 +1,280 @@
+// Effects in the frame: settings precedence (defaults < preset < scene < --set) with errors
+// that name the file, key and range; the exact passes a scene's effect list executes; and
+// uniform-only settings that do not recompile the graph.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "gi/effect_config.h"
+#include "gi/errors.h"
+#include "gi/renderer.h"
+#include "gi/scene_io.h"
+#include "process.h"
+#include "test_support.h"
+#include "vulkan_fixture.h"
+
+namespace gi {
+namespace {
+
+// Writes a constant AO with a clear (no shader needed): enough to exercise the graph.
+class ConstantAO : public Effect {
+ public:
+  EffectInfo info() const override {
+    return {"const_ao", "1", "constant ambient occlusion (test)", EffectStage::BeforeLighting, {},
+            {"ao"},     "ao"};
+  }
+  std::vector<SettingDesc> settings() const override {
+    return {{"value", SettingType::Float, 0.5, 0.0, 1.0, "AO value", false},
+            {"samples", SettingType::Int, 8, 1, 64, "pretend sample count", false},
+            {"half_res", SettingType::Bool, 0, 0, 1, "render at half resolution", true}};
+  }
+  void prepare(EffectContext&, const SettingValues&) override { ++prepares; }
+  void addPasses(FrameGraph& g, EffectContext&, const SettingValues& s) override {
+    auto ao = std::make_shared<TextureHandle>();
+    const SettingValues* values = &s;  // read at execute time: uniform-only changes apply
+    g.addPass(
+        "const_ao",
+        [&](PassBuilder& b) {
+          TextureDesc d{VK_FORMAT_R8G8B8A8_UNORM};
+          d.scale = s.flag("half_res") ? 0.5f : 1.0f;
+          *ao = b.write(b.create("ao", d), TextureUsage::TransferDst);
+        },
+        [ao, values](PassContext& pc) {
+          const float v = float(values->number("value"));
+          VkClearColorValue c{{v, v, v, 1.0f}};
+          VkImageSubresourceRange range{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+          vkCmdClearColorImage(pc.cmd(), pc.image(*ao), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &c, 1,
+                               &range);
+        });
+    g.blackboard().put("ao", *ao);
+  }
+  static inline int prepares = 0;
+};
+
+// Produces something nobody reads: requested, but its pass must be culled.
+class Orphan : public Effect {
+ public:
+  EffectInfo info() const override {
+    return {"orphan",   "1",     "output nobody reads (test)", EffectStage::AfterLighting, {"lit"},
+            {"orphan"}, "orphan"};
+  }
+  std::vector<SettingDesc> settings() const override { return {}; }
+  void prepare(EffectContext&, const SettingValues&) override {}
+  void addPasses(FrameGraph& g, EffectContext&, const SettingValues&) override {
+    TextureHandle out;
+    g.addPass(
+        "orphan",
+        [&](PassBuilder& b) {
+          b.read(g.blackboard().texture("lit"));
+          out = b.write(b.create("orphan", TextureDesc{VK_FORMAT_R8G8B8A8_UNORM}),
+                        TextureUsage::TransferDst);
+        },
+        [](PassContext&) {});
+    g.blackboard().put("orphan", out);
+  }
+};
+
+EffectRegistry testRegistry() {
+  EffectRegistry r;
+  r.add([] { return std::make_unique<ConstantAO>(); }, "test");
+  r.add([] { return std::make_unique<Orphan>(); }, "test");
+  return r;
+}
+
+std::string writeFile(const std::string& dir, const std::string& name, const std::string& text) {
+  const std::string path = dir + "/" + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+Scene sceneWith(std::vector<EffectRequest> effects) {
+  Scene s = loadScene("default");
+  s.sourcePath = "scene.json";
+  s.effects = std::move(effects);
+  return s;
+}
+
+TEST(EffectConfig, PrecedenceDefaultsPresetSceneCommandLine) {
+  EffectRegistry reg = testRegistry();
+  const std::string dir = test::makeTempDir("precedence");
+  Preset preset = loadPreset(
+      writeFile(dir, "p.json", R"({"effects": {"const_ao": {"value": 0.2, "samples": 16}}})"));
+  Scene scene = sceneWith({{"const_ao", {{"samples", 32}}}});
+  auto configs = resolveEffects(scene, &preset, {}, reg);
+  ASSERT_EQ(configs.size(), 1u);
+  EXPECT_DOUBLE_EQ(configs[0].settings.number("value"), 0.2);  // preset over default
+  EXPECT_EQ(configs[0].settings.integer("samples"), 32);       // scene over preset
+  EffectOverrides cli;
+  cli.sets = {"const_ao.samples=64", "const_ao.half_res=true"};
+  configs = resolveEffects(scene, &preset, cli, reg);
+  EXPECT_EQ(configs[0].settings.integer("samples"), 64);  // command line over scene
+  EXPECT_TRUE(configs[0].settings.flag("half_res"));
+  cli.sets.clear();
+  cli.effects = std::vector<std::string>{};  // --effects '' runs none
+  EXPECT_TRUE(resolveEffects(scene, &preset, cli, reg).empty());
+}
+
+// Each bad input must fail with the expected kind and a message containing all the fragments.
+void expectError(const std::function<void()>& f, ErrorKind kind,
+                 std::vector<std::string> fragments) {
+  try {
+    f();
+    ADD_FAILURE() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), kind) << e.what();
+    for (const std::string& frag : fragments)
+      EXPECT_NE(std::string(e.what()).find(frag), std::string::npos) << e.what();
+  }
+}
+
+TEST(EffectConfig, BadPresetsAndSettingsNameFileKeyAndRange) {
+  EffectRegistry reg = testRegistry();
+  const std::string dir = test::makeTempDir("bad-presets");
+  Scene scene = sceneWith({{"const_ao", {}}});
+  auto withPreset = [&](const std::string& name, const std::string& text) {
+    return [&, name, text] {
+      Preset p = loadPreset(writeFile(dir, name, text));
+      resolveEffects(scene, &p, {}, reg);
+    };
+  };
+  expectError(withPreset("unknown_effect.json", R"({"effects": {"nope": {}}})"), ErrorKind::Schema,
+              {"unknown_effect.json", "effects.nope", "unknown effect"});
+  expectError(withPreset("unknown_setting.json", R"({"effects": {"const_ao": {"colour": 1}}})"),
+              ErrorKind::Schema, {"unknown_setting.json", "const_ao.colour", "unknown setting"});
+  expectError(withPreset("wrong_type.json", R"({"effects": {"const_ao": {"samples": "many"}}})"),
+              ErrorKind::Schema, {"wrong_type.json", "const_ao.samples", "an integer in [1, 64]"});
+  expectError(withPreset("range.json", R"({"effects": {"const_ao": {"samples": 65}}})"),
+              ErrorKind::InvalidData, {"range.json", "const_ao.samples", "[1, 64]", "65"});
+  expectError(withPreset("fraction.json", R"({"effects": {"const_ao": {"samples": 2.5}}})"),
+              ErrorKind::Schema, {"fraction.json", "an integer"});
+  expectError(withPreset("top_key.json", R"({"effectz": {}})"), ErrorKind::Schema,
+              {"top_key.json", "effectz"});
+  expectError(withPreset("bad_json.json", R"({"effects": )"), ErrorKind::Parse, {"bad_json.json"});
+  expectError(withPreset("empty.json", ""), ErrorKind::EmptyFile, {"empty.json"});
+  expectError([&] { loadPreset("no-such-preset-anywhere"); }, ErrorKind::FileNotFound,
+              {"no-such-preset-anywhere"});
+
+  Scene badScene = sceneWith({{"const_ao", {{"value", 7}}}});
+  expectError([&] { resolveEffects(badScene, nullptr, {}, reg); }, ErrorKind::InvalidData,
+              {"scene.json", "const_ao.value", "[0, 1]"});
+  Scene unknown = sceneWith({{"ssao_typo", {}}});
+  expectError([&] { resolveEffects(unknown, nullptr, {}, reg); }, ErrorKind::Schema,
+              {"scene.json", "ssao_typo", "const_ao"});
+  EffectOverrides cli;
+  cli.sets = {"const_ao.samples"};
+  expectError([&] { resolveEffects(scene, nullptr, cli, reg); }, ErrorKind::Usage,
+              {"--set", "effect.setting=value"});
+  cli.sets = {"orphan.x=1"};
+  expectError([&] { resolveEffects(scene, nullptr, cli, reg); }, ErrorKind::Usage,
+              {"--set", "not enabled"});
+  cli.sets = {"const_ao.value=abc"};
+  expectError([&] { resolveEffects(scene, nullptr, cli, reg); }, ErrorKind::Schema,
+              {"--set", "const_ao.value"});
+  Scene twice = sceneWith({{"const_ao", {}}, {"const_ao", {}}});
+  expectError([&] { resolveEffects(twice, nullptr, {}, reg); }, ErrorKind::Schema,
+              {"listed twice"});
+}
+
+class EffectGraphTest : public test::VulkanTest {
+ protected:
+  std::unique_ptr<Renderer> make(const Scene& scene, const std::vector<std::string>& effects,
+                                 const std::string& view = "output") {
+    EffectOverrides cli;
+    cli.effects = effects;
+    RenderSettings rs;
+    rs.width = 64;
+    rs.height = 48;
+    rs.view = view;
+    rs.effects = resolveEffects(scene, nullptr, cli, registry);
+    return std::make_unique<Renderer>(ctx(), scene, rs, &registry);
+  }
+  EffectRegistry registry = testRegistry();
+  Scene scene = sceneWith({});
+};
+
+using Passes = std::vector<std::string>;
+
+TEST_F(EffectGraphTest, NoEffectsRunsOnlyTheEnginePasses) {
+  auto r = make(scene, {});
+  r->renderFrame();
+  EXPECT_EQ(r->passNames(), (Passes{"gbuffer", "lighting", "tonemap"}));
+  EXPECT_EQ(r->culledPassNames(), (Passes{"floor"}));
+}
+
+TEST_F(EffectGraphTest, AnAOEffectFeedsLighting) {
+  auto r = make(scene, {"const_ao"});
+  r->renderFrame();
+  EXPECT_EQ(r->passNames(), (Passes{"gbuffer", "const_ao", "lighting", "tonemap"}));
+}
+
+TEST_F(EffectGraphTest, RequestedEffectWhoseOutputReachesNothingIsCulled) {
+  auto r = make(scene, {"const_ao", "orphan"});
+  r->renderFrame();
+  EXPECT_EQ(r->passNames(), (Passes{"gbuffer", "const_ao", "lighting", "tonemap"}));
+  EXPECT_EQ(r->culledPassNames(), (Passes{"orphan", "floor"}));
+}
+
+TEST_F(EffectGraphTest, DebugViewKeepsOnlyWhatFeedsIt) {
+  auto r = make(scene, {"const_ao"}, "ao");
+  r->renderFrame();
+  EXPECT_EQ(r->passNames(), (Passes{"const_ao"}));
+  ImageRGBA32F ao = r->readTarget("ao");
+  EXPECT_NEAR(ao.pixels[0], 0.5f, 1.0f / 255);
+}
+
+TEST_F(EffectGraphTest, AOTermDarkensTheAmbientLight) {
+  auto lit = [&](double value) {
+    auto r = make(scene, {"const_ao"});
+    SettingValues s = registry.defaultSettings("const_ao");
+    s.set("value", value, "test");
+    r->setEffectSettings("const_ao", s);
+    r->renderFrame();
+    ImageRGBA32F img = r->readTarget("lit");
+    double sum = 0;
+    for (size_t i = 0; i < img.pixels.size(); i += 4) sum += img.pixels[i + 1];
+    return sum;
+  };
+  EXPECT_LT(lit(0.0), lit(1.0) * 0.99) << "AO 0 must remove the ambient term";
+}
+
+TEST_F(EffectGraphTest, UniformOnlySettingsDoNotRecompile) {
+  auto r = make(scene, {"const_ao"});
+  r->renderFrame();
+  const int preparesBefore = ConstantAO::prepares;
+  SettingValues s = registry.defaultSettings("const_ao");
+  s.set("value", 0.9, "test");
+  r->setEffectSettings("const_ao", s);
+  EXPECT_FALSE(r->graphRecompiledByLastChange());
+  EXPECT_EQ(ConstantAO::prepares, preparesBefore);
+  r->renderFrame();
+  EXPECT_NEAR(r->readTarget("ao").pixels[0], 0.9f, 1.0f / 255);
+  s.set("half_res", true, "test");
+  r->setEffectSettings("const_ao", s);
+  EXPECT_TRUE(r->graphRecompiledByLastChange());
+  EXPECT_EQ(ConstantAO::prepares, preparesBefore + 1);
+  r->renderFrame();
+  EXPECT_EQ(r->readTarget("ao").width, 32);
+}
+
+TEST_F(EffectGraphTest, UnknownViewListsTheAvailableOnes) {
+  expectError([&] { make(scene, {}, "nope"); }, ErrorKind::Usage,
+              {"unknown view 'nope'", "normal", "depth"});
+}
+
+TEST(GiRenderEffects, CommandLineErrorsAreClear) {
+  const std::string bin = test::binPath("gi-render");
+  auto r = test::runCommand(bin + " --scene default --out /tmp/gi-x.png --effects no_such_effect");
+  EXPECT_EQ(r.exitCode, 1) << r.output;
+  EXPECT_NE(r.output.find("unknown effect 'no_such_effect'"), std::string::npos) << r.output;
+  r = test::runCommand(bin + " --scene default --out /tmp/gi-x.png --preset no_such_preset");
+  EXPECT_NE(r.exitCode, 0);
+  EXPECT_NE(r.output.find("no_such_preset"), std::string::npos) << r.output;
+  r = test::runCommand(
+      bin + " --scene default --out /tmp/gi-x.png --effects '' --print-graph --view normal");
+  EXPECT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_NE(r.output.find("[culled] lighting"), std::string::npos) << r.output;
+}
+
+}  // namespace
+}  // namespace gi
