@@ -4,6 +4,7 @@
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <chrono>
 #include <climits>
 #include <cstdio>
 #include <cstring>
@@ -182,7 +183,11 @@ int run(const Options& o) {
   for (const std::string& w : scene.warnings)
     std::fprintf(stderr, "gi-render: warning: %s\n", w.c_str());
   gi::EffectRegistry registry;
+  const auto scanStart = std::chrono::steady_clock::now();
   registry.scanDefaultLocations();
+  const double pluginLoadMs =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - scanStart)
+          .count();
   std::optional<gi::Preset> preset;
   if (!o.preset.empty()) preset = gi::loadPreset(o.preset);
   std::vector<gi::EffectConfig> effects =
@@ -242,7 +247,8 @@ int run(const Options& o) {
     std::string culled;
     for (const std::string& c : renderer.culledPassNames()) culled += " " + c;
     std::printf("culled passes:%s\n", culled.empty() ? " none" : culled.c_str());
-    std::printf("frame graph compile %.3f ms (CPU)\n", renderer.lastCompileMs());
+    std::printf("frame graph compile %.3f ms (CPU), plugin loading %.3f ms (%zu effect(s))\n",
+                renderer.lastCompileMs(), pluginLoadMs, registry.names().size());
     rusage usage{};
     getrusage(RUSAGE_SELF, &usage);
     std::printf("peak memory %.1f MiB\n", usage.ru_maxrss / 1024.0);
