@@ -8,6 +8,7 @@
 #include <vector>
 
 #include <glm/glm.hpp>
+#include <glm/gtc/quaternion.hpp>
 #include <nlohmann/json.hpp>
 
 namespace gi {
@@ -16,6 +17,13 @@ struct Vertex {
   glm::vec3 position{0.0f};
   glm::vec3 normal{0.0f, 0.0f, 1.0f};
   glm::vec2 uv{0.0f};
+};
+
+// Per-target vertex deltas of a morph target (glTF targets: POSITION and NORMAL), parallel to
+// Mesh::vertices; normalDeltas may be empty.
+struct MorphTarget {
+  std::vector<glm::vec3> positionDeltas;
+  std::vector<glm::vec3> normalDeltas;
 };
 
 // One triangle list with one material (a glTF primitive, an OBJ material group).
@@ -27,6 +35,16 @@ struct Mesh {
   std::vector<float> triangleAreas;  // object-space area per triangle (mesh_processing)
   glm::vec3 boundsMin{0.0f}, boundsMax{0.0f};
   size_t triangleCount() const { return indices.size() / 3; }
+
+  // Skinning (glTF JOINTS_0 / WEIGHTS_0), parallel to vertices or empty for rigid meshes.
+  // Joint indices refer to the joints of the Skin of the node drawing the mesh. Weights are
+  // renormalised to sum 1 by the loader; an all-zero row keeps the vertex in its bind pose.
+  std::vector<glm::uvec4> joints;
+  std::vector<glm::vec4> weights;
+  bool skinned() const { return !joints.empty() && joints.size() == vertices.size(); }
+  // Morph targets (applied on the CPU, see gi/animation.h) and their default weights.
+  std::vector<MorphTarget> morphTargets;
+  std::vector<float> morphWeights;
 };
 
 struct Texture {
@@ -69,11 +87,52 @@ struct Node {
   std::string name;
   int parent = -1;
   std::vector<int> children;
+  // Local transform as translation, rotation, scale (what animations set). When `hasTRS`,
+  // `local` is T * R * S; nodes given by a matrix keep hasTRS false and are not animated.
+  glm::vec3 translation{0.0f};
+  glm::quat rotation{1.0f, 0.0f, 0.0f, 0.0f};
+  glm::vec3 scale{1.0f};
+  bool hasTRS = false;
   glm::mat4 local{1.0f};
-  glm::mat4 world{1.0f};    // derived by Scene::updateWorldTransforms()
-  std::vector<int> meshes;  // indices into Scene::meshes
-  int camera = -1;          // index into Scene::cameras
-  int light = -1;           // index into Scene::lights
+  glm::mat4 world{1.0f};            // derived by Scene::updateWorldTransforms()
+  std::vector<int> meshes;          // indices into Scene::meshes
+  int camera = -1;                  // index into Scene::cameras
+  int light = -1;                   // index into Scene::lights
+  int skin = -1;                    // index into Scene::skins (the node's meshes are skinned by it)
+  std::vector<float> morphWeights;  // current morph weights of the node's meshes (may be empty)
+};
+
+// A glTF skin: joint nodes and their inverse bind matrices (identity when the file has none).
+struct Skin {
+  std::string name;
+  std::vector<int> joints;  // scene node indices
+  std::vector<glm::mat4> inverseBindMatrices;
+};
+
+enum class Interpolation { Linear, Step, CubicSpline };
+enum class AnimationPath { Translation, Rotation, Scale, Weights };
+
+// Keyframes: `times` strictly increasing; `values` has `components` floats per key, times 3
+// for CUBICSPLINE (in-tangent, value, out-tangent per key, as glTF stores them). Rotations are
+// quaternions stored x, y, z, w.
+struct AnimationSampler {
+  std::vector<float> times;
+  std::vector<float> values;
+  Interpolation interpolation = Interpolation::Linear;
+  int components = 1;
+};
+
+struct AnimationChannel {
+  int sampler = 0;  // index into AnimationClip::samplers
+  int node = 0;     // scene node index
+  AnimationPath path = AnimationPath::Translation;
+};
+
+struct AnimationClip {
+  std::string name;
+  std::vector<AnimationSampler> samplers;
+  std::vector<AnimationChannel> channels;
+  float duration = 0.0f;  // last key time over all samplers; the clip loops with this period
 };
 
 // Procedural sky (default) lights the scene's ambient term and the background.
@@ -101,7 +160,9 @@ struct Scene {
   std::vector<Camera> cameras;
   std::vector<Light> lights;
   std::vector<Node> nodes;
-  std::vector<int> roots;     // top-level nodes
+  std::vector<int> roots;  // top-level nodes
+  std::vector<Skin> skins;
+  std::vector<AnimationClip> animations;
   int activeCameraNode = -1;  // node carrying the camera used for rendering, -1: frame bounds
   Environment environment;
   std::vector<EffectRequest> effects;
@@ -109,6 +170,10 @@ struct Scene {
 
   // Recompute Node::world from Node::local down the hierarchy.
   void updateWorldTransforms();
+  // Samples the animation clips at `time` seconds (each clip looping over its duration;
+  // clip -1: all clips, else only that one), sets the animated nodes' TRS / morph weights,
+  // then updates local and world transforms. Deterministic: depends only on time and clip.
+  void animate(double time, int clip = -1);
   // World-space bounds of all mesh instances (after updateWorldTransforms).
   void worldBounds(glm::vec3& outMin, glm::vec3& outMax) const;
   size_t triangleCount() const;  // sum over meshes (each mesh counted once)

@@ -497,6 +497,7 @@ class GltfLoader {
     convertMaterials();
     checkHierarchy();
     std::vector<int> roots = sceneRoots();
+    sceneNode_.assign(model_.nodes.size(), -1);
     for (int root : roots) addSubtree(root);
     if (roots.empty()) {
       // No scene or no nodes at all: show every mesh once, untransformed.
@@ -514,6 +515,8 @@ class GltfLoader {
                                        std::to_string(model_.meshes.size()) + " meshes, " +
                                        std::to_string(model_.nodes.size()) + " nodes in the file)");
     }
+    convertSkins();
+    convertAnimations();
     scene_.updateWorldTransforms();
     return std::move(scene_);
   }
@@ -836,7 +839,28 @@ class GltfLoader {
       const std::string what = "node " + std::to_string(index);
       const int node =
           scene_.addNode(gn.name.empty() ? what : gn.name, localTransform(gn, what), parent);
-      if (gn.mesh >= 0) scene_.nodes[node].meshes = meshesOf(gn.mesh, what);
+      sceneNode_[index] = node;
+      setTRS(scene_.nodes[node], gn);
+      if (gn.mesh >= 0) {
+        scene_.nodes[node].meshes = meshesOf(gn.mesh, what);
+        // Morph weights: the node's, else the mesh's defaults, else zeros.
+        size_t targets = 0;
+        for (int m : scene_.nodes[node].meshes)
+          targets = std::max(targets, scene_.meshes[m].morphTargets.size());
+        std::vector<float> weights(targets, 0.0f);
+        const std::vector<double>& src =
+            !gn.weights.empty() ? gn.weights : model_.meshes[gn.mesh].weights;
+        for (size_t i = 0; i < targets && i < src.size(); ++i) weights[i] = float(src[i]);
+        scene_.nodes[node].morphWeights = std::move(weights);
+      }
+      if (gn.skin >= 0) {
+        if (size_t(gn.skin) >= model_.skins.size())
+          fail(ErrorKind::IndexOutOfRange, what + ": skin " + std::to_string(gn.skin) +
+                                               " does not exist (file has " +
+                                               std::to_string(model_.skins.size()) + " skins)");
+        scene_.nodes[node].skin = gn.skin;  // glTF skins become scene skins in file order
+        if (gn.mesh < 0) warn(what + ": has a skin but no mesh; the skin is unused");
+      }
       if (gn.camera >= 0) {
         if (size_t(gn.camera) >= scene_.cameras.size())
           fail(ErrorKind::IndexOutOfRange, what + ": camera " + std::to_string(gn.camera) +
@@ -855,6 +879,221 @@ class GltfLoader {
       }
       for (auto c = gn.children.rbegin(); c != gn.children.rend(); ++c)
         stack.emplace_back(*c, node);
+    }
+  }
+
+  // Translation/rotation/scale of a node as the file gives them (matrix nodes keep hasTRS off:
+  // glTF does not allow animating them).
+  void setTRS(Node& node, const tinygltf::Node& gn) {
+    if (gn.matrix.size() == 16) return;
+    node.hasTRS = true;
+    if (gn.translation.size() == 3)
+      node.translation =
+          glm::vec3(float(gn.translation[0]), float(gn.translation[1]), float(gn.translation[2]));
+    if (gn.rotation.size() == 4) {
+      glm::quat q(float(gn.rotation[3]), float(gn.rotation[0]), float(gn.rotation[1]),
+                  float(gn.rotation[2]));
+      const float len = glm::length(q);
+      node.rotation = std::isfinite(len) && len > 1e-12f ? q / len : glm::quat(1, 0, 0, 0);
+    }
+    if (gn.scale.size() == 3)
+      node.scale = glm::vec3(float(gn.scale[0]), float(gn.scale[1]), float(gn.scale[2]));
+  }
+
+  // Skins in file order: joints mapped to scene nodes, inverse bind matrices checked; every
+  // skinned mesh's joint indices must fall inside the skin that draws it.
+  void convertSkins() {
+    for (size_t i = 0; i < model_.skins.size(); ++i) {
+      const tinygltf::Skin& gs = model_.skins[i];
+      const std::string what = "skin " + std::to_string(i);
+      Skin skin;
+      skin.name = gs.name.empty() ? what : gs.name;
+      for (int joint : gs.joints) {
+        if (joint < 0 || size_t(joint) >= model_.nodes.size())
+          fail(ErrorKind::IndexOutOfRange, what + ": joint node " + std::to_string(joint) +
+                                               " does not exist (file has " +
+                                               std::to_string(model_.nodes.size()) + " nodes)");
+        if (sceneNode_[joint] < 0)
+          warn(what + ": joint node " + std::to_string(joint) +
+               " is not part of the scene; it stays at its bind pose");
+        skin.joints.push_back(sceneNode_[joint]);
+      }
+      skin.inverseBindMatrices.assign(skin.joints.size(), glm::mat4(1.0f));
+      if (gs.inverseBindMatrices >= 0) {
+        const std::string label = what + " inverseBindMatrices";
+        requireFormat(gs.inverseBindMatrices, TINYGLTF_TYPE_MAT4, {TINYGLTF_COMPONENT_TYPE_FLOAT},
+                      false, label);
+        const tinygltf::Accessor& a = accessor(gs.inverseBindMatrices, label);
+        if (a.count < skin.joints.size())
+          fail(ErrorKind::InvalidData, label + ": accessor " +
+                                           std::to_string(gs.inverseBindMatrices) + " has " +
+                                           std::to_string(a.count) + " matrices for " +
+                                           std::to_string(skin.joints.size()) + " joints");
+        const std::vector<double> m = read(gs.inverseBindMatrices, label);
+        for (size_t j = 0; j < skin.joints.size(); ++j) {
+          float* dst = glm::value_ptr(skin.inverseBindMatrices[j]);
+          for (size_t k = 0; k < 16; ++k) dst[k] = float(m[16 * j + k]);
+          if (!finite(skin.inverseBindMatrices[j]))
+            fail(ErrorKind::NonFinite, label + ": matrix " + std::to_string(j) + " is not finite");
+        }
+      }
+      scene_.skins.push_back(std::move(skin));
+    }
+    for (size_t n = 0; n < scene_.nodes.size(); ++n) {
+      const Node& node = scene_.nodes[n];
+      if (node.skin < 0) continue;
+      const size_t jointCount = scene_.skins[node.skin].joints.size();
+      for (int m : node.meshes) {
+        const Mesh& mesh = scene_.meshes[m];
+        for (size_t v = 0; v < mesh.joints.size(); ++v)
+          for (int k = 0; k < 4; ++k)
+            if (mesh.weights[v][k] > 0.0f && mesh.joints[v][k] >= jointCount)
+              fail(ErrorKind::IndexOutOfRange,
+                   "node '" + node.name + "': mesh '" + mesh.name + "' vertex " +
+                       std::to_string(v) + " uses joint " + std::to_string(mesh.joints[v][k]) +
+                       " but skin " + std::to_string(node.skin) + " has " +
+                       std::to_string(jointCount) + " joints");
+      }
+    }
+  }
+
+  // Animations: samplers checked (times scalar float, finite, strictly increasing; outputs
+  // of the right type and count for the path and interpolation), channels mapped to nodes.
+  void convertAnimations() {
+    for (size_t ai = 0; ai < model_.animations.size(); ++ai) {
+      const tinygltf::Animation& ga = model_.animations[ai];
+      const std::string what = "animation " + std::to_string(ai);
+      AnimationClip clip;
+      clip.name = ga.name.empty() ? what : ga.name;
+      std::vector<int> components(ga.samplers.size(), 0);  // 0: not used by a channel yet
+      clip.samplers.resize(ga.samplers.size());
+      for (size_t si = 0; si < ga.samplers.size(); ++si) {
+        const tinygltf::AnimationSampler& gs = ga.samplers[si];
+        const std::string label = what + " sampler " + std::to_string(si);
+        AnimationSampler& s = clip.samplers[si];
+        if (gs.interpolation == "LINEAR")
+          s.interpolation = Interpolation::Linear;
+        else if (gs.interpolation == "STEP")
+          s.interpolation = Interpolation::Step;
+        else if (gs.interpolation == "CUBICSPLINE")
+          s.interpolation = Interpolation::CubicSpline;
+        else
+          fail(ErrorKind::Schema, label + ": unknown interpolation '" + gs.interpolation +
+                                      "' (expected LINEAR, STEP or CUBICSPLINE)");
+        requireFormat(gs.input, TINYGLTF_TYPE_SCALAR, {TINYGLTF_COMPONENT_TYPE_FLOAT}, false,
+                      label + " input");
+        const std::vector<double> times = read(gs.input, label + " input");
+        if (times.empty()) fail(ErrorKind::InvalidData, label + ": input has no keyframes");
+        for (size_t k = 0; k < times.size(); ++k) {
+          if (!std::isfinite(times[k]))
+            fail(ErrorKind::NonFinite,
+                 label + ": key time " + std::to_string(k) + " is not finite");
+          if (k > 0 && !(times[k] > times[k - 1]))
+            fail(ErrorKind::InvalidData, label + ": key times are not strictly increasing (key " +
+                                             std::to_string(k) + " at " + std::to_string(times[k]) +
+                                             " after " + std::to_string(times[k - 1]) + ")");
+          s.times.push_back(float(times[k]));
+        }
+        clip.duration = std::max(clip.duration, s.times.back());
+        accessor(gs.output, label + " output");  // exists; its format depends on the channel
+      }
+      for (size_t ci = 0; ci < ga.channels.size(); ++ci) {
+        const tinygltf::AnimationChannel& gc = ga.channels[ci];
+        const std::string label = what + " channel " + std::to_string(ci);
+        if (gc.sampler < 0 || size_t(gc.sampler) >= ga.samplers.size())
+          fail(ErrorKind::IndexOutOfRange, label + ": sampler " + std::to_string(gc.sampler) +
+                                               " does not exist (animation has " +
+                                               std::to_string(ga.samplers.size()) + " samplers)");
+        if (gc.target_node < 0) continue;  // targets given by an extension: not supported
+        if (size_t(gc.target_node) >= model_.nodes.size())
+          fail(ErrorKind::IndexOutOfRange,
+               label + ": target node " + std::to_string(gc.target_node) +
+                   " does not exist (file has " + std::to_string(model_.nodes.size()) + " nodes)");
+        AnimationChannel ch;
+        ch.sampler = gc.sampler;
+        int comps = 0;
+        if (gc.target_path == "translation") {
+          ch.path = AnimationPath::Translation;
+          comps = 3;
+        } else if (gc.target_path == "rotation") {
+          ch.path = AnimationPath::Rotation;
+          comps = 4;
+        } else if (gc.target_path == "scale") {
+          ch.path = AnimationPath::Scale;
+          comps = 3;
+        } else if (gc.target_path == "weights") {
+          ch.path = AnimationPath::Weights;
+        } else {
+          warn(label + ": target path '" + gc.target_path + "' is not supported; ignored");
+          continue;
+        }
+        const tinygltf::Node& target = model_.nodes[gc.target_node];
+        if (ch.path != AnimationPath::Weights && target.matrix.size() == 16)
+          fail(ErrorKind::InvalidData, label + ": node " + std::to_string(gc.target_node) +
+                                           " is given by a matrix and cannot be animated");
+        const tinygltf::AnimationSampler& gs = ga.samplers[gc.sampler];
+        AnimationSampler& s = clip.samplers[gc.sampler];
+        const size_t keys = s.times.size();
+        const size_t perKey = s.interpolation == Interpolation::CubicSpline ? 3 : 1;
+        const tinygltf::Accessor& out = accessor(gs.output, label + " output");
+        if (ch.path == AnimationPath::Weights) {
+          requireFormat(gs.output, TINYGLTF_TYPE_SCALAR,
+                        {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_BYTE,
+                         TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_SHORT,
+                         TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT},
+                        true, label + " output");
+          const size_t targets = target.mesh >= 0 && size_t(target.mesh) < model_.meshes.size() &&
+                                         !model_.meshes[target.mesh].primitives.empty()
+                                     ? model_.meshes[target.mesh].primitives[0].targets.size()
+                                     : 0;
+          if (targets == 0)
+            fail(ErrorKind::InvalidData, label + ": animates morph weights of node " +
+                                             std::to_string(gc.target_node) +
+                                             ", which has no morph targets");
+          comps = int(targets);
+        } else {
+          requireFormat(gs.output, comps == 4 ? TINYGLTF_TYPE_VEC4 : TINYGLTF_TYPE_VEC3,
+                        comps == 4
+                            ? std::initializer_list<int>{TINYGLTF_COMPONENT_TYPE_FLOAT,
+                                                         TINYGLTF_COMPONENT_TYPE_BYTE,
+                                                         TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
+                                                         TINYGLTF_COMPONENT_TYPE_SHORT,
+                                                         TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT}
+                            : std::initializer_list<int>{TINYGLTF_COMPONENT_TYPE_FLOAT},
+                        comps == 4, label + " output");
+        }
+        const size_t expected = keys * perKey * (ch.path == AnimationPath::Weights ? comps : 1);
+        if (out.count != expected)
+          fail(ErrorKind::InvalidData, label + ": output accessor " + std::to_string(gs.output) +
+                                           " has " + std::to_string(out.count) + " elements, but " +
+                                           std::to_string(keys) + " key times" +
+                                           (perKey == 3 ? " (CUBICSPLINE: 3 per key)" : "") +
+                                           (ch.path == AnimationPath::Weights
+                                                ? " x " + std::to_string(comps) + " morph targets"
+                                                : std::string()) +
+                                           " need " + std::to_string(expected));
+        if (components[gc.sampler] != 0 && components[gc.sampler] != comps)
+          fail(ErrorKind::InvalidData, label + ": sampler " + std::to_string(gc.sampler) +
+                                           " is shared by channels of different types");
+        if (components[gc.sampler] == 0) {
+          components[gc.sampler] = comps;
+          s.components = comps;
+          const std::vector<double> values = read(gs.output, label + " output");
+          s.values.reserve(values.size());
+          for (double v : values) {
+            if (!std::isfinite(v))
+              fail(ErrorKind::NonFinite, label + ": output values are not finite");
+            s.values.push_back(float(v));
+          }
+        }
+        ch.node = sceneNode_[gc.target_node];
+        if (ch.node < 0) continue;  // node not in the displayed scene
+        clip.channels.push_back(ch);
+      }
+      // Samplers no channel uses keep no values; give them nothing to sample.
+      for (size_t si = 0; si < clip.samplers.size(); ++si)
+        if (components[si] == 0) clip.samplers[si].times.clear();
+      scene_.animations.push_back(std::move(clip));
     }
   }
 
@@ -1070,6 +1309,11 @@ class GltfLoader {
         mesh.vertices[v].uv = glm::vec2(float(t[2 * v]), float(t[2 * v + 1]));
     }
 
+    readSkinAttributes(prim, mesh, what);
+    readMorphTargets(prim, mesh, vertexCount, what);
+    for (size_t t = 0; t < mesh.morphTargets.size(); ++t)
+      mesh.morphWeights.push_back(t < gm.weights.size() ? float(gm.weights[t]) : 0.0f);
+
     std::vector<uint32_t> order;  // vertex order before triangulating strips and fans
     if (prim.indices >= 0) {
       requireFormat(prim.indices, TINYGLTF_TYPE_SCALAR,
@@ -1131,10 +1375,87 @@ class GltfLoader {
     return mesh;
   }
 
+  // JOINTS_0 / WEIGHTS_0: u8/u16 joints, float or normalised u8/u16 weights. Weights are
+  // made non-negative and finite, then renormalised to sum 1; all-zero rows stay zero (the
+  // vertex keeps its bind pose).
+  void readSkinAttributes(const tinygltf::Primitive& prim, Mesh& mesh, const std::string& what) {
+    auto joints = prim.attributes.find("JOINTS_0");
+    auto weights = prim.attributes.find("WEIGHTS_0");
+    if (joints == prim.attributes.end() && weights == prim.attributes.end()) return;
+    if (joints == prim.attributes.end() || weights == prim.attributes.end())
+      fail(ErrorKind::InvalidData,
+           what + ": has " + (joints == prim.attributes.end() ? "WEIGHTS_0" : "JOINTS_0") +
+               " without " + (joints == prim.attributes.end() ? "JOINTS_0" : "WEIGHTS_0"));
+    requireFormat(joints->second, TINYGLTF_TYPE_VEC4,
+                  {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT},
+                  false, what + " JOINTS_0");
+    const tinygltf::Accessor& wa = accessor(weights->second, what + " WEIGHTS_0");
+    requireFormat(weights->second, TINYGLTF_TYPE_VEC4,
+                  {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
+                   TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT},
+                  wa.componentType != TINYGLTF_COMPONENT_TYPE_FLOAT, what + " WEIGHTS_0");
+    const std::vector<double> j = read(joints->second, what + " JOINTS_0");
+    const std::vector<double> w = read(weights->second, what + " WEIGHTS_0");
+    const size_t n = mesh.vertices.size();
+    mesh.joints.resize(n);
+    mesh.weights.resize(n);
+    size_t zero = 0;
+    for (size_t v = 0; v < n; ++v) {
+      glm::vec4 wv(0.0f);
+      float sum = 0.0f;
+      for (int k = 0; k < 4; ++k) {
+        mesh.joints[v][k] = uint32_t(j[4 * v + k]);
+        const double x = w[4 * v + k];
+        wv[k] = std::isfinite(x) && x > 0.0 ? float(x) : 0.0f;
+        sum += wv[k];
+      }
+      if (sum > 0.0f && std::isfinite(sum))
+        wv /= sum;
+      else {
+        wv = glm::vec4(0.0f);
+        ++zero;
+      }
+      mesh.weights[v] = wv;
+    }
+    if (zero > 0)
+      warn(what + ": " + std::to_string(zero) +
+           " vertices have no skin weight; they keep their bind pose");
+  }
+
+  // Morph targets: POSITION and NORMAL deltas (float VEC3), one per vertex. Other target
+  // attributes (TANGENT, ...) are ignored.
+  void readMorphTargets(const tinygltf::Primitive& prim, Mesh& mesh, size_t vertexCount,
+                        const std::string& what) {
+    for (size_t t = 0; t < prim.targets.size(); ++t) {
+      MorphTarget target;
+      for (const auto& [attribute, index] : prim.targets[t]) {
+        if (attribute != "POSITION" && attribute != "NORMAL") continue;
+        const std::string label = what + " morph target " + std::to_string(t) + " " + attribute;
+        requireFormat(index, TINYGLTF_TYPE_VEC3, {TINYGLTF_COMPONENT_TYPE_FLOAT}, false, label);
+        if (accessor(index, label).count != vertexCount)
+          fail(ErrorKind::InvalidData, label + ": accessor " + std::to_string(index) + " has " +
+                                           std::to_string(accessor(index, label).count) +
+                                           " elements but POSITION has " +
+                                           std::to_string(vertexCount));
+        const std::vector<double> d = read(index, label);
+        std::vector<glm::vec3>& dst =
+            attribute == "POSITION" ? target.positionDeltas : target.normalDeltas;
+        dst.resize(vertexCount);
+        for (size_t v = 0; v < vertexCount; ++v) {
+          dst[v] = glm::vec3(float(d[3 * v]), float(d[3 * v + 1]), float(d[3 * v + 2]));
+          if (!std::isfinite(dst[v].x) || !std::isfinite(dst[v].y) || !std::isfinite(dst[v].z))
+            fail(ErrorKind::NonFinite, label + ": delta " + std::to_string(v) + " is not finite");
+        }
+      }
+      mesh.morphTargets.push_back(std::move(target));
+    }
+  }
+
   std::string path_;
   tinygltf::Model model_;
   Scene scene_;
-  std::vector<int> parent_;                                 // per glTF node, -1 for roots
+  std::vector<int> parent_;     // per glTF node, -1 for roots
+  std::vector<int> sceneNode_;  // glTF node -> scene node, -1 when not in the scene
   std::vector<std::optional<std::vector<int>>> meshCache_;  // glTF mesh -> scene meshes
   std::vector<int> imageTexture_;  // glTF image -> scene texture, -1: none yet
   int defaultMaterial_ = -1;       // for primitives without a material

@@ -53,19 +53,37 @@ class QuietOpenMesh {
   bool wasEnabled_;
 };
 
+// Reorders a per-vertex array (skin data, morph deltas) like the vertices; `order` lists the
+// kept old indices. Arrays not parallel to the vertices are left alone.
+template <class T>
+void keepOrdered(std::vector<T>& values, const std::vector<uint32_t>& order, size_t oldCount) {
+  if (values.size() != oldCount) return;
+  std::vector<T> kept;
+  kept.reserve(order.size());
+  for (uint32_t i : order) kept.push_back(values[i]);
+  values = std::move(kept);
+}
+
 // Keeps only referenced vertices (in first-use order) and rewrites the indices.
 void compactVertices(Mesh& mesh) {
   std::vector<uint32_t> remap(mesh.vertices.size(), UINT32_MAX);
-  std::vector<Vertex> kept;
-  kept.reserve(mesh.vertices.size());
+  std::vector<uint32_t> order;
+  order.reserve(mesh.vertices.size());
   for (uint32_t& idx : mesh.indices) {
     if (remap[idx] == UINT32_MAX) {
-      remap[idx] = static_cast<uint32_t>(kept.size());
-      kept.push_back(mesh.vertices[idx]);
+      remap[idx] = static_cast<uint32_t>(order.size());
+      order.push_back(idx);
     }
     idx = remap[idx];
   }
-  mesh.vertices = std::move(kept);
+  const size_t oldCount = mesh.vertices.size();
+  keepOrdered(mesh.vertices, order, oldCount);
+  keepOrdered(mesh.joints, order, oldCount);
+  keepOrdered(mesh.weights, order, oldCount);
+  for (MorphTarget& t : mesh.morphTargets) {
+    keepOrdered(t.positionDeltas, order, oldCount);
+    keepOrdered(t.normalDeltas, order, oldCount);
+  }
 }
 
 // Merges vertices whose position, normal and uv are bit-identical; returns how many went.
@@ -214,7 +232,9 @@ MeshFixReport processMesh(Mesh& mesh, bool weld) {
   for (Vertex& v : mesh.vertices)  // uvs only need to be finite
     if (!std::isfinite(v.uv.x) || !std::isfinite(v.uv.y)) v.uv = glm::vec2(0.0f);
 
-  if (weld) report.weldedVertices = weldVertices(mesh);
+  // Skinned and morphed vertices carry more than the key compares; never weld those.
+  if (weld && mesh.joints.empty() && mesh.morphTargets.empty())
+    report.weldedVertices = weldVertices(mesh);
 
   // 4. Bounds over the (all referenced) vertices; an empty mesh gets a zero box at the origin.
   if (mesh.vertices.empty()) {
