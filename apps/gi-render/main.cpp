@@ -34,6 +34,7 @@ const char* kUsage =
     "  --frames N             frames to render; timings are medians over them\n"
     "                         (default 1; with --window: until the window is closed)\n"
     "  --time T               animation clock in seconds (default 0)\n"
+    "  --time-step S          advance the clock by S seconds per frame (default 0)\n"
     "  --timings              print the median GPU time of each pass and peak memory\n"
     "  --view NAME            write a raw resource instead of the final image: output, lit,\n"
     "                         depth, normal, albedo, material, emission, motion, floor, or an\n"
@@ -54,7 +55,7 @@ struct Options {
   bool listEffects = false, printGraph = false;
   uint32_t width = 640, height = 480;
   int frames = 0;  // 0: not given (one frame, or until the window closes)
-  double time = 0.0;
+  double time = 0.0, timeStep = 0.0;
   float exposure = 1.0f;
   bool timings = false, validation = false, window = false;
 };
@@ -96,6 +97,8 @@ Options parseArgs(int argc, char** argv) {
       o.frames = int(parseNumber(a, value(), 1, 100000));
     else if (a == "--time")
       o.time = parseNumber(a, value(), -1e9, 1e9);
+    else if (a == "--time-step")
+      o.timeStep = parseNumber(a, value(), -1e6, 1e6);
     else if (a == "--exposure")
       o.exposure = float(parseNumber(a, value(), 0, 1e6));
     else if (a == "--view")
@@ -224,6 +227,7 @@ int run(const Options& o) {
   const int frames = o.frames > 0 ? o.frames : window ? INT_MAX : 1;
   int rendered = 0;
   for (; rendered < frames && !(window && window->closed()); ++rendered) {
+    renderer.setTime(o.time + rendered * o.timeStep);
     renderer.renderFrame();
     for (const auto& t : renderer.lastTimings()) samples[t.name].push_back(t.ms);
     if (swapchain) swapchain->present(renderer);

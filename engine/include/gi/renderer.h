@@ -46,6 +46,19 @@ class Renderer {
 
   // Records, submits and waits for one frame; per-pass GPU times end up in lastTimings().
   void renderFrame();
+  // Poses the scene's animations at `seconds` (all clips, looping) for the next frames: node
+  // transforms, joint matrices and morph weights. Skinned and morphed meshes are deformed on
+  // the GPU by the "skinning" pass, only where their joints or weights changed. The previous
+  // model matrices feed the motion vectors.
+  void setTime(double seconds);
+  // Vertices the skinning pass deformed in the last frame (0 when nothing changed).
+  uint32_t lastSkinnedVertexCount() const;
+  // The GPU-deformed vertices of every skinned/morphed mesh instance (read back; for tests).
+  struct DeformedMesh {
+    int node = 0, mesh = 0;  // scene indices
+    std::vector<Vertex> vertices;
+  };
+  std::vector<DeformedMesh> readDeformedMeshes();
   const std::vector<PassTiming>& lastTimings() const;
   std::vector<std::string> passNames() const;        // passes the graph executes, in order
   std::vector<std::string> culledPassNames() const;  // passes declared but culled

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "gi/animation.h"
 #include "gi/effect.h"
 #include "gi/errors.h"
 #include "gi/graph/frame_graph.h"
@@ -32,6 +33,9 @@ glm::mat4 normalMatrixOf(const glm::mat4& m) {
   return glm::mat4(cof);
 }
 
+// The shared vertex buffer as the graph sees it once deformed meshes are written into it.
+constexpr const char* kVertices = "vertices";
+
 uint32_t groups(uint32_t n) {
   return (n + 7) / 8;
 }
@@ -57,6 +61,24 @@ struct Renderer::Impl : EffectContext {
     uint32_t instance, material;
   };
   std::vector<Draw> draws;
+  // Animation: the renderer's own copy of the node hierarchy, posed by setTime().
+  Scene pose;
+  std::vector<int> instanceNodes;  // node of each gpu::Instance
+  std::vector<gpu::Instance> instances;
+  bool instancesDirty = true;
+  // Deformed (skinned and/or morphed) mesh instances: each owns a copy of its mesh's vertices
+  // in vertexBuffer, rewritten by the "skinning" pass from its rest vertices.
+  struct Deformed {
+    int node = 0, mesh = 0;
+    uint32_t srcFirst = 0, dstFirst = 0, count = 0, jointFirst = 0, jointCount = 0;
+    std::vector<glm::mat4> lastJoints;
+    std::vector<float> lastWeights;
+    bool dirty = true;
+  };
+  std::vector<Deformed> deformed;
+  Buffer restBuffer, jointIndexBuffer, jointWeightBuffer, jointBuffer;
+  Pipeline skinningPipeline;
+  uint32_t skinnedThisFrame = 0;
   std::vector<Material> sceneMaterials;
   std::vector<Image> textures;
   Image whiteTexture, neutralAO, output;
@@ -94,6 +116,7 @@ struct Renderer::Impl : EffectContext {
       throw Error(ErrorKind::Usage, "", "image size must be between 1x1 and 16384x16384");
     cameraView = activeCamera(scene, float(settings.width) / float(settings.height));
     uploadScene();
+    updateDeformations();  // joint matrices of the scene as loaded
     createPipelines();
     for (const EffectConfig& e : settings.effects) {
       if (!registry)
@@ -160,36 +183,85 @@ struct Renderer::Impl : EffectContext {
       vertices.insert(vertices.end(), m.vertices.begin(), m.vertices.end());
       indices.insert(indices.end(), m.indices.begin(), m.indices.end());
     }
-    vertexBuffer =
-        createDeviceBuffer(ctx, vertices.data(), vertices.size() * sizeof(Vertex),
-                           VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-    indexBuffer =
-        createDeviceBuffer(ctx, indices.data(), indices.size() * sizeof(uint32_t),
-                           VK_BUFFER_USAGE_INDEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
 
-    std::vector<gpu::Instance> instances;
-    for (const Node& node : scene.nodes) {
+    pose.nodes = scene.nodes;
+    pose.roots = scene.roots;
+    pose.skins = scene.skins;
+    pose.animations = scene.animations;
+    std::vector<Vertex> rest;
+    std::vector<glm::uvec4> jointIndices;
+    std::vector<glm::vec4> jointWeights;
+    uint32_t jointTotal = 0;
+    for (size_t n = 0; n < scene.nodes.size(); ++n) {
+      const Node& node = scene.nodes[n];
       for (int m : node.meshes) {
         const Mesh& mesh = scene.meshes[m];
         if (mesh.indices.empty()) continue;
+        const bool skinned =
+            mesh.skinned() && node.skin >= 0 && size_t(node.skin) < scene.skins.size();
+        const bool morphed = !mesh.morphTargets.empty();
+        int32_t vertexOffset = ranges[m].vertexOffset;
+        if (skinned || morphed) {
+          // A private copy of the vertices, deformed in place every frame.
+          Deformed d;
+          d.node = int(n);
+          d.mesh = m;
+          d.count = uint32_t(mesh.vertices.size());
+          d.srcFirst = uint32_t(rest.size());
+          d.dstFirst = uint32_t(vertices.size());
+          d.jointFirst = jointTotal;
+          d.jointCount = skinned ? uint32_t(scene.skins[node.skin].joints.size()) : 0;
+          jointTotal += d.jointCount;
+          rest.insert(rest.end(), mesh.vertices.begin(), mesh.vertices.end());
+          for (size_t v = 0; v < mesh.vertices.size(); ++v) {
+            jointIndices.push_back(skinned ? mesh.joints[v] : glm::uvec4(0));
+            jointWeights.push_back(skinned ? mesh.weights[v] : glm::vec4(0.0f));
+          }
+          vertices.insert(vertices.end(), mesh.vertices.begin(), mesh.vertices.end());
+          vertexOffset = int32_t(d.dstFirst);
+          deformed.push_back(std::move(d));
+        }
         gpu::Instance inst;
         inst.model = inst.prevModel = node.world;
         inst.normalMatrix = normalMatrixOf(node.world);
         const uint32_t materialIndex =
             std::min<uint32_t>(mesh.material, uint32_t(sceneMaterials.size() - 1));
         inst.material = glm::uvec4(materialIndex, 0, 0, 0);
-        draws.push_back({ranges[m].firstIndex, ranges[m].indexCount, ranges[m].vertexOffset,
+        draws.push_back({ranges[m].firstIndex, ranges[m].indexCount, vertexOffset,
                          uint32_t(instances.size()), materialIndex});
         instances.push_back(inst);
+        instanceNodes.push_back(int(n));
       }
+    }
+    vertexBuffer =
+        createDeviceBuffer(ctx, vertices.data(), vertices.size() * sizeof(Vertex),
+                           VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                               VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+    indexBuffer =
+        createDeviceBuffer(ctx, indices.data(), indices.size() * sizeof(uint32_t),
+                           VK_BUFFER_USAGE_INDEX_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    if (!deformed.empty()) {
+      // Rest vertices and joint matrices change on the CPU (morphs, poses): host-visible.
+      restBuffer =
+          Buffer(ctx, rest.size() * sizeof(Vertex), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true);
+      restBuffer.write(rest.data(), rest.size() * sizeof(Vertex));
+      jointIndexBuffer =
+          createDeviceBuffer(ctx, jointIndices.data(), jointIndices.size() * sizeof(glm::uvec4),
+                             VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+      jointWeightBuffer =
+          createDeviceBuffer(ctx, jointWeights.data(), jointWeights.size() * sizeof(glm::vec4),
+                             VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+      jointBuffer = Buffer(ctx, std::max<size_t>(jointTotal, 1) * sizeof(glm::mat4),
+                           VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true);
     }
     // Grouped by material so each material's descriptor set is bound once.
     std::stable_sort(draws.begin(), draws.end(),
                      [](const Draw& a, const Draw& b) { return a.material < b.material; });
     if (instances.empty()) instances.emplace_back();  // keep the buffer non-empty
-    instanceBuffer =
-        createDeviceBuffer(ctx, instances.data(), instances.size() * sizeof(gpu::Instance),
-                           VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    // Host-visible: animated nodes rewrite their model matrices every frame.
+    instanceBuffer = Buffer(ctx, instances.size() * sizeof(gpu::Instance),
+                            VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true);
+    instanceBuffer.write(instances.data(), instances.size() * sizeof(gpu::Instance));
 
     std::vector<gpu::Material> materials;
     for (const Material& m : sceneMaterials) {
@@ -280,6 +352,81 @@ struct Renderer::Impl : EffectContext {
     tonemapPipeline =
         Pipeline::compute(ctx, loadSpirv("tonemap.comp"), {{0, ubo}, {1, tex}, {2, img}});
     floorPipeline = Pipeline::compute(ctx, loadSpirv("floor.comp"), {{0, ubo}, {1, tex}, {2, img}});
+    if (!deformed.empty())
+      skinningPipeline =
+          Pipeline::compute(ctx, loadSpirv("skinning.comp"),
+                            {{0, ssbo}, {1, ssbo}, {2, ssbo}, {3, ssbo}, {4, ssbo}}, 5 * 4);
+  }
+
+  // ---- animation --------------------------------------------------------------------------
+
+  // Poses the nodes at `time`: instance matrices (previous ones kept for motion vectors), joint
+  // matrices and morphed rest vertices; instances whose deformation changed are marked for
+  // re-skinning.
+  void setTime(double time) {
+    pose.animate(time);
+    for (size_t i = 0; i < instanceNodes.size(); ++i) {
+      gpu::Instance& inst = instances[i];
+      const glm::mat4& world = pose.nodes[instanceNodes[i]].world;
+      inst.prevModel = inst.model;
+      inst.model = world;
+      inst.normalMatrix = normalMatrixOf(world);
+    }
+    instancesDirty = true;
+    updateDeformations();
+  }
+
+  void updateDeformations() {
+    for (Deformed& d : deformed) {
+      const Mesh& mesh = scene.meshes[d.mesh];
+      if (d.jointCount > 0) {
+        std::vector<glm::mat4> joints = jointMatrices(pose, d.node);
+        if (joints != d.lastJoints) {
+          jointBuffer.write(joints.data(), joints.size() * sizeof(glm::mat4),
+                            size_t(d.jointFirst) * sizeof(glm::mat4));
+          d.lastJoints = std::move(joints);
+          d.dirty = true;
+        }
+      }
+      if (!mesh.morphTargets.empty()) {
+        const std::vector<float>& weights = pose.nodes[d.node].morphWeights;
+        if (weights != d.lastWeights || d.lastWeights.empty()) {
+          const std::vector<Vertex> morphed = morphVertices(mesh, weights);
+          restBuffer.write(morphed.data(), morphed.size() * sizeof(Vertex),
+                           size_t(d.srcFirst) * sizeof(Vertex));
+          d.lastWeights = weights;
+          d.dirty = true;
+        }
+      }
+    }
+  }
+
+  // The "skinning" pass: rewrites the vertex-buffer regions of deformed instances whose joint
+  // matrices or morph weights changed. Returns the vertex buffer's new version for readers.
+  BufferHandle addSkinningPass(BufferHandle vertices) {
+    auto io = std::make_shared<BufferHandle>();
+    graph.addPass(
+        "skinning", [&](PassBuilder& b) { *io = b.write(vertices, BufferUsage::StorageWrite); },
+        [this](PassContext& pc) {
+          DescriptorWriter w;
+          w.buffer(0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, restBuffer.handle())
+              .buffer(1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, jointIndexBuffer.handle())
+              .buffer(2, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, jointWeightBuffer.handle())
+              .buffer(3, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, jointBuffer.handle())
+              .buffer(4, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, vertexBuffer.handle());
+          bind(pc.cmd(), skinningPipeline, w);
+          skinnedThisFrame = 0;
+          for (Deformed& d : deformed) {
+            if (!d.dirty) continue;
+            const uint32_t push[5] = {d.srcFirst, d.dstFirst, d.count, d.jointFirst, d.jointCount};
+            vkCmdPushConstants(pc.cmd(), skinningPipeline.layout(), VK_SHADER_STAGE_ALL, 0,
+                               sizeof(push), push);
+            vkCmdDispatch(pc.cmd(), (d.count + 63) / 64, 1, 1);
+            d.dirty = false;
+            skinnedThisFrame += d.count;
+          }
+        });
+    return *io;
   }
 
   // ---- the frame graph ------------------------------------------------------------------
@@ -292,6 +439,12 @@ struct Renderer::Impl : EffectContext {
     // GENERAL at the end of every frame: presenters and read-back expect it.
     outputHandle = graph.importTexture(res::kOutput, output.handle(), output.view(), outDesc,
                                        VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL);
+    BufferHandle vertices;
+    if (!deformed.empty()) {
+      vertices = graph.importBuffer(kVertices, vertexBuffer.handle(), vertexBuffer.size());
+      vertices = addSkinningPass(vertices);
+      bb.put(kVertices, vertices);
+    }
     addGBufferPass(bb);
     addEffects(EffectStage::BeforeLighting);
     addLightingPass(bb);
@@ -332,6 +485,7 @@ struct Renderer::Impl : EffectContext {
     graph.addPass(
         "gbuffer",
         [&](PassBuilder& b) {
+          if (BufferHandle v = bb.buffer(kVertices); v.valid()) b.read(v, BufferUsage::Vertex);
           t->depth = b.write(b.create(res::kDepth, outputRelative(VK_FORMAT_D32_SFLOAT)),
                              TextureUsage::DepthAttachment);
           t->normal = b.write(b.create(res::kNormal, outputRelative(VK_FORMAT_R16G16B16A16_SFLOAT)),
@@ -525,6 +679,10 @@ struct Renderer::Impl : EffectContext {
 
   void renderFrame() {
     if (graphDirty) buildGraph();
+    if (instancesDirty) {
+      instanceBuffer.write(instances.data(), instances.size() * sizeof(gpu::Instance));
+      instancesDirty = false;
+    }
     updateFrameUniforms();
     descriptors.reset();
     check(vkResetCommandBuffer(cmd, 0), "vkResetCommandBuffer");
@@ -658,6 +816,26 @@ Renderer::Renderer(Context& ctx, const Scene& scene, const RenderSettings& setti
 Renderer::~Renderer() = default;
 void Renderer::renderFrame() {
   impl_->renderFrame();
+}
+void Renderer::setTime(double seconds) {
+  impl_->setTime(seconds);
+}
+uint32_t Renderer::lastSkinnedVertexCount() const {
+  return impl_->skinnedThisFrame;
+}
+std::vector<Renderer::DeformedMesh> Renderer::readDeformedMeshes() {
+  Impl& m = *impl_;
+  std::vector<DeformedMesh> out;
+  if (m.deformed.empty()) return out;
+  vk::Buffer staging(m.ctx, m.vertexBuffer.size(), VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
+  m.ctx.submitAndWait([&](VkCommandBuffer c) {
+    VkBufferCopy copy{0, 0, m.vertexBuffer.size()};
+    vkCmdCopyBuffer(c, m.vertexBuffer.handle(), staging.handle(), 1, &copy);
+  });
+  const auto* all = static_cast<const Vertex*>(staging.mapped());
+  for (const Impl::Deformed& d : m.deformed)
+    out.push_back({d.node, d.mesh, {all + d.dstFirst, all + d.dstFirst + d.count}});
+  return out;
 }
 const std::vector<PassTiming>& Renderer::lastTimings() const {
   return impl_->timings;
