@@ -6,15 +6,22 @@
 # (e.g. `ssao_comp`), so a module is one self-contained file. Shaders may
 # `#include "common.glsl"` (the engine's FrameUniforms and helpers).
 #
-# Works in the engine's own tree and against an installed package (find_package(gi)).
-# GI_PLUGIN_OUTPUT_DIR sets where modules land (default: <build>/plugins).
+# Works in the engine's own tree and against an installed package (find_package(gi), which
+# includes this file and sets GI_SHADER_INCLUDE_DIR). GI_PLUGIN_OUTPUT_DIR sets where modules
+# land (default: <build>/plugins; point GI_PLUGIN_PATH there to run them). See effects/README.md.
 
-find_program(GI_GLSLANG_VALIDATOR glslangValidator REQUIRED)
+find_program(GI_GLSLANG_VALIDATOR glslangValidator)
 
 function(gi_add_effect name)
   cmake_parse_arguments(EFFECT "" "" "SOURCES;SHADERS" ${ARGN})
   if(NOT EFFECT_SOURCES)
     message(FATAL_ERROR "gi_add_effect(${name}): SOURCES is required")
+  endif()
+  if(EFFECT_SHADERS AND NOT GI_GLSLANG_VALIDATOR)
+    message(FATAL_ERROR "gi_add_effect(${name}): glslangValidator not found (Debian: glslang-tools)")
+  endif()
+  if(NOT GI_SHADER_INCLUDE_DIR)
+    message(FATAL_ERROR "gi_add_effect(${name}): GI_SHADER_INCLUDE_DIR is not set (find_package(gi) sets it)")
   endif()
   set(target gi_effect_${name})
   add_library(${target} MODULE ${EFFECT_SOURCES})

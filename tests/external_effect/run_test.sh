@@ -1,0 +1,108 @@
+#!/usr/bin/env bash
+# Plugin development without touching the engine, end to end:
+#   1. installs the build tree into a temporary prefix (cmake --install),
+#   2. builds this folder's vignette effect and a fresh copy of the template
+#      (tools/new-effect) out of tree against that prefix only (find_package(gi)),
+#   3. runs the INSTALLED gi-render with GI_PLUGIN_PATH pointing at both builds: the effects
+#      are listed with their settings and module paths, run with validation on, show up as
+#      executed passes, and the vignette darkens the image corners.
+# usage: run_test.sh BUILD_DIR SOURCE_DIR      (ctest: external_effect)
+set -euo pipefail
+build="$(cd "$1" && pwd)"
+src="$(cd "$2" && pwd)"
+tmp="$(mktemp -d "${TMPDIR:-/tmp}/gi-external.XXXXXX")"
+trap 'rm -rf "$tmp"' EXIT
+start=$SECONDS
+step() { echo "== [$((SECONDS - start))s] $*"; }
+fail() {
+  echo "FAILED: $*" >&2
+  exit 1
+}
+# expect FILE PATTERN WHAT: grep -E PATTERN in FILE or fail showing the file.
+expect() {
+  if ! grep -qE -- "$2" "$1"; then
+    cat "$1" >&2
+    fail "$3 (no line matching '$2' in the output above)"
+  fi
+}
+
+step "install $build -> $tmp/install"
+cmake --install "$build" --prefix "$tmp/install" >"$tmp/install.log" || {
+  cat "$tmp/install.log" >&2
+  fail "cmake --install"
+}
+prefix="$tmp/install"
+gi="$prefix/bin/gi-render"
+[ -x "$gi" ] || fail "no installed gi-render at $gi"
+[ -f "$prefix/share/gi/shaders/common.glsl" ] || fail "common.glsl not installed"
+
+configure_and_build() {  # SRC_DIR BUILD_DIR
+  cmake -S "$1" -B "$2" -G Ninja -DCMAKE_PREFIX_PATH="$prefix" >"$2.log" 2>&1 || {
+    cat "$2.log" >&2
+    fail "configuring $1 against $prefix"
+  }
+  # The package must come from the install, not from the build or source tree.
+  expect "$2/CMakeCache.txt" "^gi_DIR:PATH=$prefix/" "gi package not found in $prefix"
+  cmake --build "$2" -j2 >>"$2.log" 2>&1 || {
+    cat "$2.log" >&2
+    fail "building $1"
+  }
+}
+
+step "new-effect ext_grey (from effects/_template)"
+"$src/tools/new-effect" ext_grey "$tmp/ext_grey" >/dev/null
+step "build tests/external_effect (vignette) and ext_grey against the installed package"
+configure_and_build "$src/tests/external_effect" "$tmp/vignette-build"
+configure_and_build "$tmp/ext_grey" "$tmp/ext_grey-build"
+[ -f "$tmp/vignette-build/plugins/gi_effect_vignette.so" ] || fail "no vignette module built"
+[ -f "$tmp/ext_grey-build/plugins/gi_effect_ext_grey.so" ] || fail "no ext_grey module built"
+
+export GI_PLUGIN_PATH="$tmp/vignette-build/plugins:$tmp/ext_grey-build/plugins"
+step "installed gi-render --list-effects"
+"$gi" --list-effects >"$tmp/list.txt" 2>&1 || {
+  cat "$tmp/list.txt" >&2
+  fail "gi-render --list-effects"
+}
+cat "$tmp/list.txt"
+expect "$tmp/list.txt" "^vignette 1\.0 - " "vignette not listed"
+expect "$tmp/list.txt" "module: $tmp/vignette-build/plugins/gi_effect_vignette\.so$" \
+  "vignette module path not listed"
+expect "$tmp/list.txt" "stage: after lighting, reads: lit, writes: lit vignette, debug view: vignette" \
+  "vignette stage/resources not listed"
+expect "$tmp/list.txt" "vignette\.strength \(float, default 0\.8, range \[0, 1\], uniform only\)" \
+  "vignette.strength setting not listed"
+expect "$tmp/list.txt" "^ext_grey 0\.1 - " "ext_grey (copied template) not listed"
+expect "$tmp/list.txt" "module: $tmp/ext_grey-build/plugins/gi_effect_ext_grey\.so$" \
+  "ext_grey module path not listed"
+if grep -q "^refused:" "$tmp/list.txt"; then fail "a module was refused"; fi
+
+render() {  # NAME EFFECTS [more gi-render arguments]
+  local name="$1" effects="$2"
+  shift 2
+  "$gi" --scene default --effects "$effects" --print-graph --validation --width 160 \
+    --height 120 --out "$tmp/$name.png" "$@" >"$tmp/$name.log" 2>&1 || {
+    cat "$tmp/$name.log" >&2
+    fail "gi-render --effects '$effects' ($name)"
+  }
+  [ -s "$tmp/$name.png" ] || fail "$name.png not written"
+}
+step "render with and without the vignette"
+render v vignette
+cat "$tmp/v.log"
+expect "$tmp/v.log" "^  \[run\] +vignette$" "vignette pass not executed"
+expect "$tmp/v.log" "^      reads: lit$" "vignette pass does not read lit"
+render base ""
+if grep -q "vignette" "$tmp/base.log"; then fail "vignette ran without being asked for"; fi
+python3 "$src/tests/external_effect/corners.py" "$tmp/v.png" "$tmp/base.png" ||
+  fail "the vignette does not darken the corners"
+# Uniform-only setting: strength 0 leaves the image as it was.
+render v0 vignette --set vignette.strength=0
+python3 "$src/tests/external_effect/corners.py" "$tmp/v0.png" "$tmp/base.png" >/dev/null &&
+  fail "vignette.strength=0 still darkens the corners"
+
+step "render the copied template after the vignette, and its debug view"
+render both vignette,ext_grey
+expect "$tmp/both.log" "^  \[run\] +vignette$" "vignette pass not executed"
+expect "$tmp/both.log" "^  \[run\] +ext_grey$" "ext_grey pass not executed"
+render grey_view ext_grey --view ext_grey
+step "passed"

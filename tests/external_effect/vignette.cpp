@@ -1,0 +1,89 @@
+// A vignette: an AfterLighting effect that reads the lit colour, writes a darkened copy and
+// publishes it as the new "lit" so tonemapping (and every later effect) uses it. Built out of
+// the engine's tree against the installed package (find_package(gi)); see CMakeLists.txt.
+#include <memory>
+
+#include "gi/effect.h"
+#include "gi/effect_registry.h"
+#include "gi/vk/pipeline.h"
+#include "vignette.comp.h"  // const uint32_t vignette_comp[] (SPIR-V, made by gi_add_effect)
+
+namespace {
+
+class VignetteEffect : public gi::Effect {
+ public:
+  gi::EffectInfo info() const override {
+    gi::EffectInfo i;
+    i.name = "vignette";
+    i.version = "1.0";
+    i.description = "darkens the lit colour towards the image corners";
+    i.stage = gi::EffectStage::AfterLighting;
+    i.reads = {gi::resources::kLit};
+    i.writes = {gi::resources::kLit, "vignette"};
+    i.debugView = "vignette";
+    return i;
+  }
+
+  std::vector<gi::SettingDesc> settings() const override {
+    return {{"strength", gi::SettingType::Float, 0.8, 0.0, 1.0,
+             "how much the corners are darkened (0: off, 1: black)", false},
+            {"radius", gi::SettingType::Float, 0.3, 0.0, 1.0,
+             "distance from the centre (1 = corner) where darkening starts", false}};
+  }
+
+  void prepare(gi::EffectContext& ctx, const gi::SettingValues&) override {
+    const std::vector<uint32_t> spirv(std::begin(vignette_comp), std::end(vignette_comp));
+    pipeline_ = gi::vk::Pipeline::compute(ctx.vulkan(), spirv,
+                                          {{0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
+                                           {1, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER},
+                                           {2, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE}},
+                                          sizeof(Params));
+  }
+
+  void addPasses(gi::FrameGraph& graph, gi::EffectContext& ctx,
+                 const gi::SettingValues& settings) override {
+    struct Io {
+      gi::TextureHandle in, out;
+    };
+    auto io = std::make_shared<Io>();
+    gi::Blackboard& bb = graph.blackboard();
+    graph.addPass(
+        "vignette",
+        [&](gi::PassBuilder& b) {
+          io->in = b.read(bb.texture(gi::resources::kLit));
+          io->out = b.write(b.create("vignette", gi::TextureDesc{VK_FORMAT_R16G16B16A16_SFLOAT}),
+                            gi::TextureUsage::StorageWrite);
+        },
+        // `settings` lives as long as the graph; reading it here (not in addPasses) makes
+        // uniform-only changes apply without a graph rebuild.
+        [this, io, values = &settings, frame = ctx.frameUniforms(),
+         sampler = ctx.nearestSampler()](gi::PassContext& pc) {
+          VkDescriptorSet set = pc.descriptors().allocate(pipeline_.setLayout());
+          gi::vk::DescriptorWriter()
+              .buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame)
+              .sampled(1, pc.view(io->in), sampler)
+              .storageImage(2, pc.view(io->out))
+              .update(pc.context().device(), set);
+          const Params params{float(values->number("strength")), float(values->number("radius"))};
+          const VkExtent2D size = pc.extent(io->out);
+          vkCmdBindPipeline(pc.cmd(), VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_.handle());
+          vkCmdBindDescriptorSets(pc.cmd(), VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_.layout(), 0,
+                                  1, &set, 0, nullptr);
+          vkCmdPushConstants(pc.cmd(), pipeline_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof params,
+                             &params);
+          vkCmdDispatch(pc.cmd(), (size.width + 7) / 8, (size.height + 7) / 8, 1);
+        });
+    bb.put("vignette", io->out);           // the debug view (--view vignette)
+    bb.put(gi::resources::kLit, io->out);  // what tonemapping reads from now on
+  }
+
+ private:
+  struct Params {
+    float strength, radius;
+  };
+  gi::vk::Pipeline pipeline_;
+};
+
+}  // namespace
+
+GI_EFFECT_MODULE(VignetteEffect)
