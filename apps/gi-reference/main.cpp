@@ -1,0 +1,233 @@
+// gi-reference: CPU ground-truth renderer (Embree). Estimates ambient occlusion, obscurance, the
+// Alchemy obscurance integral, direct light or direct + one bounce for exactly the scene and
+// camera gi-render uses, and writes the float image, its per-pixel standard error and an 8-bit
+// preview. Prints the time taken, the samples per pixel reached and the mean standard error.
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "gi/errors.h"
+#include "gi/image_io.h"
+#include "gi/reference/reference.h"
+#include "gi/scene_io.h"
+
+namespace {
+
+namespace ref = gi::reference;
+
+const char* kUsage =
+    "usage: gi-reference --scene FILE|default --out IMAGE.pfm [options]\n"
+    "  --quantity Q           ao, obscurance, alchemy, direct, direct+indirect, depth, normal\n"
+    "                         (default ao)\n"
+    "  --radius R             AO / obscurance / Alchemy radius in world units (default 0.5)\n"
+    "  --spp N                maximum samples per pixel (default 64)\n"
+    "  --noise-target E       stop early once the mean per-pixel standard error is <= E\n"
+    "  --min-spp N            samples before the noise target is checked (default 16)\n"
+    "  --width W --height H   image size (default 320x240)\n"
+    "  --seed S               random seed (default 1); a seed always gives the same image\n"
+    "  --threads T            worker threads (default: all cores); does not change the image\n"
+    "  --time T               animation clock in seconds, as gi-render --time (default 0)\n"
+    "  --membership M         obscurance membership mu: sqrt (default), linear, smoothstep,\n"
+    "                         step (= AO), exp\n"
+    "  --alchemy-sigma S      Alchemy intensity sigma (default 1)\n"
+    "  --alchemy-u U          Alchemy falloff knee u (default 0: the paper's eq. 10 form)\n"
+    "  --alchemy-epsilon E    Alchemy epsilon (default 1e-4)\n"
+    "  --alchemy-contrast K   Alchemy contrast k (default 1)\n"
+    "  --out FILE.pfm         the estimate (float RGB)\n"
+    "  --stderr-out FILE.pfm  per-pixel standard error (default: <out>.stderr.pfm)\n"
+    "  --png FILE.png         8-bit preview (grey for AO-like quantities, tonemapped light)\n"
+    "  --gbuffer PREFIX       also write PREFIX_depth.pfm (reverse-Z depth, view z, distance),\n"
+    "                         PREFIX_normal.pfm (view space), PREFIX_position.pfm (world)\n"
+    "  --exposure E           preview exposure for the lighting quantities (default 1)\n"
+    "  --quiet                no progress lines\n";
+
+struct Options {
+  std::string scene, out, png, stderrOut, gbuffer;
+  ref::Settings settings;
+  double time = 0.0;
+  float exposure = 1.0f;
+  bool quiet = false;
+};
+
+[[noreturn]] void usageError(const std::string& message) {
+  throw gi::Error(gi::ErrorKind::Usage, "", message + " (see gi-reference --help)");
+}
+
+double parseNumber(const std::string& flag, const char* text, double lo, double hi) {
+  char* end = nullptr;
+  double v = std::strtod(text, &end);
+  if (end == text || *end != '\0' || !(v >= lo && v <= hi))
+    usageError(flag + " expects a number in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+               "], got '" + text + "'");
+  return v;
+}
+
+uint64_t parseSeed(const char* text) {
+  char* end = nullptr;
+  errno = 0;
+  unsigned long long v = std::strtoull(text, &end, 10);
+  if (end == text || *end != '\0' || errno != 0 || text[0] == '-')
+    usageError(std::string("--seed expects a non-negative integer, got '") + text + "'");
+  return v;
+}
+
+Options parseArgs(int argc, char** argv) {
+  Options o;
+  ref::Settings& s = o.settings;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto value = [&]() -> const char* {
+      if (i + 1 >= argc) usageError(a + " needs a value");
+      return argv[++i];
+    };
+    if (a == "--help" || a == "-h") {
+      std::fputs(kUsage, stdout);
+      std::exit(0);
+    } else if (a == "--scene")
+      o.scene = value();
+    else if (a == "--out")
+      o.out = value();
+    else if (a == "--png")
+      o.png = value();
+    else if (a == "--stderr-out")
+      o.stderrOut = value();
+    else if (a == "--gbuffer")
+      o.gbuffer = value();
+    else if (a == "--quantity")
+      s.quantity = ref::parseQuantity(value());
+    else if (a == "--membership")
+      s.membership = ref::parseMembership(value());
+    else if (a == "--radius")
+      s.radius = float(parseNumber(a, value(), 1e-9, 1e9));
+    else if (a == "--spp")
+      s.spp = uint32_t(parseNumber(a, value(), 1, 1 << 24));
+    else if (a == "--min-spp")
+      s.minSpp = uint32_t(parseNumber(a, value(), 1, 1 << 24));
+    else if (a == "--noise-target")
+      s.noiseTarget = parseNumber(a, value(), 0, 1e9);
+    else if (a == "--width")
+      s.width = uint32_t(parseNumber(a, value(), 1, 16384));
+    else if (a == "--height")
+      s.height = uint32_t(parseNumber(a, value(), 1, 16384));
+    else if (a == "--seed")
+      s.seed = parseSeed(value());
+    else if (a == "--threads")
+      s.threads = unsigned(parseNumber(a, value(), 1, 1024));
+    else if (a == "--time")
+      o.time = parseNumber(a, value(), -1e9, 1e9);
+    else if (a == "--alchemy-sigma")
+      s.alchemy.sigma = float(parseNumber(a, value(), 0, 1e9));
+    else if (a == "--alchemy-u")
+      s.alchemy.u = float(parseNumber(a, value(), 0, 1e9));
+    else if (a == "--alchemy-epsilon")
+      s.alchemy.epsilon = float(parseNumber(a, value(), 0, 1e9));
+    else if (a == "--alchemy-contrast")
+      s.alchemy.contrast = float(parseNumber(a, value(), 1e-6, 1e6));
+    else if (a == "--exposure")
+      o.exposure = float(parseNumber(a, value(), 0, 1e6));
+    else if (a == "--quiet")
+      o.quiet = true;
+    else
+      usageError("unknown argument '" + a + "'");
+  }
+  if (o.scene.empty()) usageError("--scene is required");
+  if (o.out.empty()) usageError("--out is required");
+  auto requireExt = [](const std::string& path, const char* ext) {
+    if (!path.empty() && std::filesystem::path(path).extension() != ext)
+      throw gi::Error(gi::ErrorKind::Usage, path, std::string("output must end in ") + ext);
+  };
+  requireExt(o.out, ".pfm");
+  requireExt(o.stderrOut, ".pfm");
+  requireExt(o.png, ".png");
+  if (o.stderrOut.empty())
+    o.stderrOut = (std::filesystem::path(o.out).replace_extension(".stderr.pfm")).string();
+  return o;
+}
+
+// Fails before any work when an output cannot be created (missing or non-directory parent).
+void checkWritable(const std::string& path) {
+  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+  std::error_code ec;
+  if (!parent.empty() && !std::filesystem::is_directory(parent, ec))
+    throw gi::Error(gi::ErrorKind::FileNotFound, path, "output folder does not exist");
+  if (std::filesystem::is_directory(path, ec))
+    throw gi::Error(gi::ErrorKind::FileNotFound, path, "output path is a folder");
+}
+
+int run(const Options& o) {
+  std::vector<std::pair<std::string, const gi::ImageRGBA32F*>> floats;
+  std::vector<std::string> outputs = {o.out, o.stderrOut};
+  if (!o.png.empty()) outputs.push_back(o.png);
+  if (!o.gbuffer.empty())
+    for (const char* suffix : {"_depth.pfm", "_normal.pfm", "_position.pfm"})
+      outputs.push_back(o.gbuffer + suffix);
+  for (const std::string& path : outputs) checkWritable(path);
+
+  gi::Scene scene = gi::loadScene(o.scene);
+  for (const std::string& w : scene.warnings)
+    std::fprintf(stderr, "gi-reference: warning: %s\n", w.c_str());
+  scene.animate(o.time);  // as gi-render poses the scene (Renderer::setTime)
+
+  ref::Settings settings = o.settings;
+  if (!o.quiet)
+    settings.progress = [](const ref::Progress& p) {
+      std::fprintf(stderr, "gi-reference: %u spp, mean standard error %.6g, %.2f s\n", p.spp,
+                   p.meanStdError, p.seconds);
+    };
+  const ref::Result r = ref::render(scene, settings);
+
+  floats.push_back({o.out, &r.value});
+  floats.push_back({o.stderrOut, &r.stdError});
+  if (!o.gbuffer.empty()) {
+    floats.push_back({o.gbuffer + "_depth.pfm", &r.depth});
+    floats.push_back({o.gbuffer + "_normal.pfm", &r.normal});
+    floats.push_back({o.gbuffer + "_position.pfm", &r.position});
+  }
+  // Each file is written through a temporary name; if a later one fails, the earlier ones are
+  // removed so no partial set of outputs is left behind.
+  std::vector<std::string> written;
+  try {
+    for (const auto& [path, image] : floats) {
+      gi::writePfm(path, *image);
+      written.push_back(path);
+    }
+    if (!o.png.empty()) {
+      gi::writePng(o.png, ref::preview(r.value, settings.quantity, o.exposure));
+      written.push_back(o.png);
+    }
+  } catch (...) {
+    std::error_code ec;
+    for (const std::string& path : written) std::filesystem::remove(path, ec);
+    throw;
+  }
+
+  std::printf("scene %s, %ux%u, %zu triangles, quantity %s", o.scene.c_str(), settings.width,
+              settings.height, r.triangles, ref::quantityName(settings.quantity));
+  if (settings.quantity == ref::Quantity::AO || settings.quantity == ref::Quantity::Alchemy ||
+      settings.quantity == ref::Quantity::Obscurance)
+    std::printf(", radius %g", double(settings.radius));
+  if (settings.quantity == ref::Quantity::Obscurance)
+    std::printf(", membership %s", ref::membershipName(settings.membership));
+  std::printf("\n");
+  std::printf("time %.3f s, %u samples per pixel, mean standard error %.6g (%zu geometry pixels)\n",
+              r.seconds, r.spp, r.meanStdError, r.geometryPixels);
+  for (const std::string& path : written) std::printf("wrote %s\n", path.c_str());
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(parseArgs(argc, argv));
+  } catch (const gi::Error& e) {
+    std::fprintf(stderr, "gi-reference: error (%s): %s\n", gi::errorKindName(e.kind()), e.what());
+    return e.kind() == gi::ErrorKind::Usage ? 2 : 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "gi-reference: error: %s\n", e.what());
+    return 1;
+  }
+}

@@ -1,0 +1,130 @@
+// CPU ground-truth renderer (Embree ray tracing, no Vulkan). For the scene, camera and pixel
+// convention of the Vulkan renderer it estimates, per pixel, the quantity a screen-space effect
+// approximates, together with its own standard error:
+//
+//  - The camera is gi::activeCamera(scene, width / height). Pixel (x, y) is sampled at its
+//    centre: uv = ((x + 0.5) / w, (y + 0.5) / h), y down, NDC = uv * 2 - 1, and the primary ray
+//    runs from the camera through the inverse projection of that NDC point, between the near
+//    and far planes (what the rasteriser keeps). There is no antialiasing: every quantity is
+//    the one at the surface point a deferred renderer stores for that pixel, so reference and
+//    effect images compare pixel by pixel.
+//  - Surfaces are double-sided like the rasteriser's (no culling; normals face the viewer).
+//
+// Quantities (n: the G-buffer normal, i.e. the interpolated vertex normal facing the viewer;
+// t(w): distance to the first surface along direction w; integrals over the hemisphere of n):
+//  - AO (RTR eq. 11.8 with a distance limit r):  k_A = (1/pi) int V_r(w) cos(theta) dw, where
+//    V_r = 0 if something is hit within r, else 1. 1 = fully open.
+//  - Obscurance (seed 001 eq. 5):  O = (1/pi) int mu(t(w)) cos(theta) dw, mu a membership
+//    function reaching 1 at distance R = r (a miss counts 1).
+//  - Alchemy (seed 003): the integral the Alchemy AO estimator claims to estimate, see below.
+//  - Direct: L = Le + sum over point/spot/directional lights of (rho/pi) E_l cos V_l (the
+//    rasteriser's light units and falloffs, plus a shadow ray) + (rho/pi) int L_env(w) V(w) cos
+//    dw (the procedural sky or constant environment, occluded by the scene), with rho the
+//    diffuse colour albedo * (1 - metallic). Diffuse only: no specular term.
+//  - DirectIndirect: Direct + one diffuse bounce: (rho/pi) int L_1(y(w)) cos dw over the
+//    directions that hit a surface y, where L_1(y) = Le(y) + Direct-without-Le at y, i.e.
+//    emissive surfaces count as light sources here (only here: Direct ignores them as lights).
+//  - Depth, Normal: the primary hit (deterministic, one sample).
+//
+// Estimators: i.i.d. cosine-weighted directions (pdf cos/pi), one per sample; each sample
+// reuses the pixel's deterministic light terms. Each sample's random numbers come from
+// (seed, pixel, sample index) only, so an image is identical for any thread count. The
+// standard error is sqrt(s^2 / n) from the per-pixel sample variance s^2 (Welford, double).
+// A pixel whose samples are all equal reports 0 even if its expectation lies between (e.g.
+// AO near 1 with few samples): read it together with the sample count.
+//
+// What the Alchemy estimator estimates. Seed 003 eq. 4 defines obscurance with a falloff g as
+//   A = 1 - (1/pi) int [1 - V(c, c + w min(t(w) + eps, r))] g(t(w)) (w.n) dw,
+// which, the visibility term being 0 exactly on the set Gamma of directions whose first hit is
+// nearer than r, is eq. 6:  A = 1 - (1/pi) int_Gamma g(t(w)) (w.n) dw.  With the falloff
+// g(t) = u t / max(u, t)^2 and v = t w this is eq. 8, A = 1 - (u/pi) int_Gamma (v.n)/max(u^2,
+// v.v) dw; sampling w uniformly on the hemisphere (pdf 1/(2 pi)) gives eq. 9,
+// 1 - (2u/s) sum max(0, v_i.n) H(r - |v_i|) / max(u^2, v_i.v_i), whose expectation is exactly
+// eq. 8. Eq. 10 then replaces u in the numerator by the intensity sigma and max(u^2, v.v) by
+// v.v + epsilon, drops the Heaviside in favour of sampling within the radius, adds the bias
+// beta (a depth-precision concession, 0 here) and applies max(0, .)^k. So, for a sample set
+// that is uniform in direction, the sum in eq. 10 estimates
+//   I = (1/pi) int_Gamma g(t(w)) cos(theta) dw,  g(t) = sigma t / (max(u^2, t^2) + epsilon)
+// (u = 0 for eq. 10; sigma = u, epsilon = 0 for eq. 7-9), and the effect's output claims
+// A = max(0, 1 - I)^k. This renderer computes I by cosine-weighted sampling (I = E[g(t) H(r -
+// t)] over cos-distributed w) and reports A = max(0, 1 - mean)^k, with the standard error
+// propagated through the derivative k (1 - I)^(k - 1). Two things the screen-space estimator
+// does differently are not part of the claim and show up as its error: (1) its samples are
+// points on a disk of radius r in the image plane read back from the depth buffer, not
+// directions uniform on the hemisphere, so its expectation weights the hemisphere differently
+// (and sees only the depth layer); (2) it applies max(0, .)^k per pixel to a finite-sample
+// sum, and E[max(0, 1 - X)^k] != max(0, 1 - E[X])^k.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+
+#include "gi/image_io.h"
+#include "gi/reference/sampling.h"
+#include "gi/scene.h"
+
+namespace gi::reference {
+
+enum class Quantity { AO, Obscurance, Alchemy, Direct, DirectIndirect, Depth, Normal };
+
+// Command-line names: ao, obscurance, alchemy, direct, direct+indirect, depth, normal;
+// memberships: sqrt, linear, smoothstep, step, exp. Throw gi::Error(Usage) for unknown names.
+Quantity parseQuantity(const std::string& name);
+const char* quantityName(Quantity q);
+Membership parseMembership(const std::string& name);
+const char* membershipName(Membership m);
+
+struct Progress {
+  uint32_t spp = 0;           // samples per pixel so far
+  double meanStdError = 0.0;  // over geometry pixels
+  double seconds = 0.0;       // since the start of render()
+};
+
+struct Settings {
+  uint32_t width = 320, height = 240;
+  Quantity quantity = Quantity::AO;
+  float radius = 0.5f;  // AO radius r, obscurance R, Alchemy r (world units)
+  Membership membership = Membership::Sqrt;
+  AlchemyParams alchemy;
+  uint32_t spp = 64;         // maximum samples per pixel
+  double noiseTarget = 0.0;  // > 0: stop once the mean standard error is at most this
+  uint32_t minSpp = 16;      // samples before the noise target is first checked
+  uint64_t seed = 1;
+  unsigned threads = 0;                           // 0: std::thread::hardware_concurrency()
+  std::function<void(const Progress&)> progress;  // called after each progressive pass
+};
+
+struct Result {
+  // The quantity (rgb; scalar quantities repeated in rgb), alpha 1 on geometry, 0 on sky. Sky
+  // pixels hold 1 for AO/obscurance/Alchemy (fully open), the environment radiance for the
+  // lighting quantities, and 0 for depth/normal.
+  ImageRGBA32F value;
+  ImageRGBA32F stdError;  // per-pixel standard error of `value` (rgb), alpha as in value
+  // The primary hits, in the Vulkan renderer's conventions (all 0 on sky pixels):
+  ImageRGBA32F depth;     // r: reverse-Z NDC depth (1 near, 0 far; 0 = sky, the clear value),
+                          // g: view-space z (negative in front of the camera), b: ray distance,
+                          // a: 1 on geometry, 0 on sky (the sky mask)
+  ImageRGBA32F normal;    // view-space normal facing the camera (the G-buffer's), a: mask
+  ImageRGBA32F position;  // world-space position, a: mask
+  CameraView camera;
+  uint32_t spp = 0;           // samples per pixel reached (1 for depth/normal)
+  double meanStdError = 0.0;  // mean over geometry pixels of the per-pixel error (mean of rgb)
+  double seconds = 0.0;       // wall time of render() (including the BVH build)
+  size_t geometryPixels = 0;
+  size_t triangles = 0;
+};
+
+// Renders `scene` as it stands (world transforms as updated by the caller, e.g. after
+// Scene::animate(time)). Throws gi::Error(Usage) for invalid settings.
+Result render(const Scene& scene, const Settings& settings);
+
+// The procedural sky / constant environment radiance in world direction `dir` (unit), the
+// same function as environmentRadiance in engine/shaders/common.glsl.
+glm::vec3 environmentRadiance(const Environment& env, const glm::vec3& dir);
+
+// 8-bit preview: AO-like quantities as grey, lighting with the renderer's tonemap (exposure,
+// ACES fit, sRGB), depth as grey NDC depth, normals as n * 0.5 + 0.5.
+ImageRGBA8 preview(const ImageRGBA32F& value, Quantity q, float exposure = 1.0f);
+
+}  // namespace gi::reference

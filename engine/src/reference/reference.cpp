@@ -1,0 +1,509 @@
+#include "gi/reference/reference.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <thread>
+#include <vector>
+
+#include "gi/errors.h"
+#include "gi/reference/ray_scene.h"
+
+namespace gi::reference {
+
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+// The rasteriser's guard: squared light distance is clamped so a light on a surface stays finite.
+constexpr float kMinLightDistance2 = 1e-4f;
+
+[[noreturn]] void usage(const std::string& message) {
+  throw Error(ErrorKind::Usage, "", message);
+}
+
+bool finite(const glm::vec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+glm::vec3 safeNormalize(const glm::vec3& v, const glm::vec3& fallback) {
+  const float len2 = glm::dot(v, v);
+  return (len2 > 1e-30f && std::isfinite(len2)) ? v / std::sqrt(len2) : fallback;
+}
+
+glm::vec3 finiteOrZero(const glm::vec3& v) {
+  return finite(v) ? v : glm::vec3(0.0f);
+}
+
+float smoothstep(float e0, float e1, float x) {
+  const float t = std::clamp((x - e0) / (e1 - e0), 0.0f, 1.0f);
+  return t * t * (3.0f - 2.0f * t);
+}
+
+// Base-colour texture decoded to linear once; sampled bilinearly with repeat wrapping (the
+// rasteriser's sampler for base colour).
+struct LinearTexture {
+  int width = 1, height = 1;
+  std::vector<glm::vec3> texels{glm::vec3(1.0f)};
+
+  explicit LinearTexture(const Texture& t) {
+    if (t.width <= 0 || t.height <= 0 || t.rgba8.size() != size_t(t.width) * t.height * 4)
+      return;  // invalid: white, like the rasteriser
+    float table[256];
+    for (int i = 0; i < 256; ++i) {
+      const float c = float(i) / 255.0f;
+      table[i] = c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+    }
+    width = t.width;
+    height = t.height;
+    texels.resize(size_t(width) * height);
+    for (size_t i = 0; i < texels.size(); ++i)
+      texels[i] =
+          glm::vec3(table[t.rgba8[i * 4]], table[t.rgba8[i * 4 + 1]], table[t.rgba8[i * 4 + 2]]);
+  }
+
+  glm::vec3 sample(glm::vec2 uv) const {
+    if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) uv = glm::vec2(0.0f);
+    const float fx = uv.x * float(width) - 0.5f, fy = uv.y * float(height) - 0.5f;
+    const float x0f = std::floor(fx), y0f = std::floor(fy);
+    const float ax = fx - x0f, ay = fy - y0f;
+    auto wrap = [](double i, int n) {
+      const double m = std::fmod(i, double(n));
+      return int(m < 0 ? m + n : m) % n;
+    };
+    const int x0 = wrap(x0f, width), x1 = wrap(double(x0f) + 1, width);
+    const int y0 = wrap(y0f, height), y1 = wrap(double(y0f) + 1, height);
+    auto at = [&](int x, int y) { return texels[size_t(y) * width + x]; };
+    return glm::mix(glm::mix(at(x0, y0), at(x1, y0), ax), glm::mix(at(x0, y1), at(x1, y1), ax), ay);
+  }
+};
+
+struct WorldLight {
+  LightType type = LightType::Point;
+  glm::vec3 position{0.0f};
+  glm::vec3 direction{0.0f, -1.0f, 0.0f};  // where the light points (unit)
+  glm::vec3 radiance{0.0f};                // colour * intensity (lux or candela)
+  float range = 0.0f, cosInner = 1.0f, cosOuter = 0.0f;
+  bool shadows = true;
+};
+
+struct SurfaceMaterial {
+  glm::vec3 diffuse{0.0f};  // albedo * (1 - metallic): the Lambert colour (BRDF = diffuse / pi)
+  glm::vec3 emission{0.0f};
+};
+
+// Everything a sample needs, shared read-only by the worker threads.
+class Shading {
+ public:
+  Shading(const Scene& scene, const RayScene& rays) : rays_(rays), env_(scene.environment) {
+    materials_ = scene.materials;
+    if (materials_.empty()) materials_.emplace_back();
+    for (const Texture& t : scene.textures) textures_.emplace_back(t);
+    for (const Node& node : scene.nodes) {
+      if (node.light < 0 || size_t(node.light) >= scene.lights.size()) continue;
+      const Light& l = scene.lights[node.light];
+      WorldLight w;
+      w.type = l.type;
+      w.position = glm::vec3(node.world * glm::vec4(0, 0, 0, 1));
+      w.direction =
+          safeNormalize(glm::vec3(node.world * glm::vec4(0, 0, -1, 0)), glm::vec3(0, -1, 0));
+      w.radiance = l.color * std::max(l.intensity, 0.0f);
+      w.range = std::max(l.range, 0.0f);
+      w.cosInner = std::cos(l.innerConeAngle);
+      w.cosOuter = std::cos(l.outerConeAngle);
+      w.shadows = l.castsShadows;
+      if (!finite(w.position) || !finite(w.radiance)) continue;
+      lights_.push_back(w);
+    }
+  }
+
+  const RayScene& rays() const { return rays_; }
+
+  SurfaceMaterial material(const SurfaceHit& hit) const {
+    const Material& m = materials_[std::min<size_t>(hit.material, materials_.size() - 1)];
+    glm::vec3 albedo(m.baseColor);
+    if (m.baseColorTexture >= 0 && size_t(m.baseColorTexture) < textures_.size())
+      albedo *= textures_[m.baseColorTexture].sample(hit.uv);
+    albedo = glm::clamp(finiteOrZero(albedo), 0.0f, 1.0f);
+    const float metallic = std::isfinite(m.metallic) ? std::clamp(m.metallic, 0.0f, 1.0f) : 0.0f;
+    return {albedo * (1.0f - metallic), glm::max(finiteOrZero(m.emission), glm::vec3(0.0f))};
+  }
+
+  glm::vec3 environment(const glm::vec3& dir) const { return environmentRadiance(env_, dir); }
+
+  // Reflected radiance from the point, spot and directional lights with shadow rays:
+  // sum (diffuse / pi) E_l cos(theta_l) V_l, with the rasteriser's units and falloffs.
+  glm::vec3 directLights(const SurfaceHit& hit, const glm::vec3& diffuse) const {
+    glm::vec3 sum(0.0f);
+    if (lights_.empty() || diffuse == glm::vec3(0.0f)) return sum;
+    const glm::vec3 n = hit.shadingNormal;
+    const glm::vec3 origin = RayScene::spawnOrigin(hit);
+    for (const WorldLight& light : lights_) {
+      glm::vec3 l;
+      float attenuation = 1.0f;
+      if (light.type == LightType::Directional) {
+        l = -light.direction;
+      } else {
+        const glm::vec3 toLight = light.position - hit.position;
+        const float d2 = std::max(glm::dot(toLight, toLight), kMinLightDistance2);
+        l = toLight / std::sqrt(d2);
+        attenuation = 1.0f / d2;
+        if (light.range > 0.0f) {  // glTF's recommended smooth range window
+          const float r = d2 / (light.range * light.range);
+          attenuation *= std::clamp(1.0f - r * r, 0.0f, 1.0f);
+        }
+        if (light.type == LightType::Spot) {
+          const float cd = glm::dot(light.direction, -l);
+          attenuation *=
+              smoothstep(light.cosOuter, std::max(light.cosInner, light.cosOuter + 1e-4f), cd);
+        }
+      }
+      const float ndl = std::max(glm::dot(n, l), 0.0f);
+      if (!(ndl > 0.0f) || !(attenuation > 0.0f)) continue;
+      if (light.shadows) {
+        const bool blocked = light.type == LightType::Directional
+                                 ? rays_.occluded(origin, l, 0.0f, kInf)
+                                 : rays_.occluded(origin, light.position - origin, 0.0f, 0.9999f);
+        if (blocked) continue;
+      }
+      sum += diffuse / kPi * light.radiance * (attenuation * ndl);
+    }
+    return sum;
+  }
+
+ private:
+  const RayScene& rays_;
+  Environment env_;
+  std::vector<Material> materials_;
+  std::vector<LinearTexture> textures_;
+  std::vector<WorldLight> lights_;
+};
+
+// What a pixel's samples start from: its primary hit and the deterministic light terms.
+struct Primary {
+  bool geometry = false;
+  SurfaceHit hit;
+  SurfaceMaterial material;
+  glm::vec3 base{0.0f};  // Le + direct light from the point/spot/directional lights
+};
+
+glm::vec3 cosineDirection(const glm::vec3& n, Rng& rng) {
+  const float u1 = rng.uniform(), u2 = rng.uniform();
+  return Basis(n).toWorld(cosineHemisphere(u1, u2));
+}
+
+// One sample of the pixel's quantity (before the Alchemy transform).
+glm::vec3 sampleQuantity(const Settings& s, const Shading& shading, const Primary& p, Rng& rng) {
+  const RayScene& rays = shading.rays();
+  const glm::vec3 origin = RayScene::spawnOrigin(p.hit);
+  const glm::vec3 dir = cosineDirection(p.hit.shadingNormal, rng);
+  switch (s.quantity) {
+    case Quantity::AO:
+      return glm::vec3(rays.occluded(origin, dir, 0.0f, s.radius) ? 0.0f : 1.0f);
+    case Quantity::Obscurance: {
+      const float tfar = s.membership == Membership::Exponential ? kInf : s.radius;
+      SurfaceHit h;
+      if (!rays.intersect(origin, dir, 0.0f, tfar, h)) return glm::vec3(1.0f);
+      return glm::vec3(membership(s.membership, h.t, s.radius));
+    }
+    case Quantity::Alchemy: {
+      SurfaceHit h;
+      if (!rays.intersect(origin, dir, 0.0f, s.radius, h)) return glm::vec3(0.0f);
+      return glm::vec3(alchemyFalloff(s.alchemy, h.t));
+    }
+    case Quantity::Direct:
+      if (rays.occluded(origin, dir, 0.0f, kInf)) return p.base;
+      return p.base + p.material.diffuse * shading.environment(dir);
+    case Quantity::DirectIndirect: {
+      SurfaceHit y;
+      if (!rays.intersect(origin, dir, 0.0f, kInf, y))
+        return p.base + p.material.diffuse * shading.environment(dir);
+      // One bounce: the radiance leaving y towards the pixel's point is its emission plus its
+      // direct light (lights with shadow rays, environment by one cosine sample).
+      const SurfaceMaterial my = shading.material(y);
+      glm::vec3 ly = my.emission;
+      if (my.diffuse != glm::vec3(0.0f)) {
+        ly += shading.directLights(y, my.diffuse);
+        const glm::vec3 dir2 = cosineDirection(y.shadingNormal, rng);
+        if (!rays.occluded(RayScene::spawnOrigin(y), dir2, 0.0f, kInf))
+          ly += my.diffuse * shading.environment(dir2);
+      }
+      return p.base + p.material.diffuse * ly;
+    }
+    case Quantity::Depth:
+    case Quantity::Normal:
+      break;
+  }
+  return glm::vec3(0.0f);
+}
+
+template <class F>
+void parallelRows(unsigned threads, uint32_t rows, const F& f) {
+  std::atomic<uint32_t> next{0};
+  auto worker = [&] {
+    for (uint32_t y = next.fetch_add(1); y < rows; y = next.fetch_add(1)) f(y);
+  };
+  std::vector<std::thread> pool;
+  for (unsigned i = 1; i < std::min<unsigned>(threads, rows); ++i) pool.emplace_back(worker);
+  worker();
+  for (std::thread& t : pool) t.join();
+}
+
+void validate(const Settings& s) {
+  if (s.width < 1 || s.height < 1 || s.width > 16384 || s.height > 16384)
+    usage("image size must be 1..16384 pixels per side");
+  const bool needsRadius = s.quantity == Quantity::AO || s.quantity == Quantity::Obscurance ||
+                           s.quantity == Quantity::Alchemy;
+  if (needsRadius && !(s.radius > 0.0f && std::isfinite(s.radius)))
+    usage("radius must be a positive finite number");
+  if (s.spp < 1) usage("samples per pixel must be at least 1");
+  if (!(s.noiseTarget >= 0.0 && std::isfinite(s.noiseTarget)))
+    usage("noise target must be a finite number >= 0");
+  const AlchemyParams& a = s.alchemy;
+  if (!(a.sigma >= 0.0f && std::isfinite(a.sigma)) || !(a.u >= 0.0f && std::isfinite(a.u)) ||
+      !(a.epsilon >= 0.0f && std::isfinite(a.epsilon)) ||
+      !(a.contrast > 0.0f && std::isfinite(a.contrast)))
+    usage("Alchemy parameters must be finite, sigma/u/epsilon >= 0 and contrast > 0");
+}
+
+void setPixel(ImageRGBA32F& img, size_t i, const glm::vec3& v, float a) {
+  img.pixels[i * 4 + 0] = v.x;
+  img.pixels[i * 4 + 1] = v.y;
+  img.pixels[i * 4 + 2] = v.z;
+  img.pixels[i * 4 + 3] = a;
+}
+
+ImageRGBA32F blank(uint32_t w, uint32_t h) {
+  return ImageRGBA32F{int(w), int(h), std::vector<float>(size_t(w) * h * 4, 0.0f)};
+}
+
+}  // namespace
+
+Quantity parseQuantity(const std::string& name) {
+  for (Quantity q : {Quantity::AO, Quantity::Obscurance, Quantity::Alchemy, Quantity::Direct,
+                     Quantity::DirectIndirect, Quantity::Depth, Quantity::Normal})
+    if (name == quantityName(q)) return q;
+  usage("unknown quantity '" + name +
+        "' (ao, obscurance, alchemy, direct, direct+indirect, depth, normal)");
+}
+
+const char* quantityName(Quantity q) {
+  switch (q) {
+    case Quantity::AO:
+      return "ao";
+    case Quantity::Obscurance:
+      return "obscurance";
+    case Quantity::Alchemy:
+      return "alchemy";
+    case Quantity::Direct:
+      return "direct";
+    case Quantity::DirectIndirect:
+      return "direct+indirect";
+    case Quantity::Depth:
+      return "depth";
+    case Quantity::Normal:
+      return "normal";
+  }
+  return "?";
+}
+
+Membership parseMembership(const std::string& name) {
+  for (Membership m : {Membership::Sqrt, Membership::Linear, Membership::Smoothstep,
+                       Membership::Step, Membership::Exponential})
+    if (name == membershipName(m)) return m;
+  usage("unknown membership function '" + name + "' (sqrt, linear, smoothstep, step, exp)");
+}
+
+const char* membershipName(Membership m) {
+  switch (m) {
+    case Membership::Sqrt:
+      return "sqrt";
+    case Membership::Linear:
+      return "linear";
+    case Membership::Smoothstep:
+      return "smoothstep";
+    case Membership::Step:
+      return "step";
+    case Membership::Exponential:
+      return "exp";
+  }
+  return "?";
+}
+
+glm::vec3 environmentRadiance(const Environment& env, const glm::vec3& dir) {
+  const float intensity = std::max(env.intensity, 0.0f);
+  if (env.kind == Environment::Kind::Constant) return env.constantColor * intensity;
+  const float y = std::isfinite(dir.y) ? std::clamp(dir.y, -1.0f, 1.0f) : 0.0f;
+  const glm::vec3 c = y >= 0.0f ? glm::mix(env.horizonColor, env.zenithColor, std::sqrt(y))
+                                : glm::mix(env.horizonColor, env.groundColor, std::sqrt(-y));
+  return c * intensity;
+}
+
+Result render(const Scene& scene, const Settings& settings) {
+  validate(settings);
+  const auto start = std::chrono::steady_clock::now();
+  auto elapsed = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
+  const uint32_t W = settings.width, H = settings.height;
+  const size_t N = size_t(W) * H;
+  const unsigned threads =
+      settings.threads > 0 ? settings.threads : std::max(1u, std::thread::hardware_concurrency());
+
+  RayScene rays(scene);
+  Shading shading(scene, rays);
+  Result result;
+  result.triangles = rays.triangleCount();
+  result.camera = activeCamera(scene, float(W) / float(H));
+  const CameraView& cam = result.camera;
+  // Primary rays in double precision from the same matrices the rasteriser uses.
+  const glm::dmat4 proj(cam.proj), view(cam.view);
+  const glm::dmat4 invProj = glm::inverse(proj), invView = glm::inverse(view);
+  const glm::dvec3 eye(invView[3]);
+  const double znear = cam.znear, zfar = cam.zfar;
+
+  result.value = blank(W, H);
+  result.stdError = blank(W, H);
+  result.depth = blank(W, H);
+  result.normal = blank(W, H);
+  result.position = blank(W, H);
+  std::vector<Primary> primary(N);
+  std::vector<glm::vec3> skyRadiance(N, glm::vec3(0.0f));
+  const bool lighting =
+      settings.quantity == Quantity::Direct || settings.quantity == Quantity::DirectIndirect;
+
+  parallelRows(threads, H, [&](uint32_t y) {
+    for (uint32_t x = 0; x < W; ++x) {
+      const size_t i = size_t(y) * W + x;
+      const glm::dvec2 ndc = glm::dvec2((x + 0.5) / W, (y + 0.5) / H) * 2.0 - 1.0;
+      // The near-plane point (reverse-Z depth 1) through the pixel centre, scaled to view z = -1:
+      // the ray parameter is then the view-space depth, and [znear, zfar] is what is rasterised.
+      glm::dvec4 nearPoint = invProj * glm::dvec4(ndc, 1.0, 1.0);
+      glm::dvec3 dirView = glm::dvec3(nearPoint) / nearPoint.w;
+      dirView /= -dirView.z;
+      const glm::vec3 dirWorld(glm::dmat3(invView) * dirView);
+      skyRadiance[i] = shading.environment(safeNormalize(dirWorld, glm::vec3(0, 0, -1)));
+      Primary& p = primary[i];
+      p.geometry = rays.intersect(glm::vec3(eye), dirWorld, float(znear), float(zfar), p.hit);
+      if (!p.geometry) continue;
+      const glm::dvec4 viewPos = view * glm::dvec4(glm::dvec3(p.hit.position), 1.0);
+      const glm::dvec4 clip = proj * viewPos;
+      const double depth = clip.w != 0.0 ? clip.z / clip.w : 0.0;
+      const float distance = float(glm::length(glm::dvec3(p.hit.position) - eye));
+      setPixel(result.depth, i, glm::vec3(float(depth), float(viewPos.z), distance), 1.0f);
+      setPixel(result.normal, i, glm::vec3(glm::dmat3(view) * glm::dvec3(p.hit.shadingNormal)),
+               1.0f);
+      setPixel(result.position, i, p.hit.position, 1.0f);
+      if (lighting) {
+        p.material = shading.material(p.hit);
+        p.base = p.material.emission + shading.directLights(p.hit, p.material.diffuse);
+      }
+    }
+  });
+  for (const Primary& p : primary) result.geometryPixels += p.geometry ? 1 : 0;
+
+  if (settings.quantity == Quantity::Depth || settings.quantity == Quantity::Normal) {
+    result.value = settings.quantity == Quantity::Depth ? result.depth : result.normal;
+    for (size_t i = 0; i < N; ++i) result.stdError.pixels[i * 4 + 3] = primary[i].geometry;
+    result.spp = 1;
+    result.seconds = elapsed();
+    if (settings.progress) settings.progress({1, 0.0, result.seconds});
+    return result;
+  }
+
+  // Progressive estimation: per-pixel running mean and M2 (Welford) in double, extended in
+  // passes of growing size until the sample budget or the noise target is reached.
+  std::vector<double> mean(N * 3, 0.0), m2(N * 3, 0.0);
+  const bool alchemy = settings.quantity == Quantity::Alchemy;
+  const AlchemyParams& ap = settings.alchemy;
+  uint32_t done = 0;
+  auto finishPixel = [&](size_t i) {
+    // Value and standard error of the pixel after `done` samples.
+    glm::vec3 value, se;
+    for (int c = 0; c < 3; ++c) {
+      const double m = mean[i * 3 + c];
+      const double var = done > 1 ? m2[i * 3 + c] / double(done - 1) : 0.0;
+      double err = std::sqrt(std::max(var, 0.0) / double(done));
+      double v = m;
+      if (alchemy) {
+        const double base = 1.0 - m;
+        v = base > 0.0 ? std::pow(base, double(ap.contrast)) : 0.0;
+        if (ap.contrast != 1.0f)
+          err *= base > 0.0 ? std::min(ap.contrast * std::pow(base, ap.contrast - 1.0), 1e6) : 0.0;
+      }
+      value[c] = std::isfinite(v) ? float(v) : 0.0f;
+      se[c] = std::isfinite(err) ? float(err) : 0.0f;
+    }
+    setPixel(result.value, i, value, 1.0f);
+    setPixel(result.stdError, i, se, 1.0f);
+    return (double(se.x) + se.y + se.z) / 3.0;
+  };
+
+  uint32_t target = std::min(settings.spp, std::max(settings.minSpp, 1u));
+  while (true) {
+    const uint32_t from = done, to = target;
+    parallelRows(threads, H, [&](uint32_t y) {
+      for (uint32_t x = 0; x < W; ++x) {
+        const size_t i = size_t(y) * W + x;
+        const Primary& p = primary[i];
+        if (!p.geometry) continue;
+        for (uint32_t s = from; s < to; ++s) {
+          Rng rng = Rng::forSample(settings.seed, i, s);
+          glm::vec3 v = sampleQuantity(settings, shading, p, rng);
+          if (!finite(v)) v = glm::vec3(0.0f);  // guard: never let a NaN into the estimate
+          const double n = double(s) + 1.0;
+          for (int c = 0; c < 3; ++c) {
+            const double d = double(v[c]) - mean[i * 3 + c];
+            mean[i * 3 + c] += d / n;
+            m2[i * 3 + c] += d * (double(v[c]) - mean[i * 3 + c]);
+          }
+        }
+      }
+    });
+    done = to;
+    double sumError = 0.0;
+    for (size_t i = 0; i < N; ++i)
+      if (primary[i].geometry) sumError += finishPixel(i);
+    result.meanStdError = result.geometryPixels > 0 ? sumError / double(result.geometryPixels) : 0;
+    if (settings.progress) settings.progress({done, result.meanStdError, elapsed()});
+    if (done >= settings.spp) break;
+    if (settings.noiseTarget > 0.0 && done >= 2 && result.meanStdError <= settings.noiseTarget)
+      break;
+    if (result.geometryPixels == 0) break;
+    target = std::min<uint32_t>(settings.spp, done + std::max(done / 2, 1u));
+  }
+
+  // Sky pixels: fully open for the occlusion quantities, the environment for lighting.
+  for (size_t i = 0; i < N; ++i) {
+    if (primary[i].geometry) continue;
+    setPixel(result.value, i, lighting ? finiteOrZero(skyRadiance[i]) : glm::vec3(1.0f), 0.0f);
+    setPixel(result.stdError, i, glm::vec3(0.0f), 0.0f);
+  }
+  result.spp = done;
+  result.seconds = elapsed();
+  return result;
+}
+
+ImageRGBA8 preview(const ImageRGBA32F& value, Quantity q, float exposure) {
+  ImageRGBA8 out{value.width, value.height, std::vector<uint8_t>(value.pixels.size(), 255)};
+  auto aces = [](float x) {
+    return std::clamp((x * (2.51f * x + 0.03f)) / (x * (2.43f * x + 0.59f) + 0.14f), 0.0f, 1.0f);
+  };
+  auto srgb = [](float c) {
+    return c > 0.0031308f ? 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f : c * 12.92f;
+  };
+  const bool tonemap = q == Quantity::Direct || q == Quantity::DirectIndirect;
+  for (size_t i = 0; i + 3 < value.pixels.size(); i += 4) {
+    for (int c = 0; c < 3; ++c) {
+      float v = q == Quantity::Depth ? value.pixels[i] : value.pixels[i + c];
+      if (!std::isfinite(v)) v = 0.0f;
+      if (tonemap) v = srgb(aces(std::max(v * exposure, 0.0f)));
+      if (q == Quantity::Normal) v = v * 0.5f + 0.5f;
+      out.pixels[i + c] = uint8_t(std::clamp(v, 0.0f, 1.0f) * 255.0f + 0.5f);
+    }
+  }
+  return out;
+}
+
+}  // namespace gi::reference
