@@ -250,6 +250,18 @@ glm::vec3 RayScene::spawnOrigin(const SurfaceHit& hit) {
   return hit.position + offsetDistance(hit) * hit.geometricNormal;
 }
 
+std::vector<WorldTriangle> RayScene::triangles(
+    const std::function<bool(uint32_t material)>& keep) const {
+  std::vector<WorldTriangle> out;
+  for (const auto& inst : impl_->instances) {
+    if (!keep(inst->material)) continue;
+    for (size_t t = 0; t + 2 < inst->indices.size(); t += 3)
+      out.push_back({inst->positions[inst->indices[t]], inst->positions[inst->indices[t + 1]],
+                     inst->positions[inst->indices[t + 2]], inst->material});
+  }
+  return out;
+}
+
 size_t RayScene::triangleCount() const {
   return impl_->triangles;
 }

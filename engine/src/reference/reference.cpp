@@ -88,6 +88,15 @@ struct WorldLight {
   bool shadows = true;
 };
 
+// An emissive triangle, sampled for next-event estimation in the bounce.
+struct Emitter {
+  glm::vec3 p0{0.0f}, e1{0.0f}, e2{0.0f}, normal{0.0f, 1.0f, 0.0f}, emission{0.0f};
+};
+
+float luminance(const glm::vec3& c) {
+  return (c.x + c.y + c.z) / 3.0f;
+}
+
 struct SurfaceMaterial {
   glm::vec3 diffuse{0.0f};  // albedo * (1 - metallic): the Lambert colour (BRDF = diffuse / pi)
   glm::vec3 emission{0.0f};
@@ -115,6 +124,26 @@ class Shading {
       w.shadows = l.castsShadows;
       if (!finite(w.position) || !finite(w.radiance)) continue;
       lights_.push_back(w);
+    }
+    // Emissive triangles, chosen with probability proportional to area * luminance(Le).
+    auto emission = [&](uint32_t m) {
+      const glm::vec3 e = materials_[std::min<size_t>(m, materials_.size() - 1)].emission;
+      return finite(e) ? glm::max(e, glm::vec3(0.0f)) : glm::vec3(0.0f);
+    };
+    for (const WorldTriangle& t :
+         rays.triangles([&](uint32_t m) { return luminance(emission(m)) > 0.0f; })) {
+      Emitter e;
+      e.p0 = t.p0;
+      e.e1 = t.p1 - t.p0;
+      e.e2 = t.p2 - t.p0;
+      const glm::vec3 c = glm::cross(e.e1, e.e2);
+      const float area = 0.5f * glm::length(c);
+      if (!(area > 0.0f) || !std::isfinite(area)) continue;
+      e.normal = c / (2.0f * area);
+      e.emission = emission(t.material);
+      emitterPower_ += double(area) * luminance(e.emission);
+      emitterCdf_.push_back(emitterPower_);
+      emitters_.push_back(e);
     }
   }
 
@@ -172,12 +201,59 @@ class Shading {
     return sum;
   }
 
+  // Light-sampling density (per unit area) of a point on an emitter of radiance `le`.
+  double emitterAreaPdf(const glm::vec3& le) const {
+    return emitterPower_ > 0.0 ? luminance(le) / emitterPower_ : 0.0;
+  }
+
+  // MIS weight (balance heuristic) of the cosine-sampled direction `dir` from `x` that hit the
+  // emitter point `y`, against light sampling of the emitters.
+  float bsdfWeight(const SurfaceHit& x, const glm::vec3& dir, const SurfaceHit& y,
+                   const glm::vec3& le) const {
+    const double pArea = emitterAreaPdf(le);
+    if (pArea <= 0.0) return 1.0f;
+    const double cosY = std::abs(glm::dot(y.geometricNormal, dir));
+    const double pBsdf = std::max(0.0f, glm::dot(x.shadingNormal, dir)) / kPi;
+    if (cosY <= 0.0) return 1.0f;
+    const double pLight = pArea * double(y.t) * y.t / cosY;
+    return float(pBsdf / (pBsdf + pLight));
+  }
+
+  // Next-event estimation of the light the emissive surfaces send to `x` directly (two-sided
+  // emitters, shadow ray), MIS-weighted against the cosine-sampled bounce: returns
+  // Le cos_x / pi / (p_light + p_bsdf), to be multiplied by the diffuse colour.
+  glm::vec3 sampleEmitters(const SurfaceHit& x, Rng& rng) const {
+    if (emitters_.empty()) return glm::vec3(0.0f);
+    const double u = double(rng.uniform()) * emitterPower_;
+    const size_t k = std::min<size_t>(
+        size_t(std::upper_bound(emitterCdf_.begin(), emitterCdf_.end(), u) - emitterCdf_.begin()),
+        emitters_.size() - 1);
+    const Emitter& e = emitters_[k];
+    const float su = std::sqrt(rng.uniform()), v = rng.uniform();
+    const glm::vec3 point = e.p0 + su * (1.0f - v) * e.e1 + su * v * e.e2;
+    const glm::vec3 w = point - x.position;
+    const float d2 = glm::dot(w, w);
+    if (!(d2 > 0.0f) || !std::isfinite(d2)) return glm::vec3(0.0f);
+    const glm::vec3 wn = w / std::sqrt(d2);
+    const float cosX = glm::dot(x.shadingNormal, wn);
+    const float cosY = std::abs(glm::dot(e.normal, wn));
+    if (!(cosX > 0.0f) || !(cosY > 0.0f)) return glm::vec3(0.0f);
+    const glm::vec3 origin = RayScene::spawnOrigin(x);
+    if (rays_.occluded(origin, point - origin, 0.0f, 0.9999f)) return glm::vec3(0.0f);
+    const double pLight = emitterAreaPdf(e.emission) * d2 / cosY;
+    const double pBsdf = cosX / kPi;
+    return e.emission * float((cosX / kPi) / (pLight + pBsdf));
+  }
+
  private:
   const RayScene& rays_;
   Environment env_;
   std::vector<Material> materials_;
   std::vector<LinearTexture> textures_;
   std::vector<WorldLight> lights_;
+  std::vector<Emitter> emitters_;
+  std::vector<double> emitterCdf_;  // running sum of area * luminance
+  double emitterPower_ = 0.0;
 };
 
 // What a pixel's samples start from: its primary hit and the deterministic light terms.
@@ -216,20 +292,27 @@ glm::vec3 sampleQuantity(const Settings& s, const Shading& shading, const Primar
       if (rays.occluded(origin, dir, 0.0f, kInf)) return p.base;
       return p.base + p.material.diffuse * shading.environment(dir);
     case Quantity::DirectIndirect: {
+      // Light from emissive surfaces: sampled on the emitters and, below, by the cosine-
+      // sampled bounce, combined by multiple importance sampling (balance heuristic).
+      const glm::vec3 emitted = p.material.diffuse == glm::vec3(0.0f)
+                                    ? glm::vec3(0.0f)
+                                    : p.material.diffuse * shading.sampleEmitters(p.hit, rng);
       SurfaceHit y;
       if (!rays.intersect(origin, dir, 0.0f, kInf, y))
-        return p.base + p.material.diffuse * shading.environment(dir);
+        return p.base + emitted + p.material.diffuse * shading.environment(dir);
       // One bounce: the radiance leaving y towards the pixel's point is its emission plus its
       // direct light (lights with shadow rays, environment by one cosine sample).
       const SurfaceMaterial my = shading.material(y);
-      glm::vec3 ly = my.emission;
+      glm::vec3 ly(0.0f);
+      if (my.emission != glm::vec3(0.0f))
+        ly += my.emission * shading.bsdfWeight(p.hit, dir, y, my.emission);
       if (my.diffuse != glm::vec3(0.0f)) {
         ly += shading.directLights(y, my.diffuse);
         const glm::vec3 dir2 = cosineDirection(y.shadingNormal, rng);
         if (!rays.occluded(RayScene::spawnOrigin(y), dir2, 0.0f, kInf))
           ly += my.diffuse * shading.environment(dir2);
       }
-      return p.base + p.material.diffuse * ly;
+      return p.base + emitted + p.material.diffuse * ly;
     }
     case Quantity::Depth:
     case Quantity::Normal:

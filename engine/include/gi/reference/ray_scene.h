@@ -5,7 +5,9 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -23,6 +25,11 @@ struct SurfaceHit {
   float offsetScale = 0.0f;  // scale of the surface's coordinates, for offsetting new rays
   int node = -1, mesh = -1;
   uint32_t triangle = 0;  // index of the triangle within its mesh
+};
+
+struct WorldTriangle {
+  glm::vec3 p0{0.0f}, p1{0.0f}, p2{0.0f};  // world space, as intersected
+  uint32_t material = 0;
 };
 
 class RayScene {
@@ -49,6 +56,9 @@ class RayScene {
   // The offset used by spawnOrigin: a fixed number of float ulps of the largest coordinate
   // involved (the hit position and its triangle's vertices), so it scales with the scene.
   static float offsetDistance(const SurfaceHit& hit);
+
+  // The triangles (world space) whose material satisfies `keep`, e.g. the emitters.
+  std::vector<WorldTriangle> triangles(const std::function<bool(uint32_t material)>& keep) const;
 
   size_t triangleCount() const;
   glm::vec3 boundsMin() const;

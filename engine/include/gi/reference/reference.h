@@ -24,10 +24,15 @@
 //  - DirectIndirect: Direct + one diffuse bounce: (rho/pi) int L_1(y(w)) cos dw over the
 //    directions that hit a surface y, where L_1(y) = Le(y) + Direct-without-Le at y, i.e.
 //    emissive surfaces count as light sources here (only here: Direct ignores them as lights).
+//    Emitters are two-sided, like the rasteriser's surfaces.
 //  - Depth, Normal: the primary hit (deterministic, one sample).
 //
 // Estimators: i.i.d. cosine-weighted directions (pdf cos/pi), one per sample; each sample
-// reuses the pixel's deterministic light terms. Each sample's random numbers come from
+// reuses the pixel's deterministic light terms. The light of emissive surfaces in
+// DirectIndirect is estimated both by that direction and by a point sampled on the emitters
+// (triangle chosen by area * luminance, uniform on it, shadow ray), combined by multiple
+// importance sampling with the balance heuristic: small bright emitters converge fast, and
+// points very close to an emitter do not blow up. Each sample's random numbers come from
 // (seed, pixel, sample index) only, so an image is identical for any thread count. The
 // standard error is sqrt(s^2 / n) from the per-pixel sample variance s^2 (Welford, double).
 // A pixel whose samples are all equal reports 0 even if its expectation lies between (e.g.
