@@ -1,6 +1,7 @@
 #include "process.h"
 
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <array>
 #include <cstdio>
@@ -21,7 +22,8 @@ ProcessResult runCommand(const std::string& commandLine) {
 }
 
 std::string makeTempDir(const std::string& name) {
-  auto dir = std::filesystem::temp_directory_path() / ("gi-test-" + name);
+  // Per process, so test cases that ctest runs in parallel never share (or delete) a folder.
+  auto dir = std::filesystem::temp_directory_path() / ("gi-test-" + std::to_string(getpid()) + "-" + name);
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir.string();
