@@ -655,10 +655,12 @@ TEST(ReferenceDepth, PrimaryHitsFollowTheVulkanConventions) {
     const float* n = &r.normal.pixels[i * 4];
     if (d[3] == 0.0f) {
       EXPECT_EQ(d[0], 0.0f);
+      EXPECT_EQ(d[2], 0.0f);
       EXPECT_EQ(n[3], 0.0f);
       continue;
     }
     ++plane;
+    EXPECT_EQ(d[2], 1.0f);  // the sky mask
     EXPECT_NEAR(d[1], -5.0f, 5e-6f);
     EXPECT_NEAR(d[0], clip.z / clip.w, 1e-7f);
     EXPECT_NEAR(n[2], 1.0f, 1e-6f);

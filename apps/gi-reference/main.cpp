@@ -39,7 +39,8 @@ const char* kUsage =
     "  --out FILE.pfm         the estimate (float RGB)\n"
     "  --stderr-out FILE.pfm  per-pixel standard error (default: <out>.stderr.pfm)\n"
     "  --png FILE.png         8-bit preview (grey for AO-like quantities, tonemapped light)\n"
-    "  --gbuffer PREFIX       also write PREFIX_depth.pfm (reverse-Z depth, view z, distance),\n"
+    "  --gbuffer PREFIX       also write PREFIX_depth.pfm (reverse-Z depth, view z, 1 on "
+    "geometry),\n"
     "                         PREFIX_normal.pfm (view space), PREFIX_position.pfm (world)\n"
     "  --exposure E           preview exposure for the lighting quantities (default 1)\n"
     "  --quiet                no progress lines\n";

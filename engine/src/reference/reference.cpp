@@ -473,8 +473,7 @@ Result render(const Scene& scene, const Settings& settings) {
       const glm::dvec4 viewPos = view * glm::dvec4(glm::dvec3(p.hit.position), 1.0);
       const glm::dvec4 clip = proj * viewPos;
       const double depth = clip.w != 0.0 ? clip.z / clip.w : 0.0;
-      const float distance = float(glm::length(glm::dvec3(p.hit.position) - eye));
-      setPixel(result.depth, i, glm::vec3(float(depth), float(viewPos.z), distance), 1.0f);
+      setPixel(result.depth, i, glm::vec3(float(depth), float(viewPos.z), 1.0f), 1.0f);
       setPixel(result.normal, i, glm::vec3(glm::dmat3(view) * glm::dvec3(p.hit.shadingNormal)),
                1.0f);
       setPixel(result.position, i, p.hit.position, 1.0f);

@@ -108,8 +108,8 @@ struct Result {
   ImageRGBA32F stdError;  // per-pixel standard error of `value` (rgb), alpha as in value
   // The primary hits, in the Vulkan renderer's conventions (all 0 on sky pixels):
   ImageRGBA32F depth;     // r: reverse-Z NDC depth (1 near, 0 far; 0 = sky, the clear value),
-                          // g: view-space z (negative in front of the camera), b: ray distance,
-                          // a: 1 on geometry, 0 on sky (the sky mask)
+                          // g: view-space z (negative in front of the camera), b: 1 on geometry,
+                          // 0 on sky (the sky mask, kept in 3-channel PFM files), a: same
   ImageRGBA32F normal;    // view-space normal facing the camera (the G-buffer's), a: mask
   ImageRGBA32F position;  // world-space position, a: mask
   CameraView camera;
