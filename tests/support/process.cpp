@@ -23,7 +23,8 @@ ProcessResult runCommand(const std::string& commandLine) {
 
 std::string makeTempDir(const std::string& name) {
   // Per process, so test cases that ctest runs in parallel never share (or delete) a folder.
-  auto dir = std::filesystem::temp_directory_path() / ("gi-test-" + std::to_string(getpid()) + "-" + name);
+  auto dir =
+      std::filesystem::temp_directory_path() / ("gi-test-" + std::to_string(getpid()) + "-" + name);
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir.string();
