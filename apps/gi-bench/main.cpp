@@ -1,0 +1,839 @@
+// gi-bench: what accuracy costs in time. Sweeps scenes x effects x presets x parameter grids,
+// renders each configuration for a few frames (median GPU time per pass from timestamp
+// queries), compares the effect's output with the CPU ray-traced reference (gi::reference,
+// cached on disk) by NRMSE and SSIM, and writes results.csv/json, report.md and SVG plots.
+// --calibrate measures this device and writes a preset whose sample counts are the most
+// accurate that fit a frame budget.
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "bench.h"
+#include "gi/effect_config.h"
+#include "gi/errors.h"
+#include "gi/image_io.h"
+#include "gi/reference/reference.h"
+#include "gi/renderer.h"
+#include "gi/scene_io.h"
+#include "gi/vk/context.h"
+#include "metrics.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+namespace ref = gi::reference;
+using gi::bench::Row;
+
+const char* kUsage =
+    "usage: gi-bench --out DIR [--scenes A,B] [--effects E1,E2+E3,none] [--presets P1,none]\n"
+    "                [--grid EFFECT.KEY=V1,V2,...]... [options]\n"
+    "       gi-bench --quick --out DIR                  (CI smoke sweep, a few seconds)\n"
+    "       gi-bench --calibrate --budget-ms B --width W --height H [--scene S]\n"
+    "                [--effects E] --out PRESET.json\n"
+    "  --scenes A,B          scenes (JSON, model files or 'default'; default: default)\n"
+    "  --effects A,B+C,none  effect sets to sweep, one per comma; '+' runs effects together,\n"
+    "                        'none' is the engine alone (default: ssao when found, else none)\n"
+    "  --presets P,none      quality presets (names or files; 'none': effect defaults)\n"
+    "  --grid E.K=V1,V2      sweep one setting; several --grid flags form a cartesian product\n"
+    "  --frames K            frames measured per configuration, after one warm-up (default 5)\n"
+    "  --width W --height H  resolution (default 320x240)\n"
+    "  --ref-spp N           reference samples per pixel (default 256)\n"
+    "  --ref-seed N          reference seed (default 1)\n"
+    "  --cache DIR           reference cache (default <bin>/../bench-cache)\n"
+    "  --budget-ms B         --calibrate: frame budget (GPU ms, all passes)\n"
+    "  --headroom F          --calibrate: keep the measured time under (1 - F) * budget (0.1)\n"
+    "  --no-progress         no progress lines on stderr\n"
+    "  --validation          Vulkan validation layers (also GI_VALIDATION=1)\n"
+    "  --device NAME         Vulkan device by name or index (also GI_DEVICE)\n"
+    "Comparison table (by effect name): ssao, hbao, sao, alchemy -> its 'ao' resource vs\n"
+    "reference AO of the effect's 'radius'; ssdo, radiosity, instant_radiosity, ambient_transfer\n"
+    "-> the lit image vs reference direct+indirect; anything else (and none) -> the lit image vs\n"
+    "reference direct. Sky pixels (reference sky mask or G-buffer depth 0) are excluded.\n";
+
+struct Options {
+  std::string out, cache, device;
+  std::vector<std::string> scenes{"default"}, presets{"none"}, grids;
+  std::optional<std::vector<std::string>> effects;
+  uint32_t width = 320, height = 240, refSpp = 256;
+  uint64_t refSeed = 1;
+  int frames = 5;
+  bool quick = false, calibrate = false, progress = true, validation = false;
+  double budgetMs = 0.0, headroom = 0.1;
+  bool sizeGiven = false, framesGiven = false, sppGiven = false;
+  std::string commandLine;
+};
+
+[[noreturn]] void usageError(const std::string& where, const std::string& message) {
+  throw gi::Error(gi::ErrorKind::Usage, where, message + " (see gi-bench --help)");
+}
+
+double parseNumber(const std::string& flag, const char* text, double lo, double hi) {
+  char* end = nullptr;
+  const double v = std::strtod(text, &end);
+  if (end == text || *end != '\0' || !(v >= lo && v <= hi))
+    usageError(flag, "expects a number in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+                         "], got '" + text + "'");
+  return v;
+}
+
+std::vector<std::string> splitList(const std::string& text) {
+  std::vector<std::string> out;
+  std::string item;
+  std::istringstream in(text);
+  while (std::getline(in, item, ','))
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+Options parseArgs(int argc, char** argv) {
+  Options o;
+  o.validation = gi::vk::ContextOptions::fromEnvironment().validation;
+  for (int i = 0; i < argc; ++i) o.commandLine += (i ? " " : "") + std::string(argv[i]);
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto value = [&]() -> const char* {
+      if (i + 1 >= argc) usageError(a, "needs a value");
+      return argv[++i];
+    };
+    if (a == "--help" || a == "-h") {
+      std::fputs(kUsage, stdout);
+      std::exit(0);
+    } else if (a == "--out")
+      o.out = value();
+    else if (a == "--scenes" || a == "--scene")
+      o.scenes = splitList(value());
+    else if (a == "--effects")
+      o.effects = splitList(value());
+    else if (a == "--presets" || a == "--preset")
+      o.presets = splitList(value());
+    else if (a == "--grid")
+      o.grids.push_back(value());
+    else if (a == "--frames") {
+      o.frames = int(parseNumber(a, value(), 1, 10000));
+      o.framesGiven = true;
+    } else if (a == "--width") {
+      o.width = uint32_t(parseNumber(a, value(), 1, 16384));
+      o.sizeGiven = true;
+    } else if (a == "--height") {
+      o.height = uint32_t(parseNumber(a, value(), 1, 16384));
+      o.sizeGiven = true;
+    } else if (a == "--ref-spp") {
+      o.refSpp = uint32_t(parseNumber(a, value(), 1, 1 << 20));
+      o.sppGiven = true;
+    } else if (a == "--ref-seed")
+      o.refSeed = uint64_t(parseNumber(a, value(), 0, 1e15));
+    else if (a == "--cache")
+      o.cache = value();
+    else if (a == "--budget-ms")
+      o.budgetMs = parseNumber(a, value(), 1e-6, 1e7);
+    else if (a == "--headroom")
+      o.headroom = parseNumber(a, value(), 0, 0.9);
+    else if (a == "--quick")
+      o.quick = true;
+    else if (a == "--calibrate")
+      o.calibrate = true;
+    else if (a == "--no-progress")
+      o.progress = false;
+    else if (a == "--validation")
+      o.validation = true;
+    else if (a == "--device")
+      o.device = value();
+    else
+      usageError("", "unknown argument '" + a + "'");
+  }
+  if (o.out.empty()) usageError("", "--out is required");
+  if (o.scenes.empty()) usageError("--scenes", "no scene given");
+  if (o.presets.empty()) usageError("--presets", "no preset given");
+  if (o.calibrate) {
+    if (!(o.budgetMs > 0)) usageError("--calibrate", "needs --budget-ms");
+    if (fs::path(o.out).extension() != ".json")
+      usageError(o.out, "--calibrate writes a preset: --out must end in .json");
+  }
+  if (o.quick) {
+    if (!o.sizeGiven) o.width = 64, o.height = 48;
+    if (!o.framesGiven) o.frames = 2;
+    if (!o.sppGiven) o.refSpp = 16;
+  }
+  if (o.cache.empty()) {
+    std::error_code ec;
+    const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+    o.cache = ec ? "bench-cache" : (exe.parent_path().parent_path() / "bench-cache").string();
+  }
+  return o;
+}
+
+// ---- What an effect is compared with -------------------------------------------------------
+
+struct Comparison {
+  std::string resource = gi::resources::kLit;  // what the frame is read at
+  ref::Quantity quantity = ref::Quantity::Direct;
+  float radius = 0.0f;  // AO radius (from the effect's "radius" setting)
+  std::string effect;   // the effect that decided it ("" for the engine)
+};
+
+bool isAoEffect(const std::string& n) {
+  return n == "ssao" || n == "hbao" || n == "sao" || n == "alchemy";
+}
+bool isIndirectEffect(const std::string& n) {
+  return n == "ssdo" || n == "radiosity" || n == "instant_radiosity" || n == "ambient_transfer";
+}
+
+Comparison comparisonFor(const std::vector<gi::EffectConfig>& effects) {
+  Comparison c;
+  for (const auto& e : effects)
+    if (isAoEffect(e.name)) {
+      c.resource = gi::resources::kAO;
+      c.quantity = ref::Quantity::AO;
+      c.effect = e.name;
+      bool hasRadius = false;
+      for (const auto& d : e.settings.descs()) hasRadius |= d.name == "radius";
+      c.radius = hasRadius ? float(e.settings.number("radius")) : 0.5f;
+      return c;
+    }
+  for (const auto& e : effects)
+    if (isIndirectEffect(e.name)) {
+      c.quantity = ref::Quantity::DirectIndirect;
+      c.effect = e.name;
+    }
+  return c;
+}
+
+std::string referenceLabel(const Comparison& c, uint32_t spp) {
+  std::string s = ref::quantityName(c.quantity);
+  if (c.quantity == ref::Quantity::AO) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, " r=%g", double(c.radius));
+    s += buf;
+  }
+  return s + " spp=" + std::to_string(spp);
+}
+
+// ---- Reference cache -------------------------------------------------------------------------
+
+uint64_t fnv1a(const std::string& s, uint64_t h = 1469598103934665603ULL) {
+  for (unsigned char c : s) h = (h ^ c) * 1099511628211ULL;
+  return h;
+}
+
+struct Reference {
+  gi::ImageRGBA32F value, depth;
+  uint32_t spp = 0;
+  double meanStdError = 0.0, seconds = 0.0;
+  bool cached = false;
+};
+
+struct ReferenceKey {
+  size_t scene = 0;
+  ref::Quantity quantity = ref::Quantity::Direct;
+  float radius = 0.0f;
+  bool operator<(const ReferenceKey& o) const {
+    return std::tie(scene, quantity, radius) < std::tie(o.scene, o.quantity, o.radius);
+  }
+};
+
+struct LoadedScene {
+  std::string name;  // as given
+  gi::Scene scene;
+  std::string contents;  // file bytes ("default" for the built-in scene)
+};
+
+std::string cacheStem(const Options& o, const LoadedScene& s, const ReferenceKey& k) {
+  std::ostringstream key;
+  key << "gi-bench-reference-v1|" << s.contents.size() << '|';
+  const gi::CameraView cam = gi::activeCamera(s.scene, float(o.width) / float(o.height));
+  const float* v = &cam.view[0][0];
+  const float* p = &cam.proj[0][0];
+  char buf[32];
+  for (int i = 0; i < 16; ++i) {
+    std::snprintf(buf, sizeof buf, "%a,%a,", double(v[i]), double(p[i]));
+    key << buf;
+  }
+  std::snprintf(buf, sizeof buf, "%a", double(k.radius));
+  key << '|' << o.width << 'x' << o.height << '|' << ref::quantityName(k.quantity) << '|' << buf
+      << '|' << o.refSpp << '|' << o.refSeed << '|' << s.scene.triangleCount();
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx",
+                static_cast<unsigned long long>(fnv1a(s.contents, fnv1a(key.str()))));
+  return (fs::path(o.cache) / hex).string();
+}
+
+Reference computeReference(const Options& o, const LoadedScene& s, const ReferenceKey& k) {
+  const std::string stem = cacheStem(o, s, k);
+  Reference r;
+  if (fs::exists(stem + ".json")) {
+    try {
+      std::ifstream in(stem + ".json");
+      const nlohmann::json meta = nlohmann::json::parse(in);
+      r.value = gi::readPfm(stem + ".value.pfm");
+      r.depth = gi::readPfm(stem + ".depth.pfm");
+      r.spp = meta.at("spp");
+      r.meanStdError = meta.at("mean_stderr");
+      r.seconds = meta.at("seconds");
+      r.cached = true;
+      if (r.value.width == int(o.width) && r.value.height == int(o.height)) return r;
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "gi-bench: warning: %s: unreadable cache entry, recomputing (%s)\n",
+                   stem.c_str(), e.what());
+    }
+  }
+  ref::Settings rs;
+  rs.width = o.width;
+  rs.height = o.height;
+  rs.quantity = k.quantity;
+  rs.radius = k.quantity == ref::Quantity::AO ? k.radius : 0.5f;
+  rs.spp = o.refSpp;
+  rs.minSpp = std::min(rs.minSpp, o.refSpp);
+  rs.seed = o.refSeed;
+  ref::Result res = ref::render(s.scene, rs);
+  r = Reference{res.value, res.depth, res.spp, res.meanStdError, res.seconds, false};
+  fs::create_directories(o.cache);
+  // The metadata is written last: its presence marks a complete entry.
+  gi::writePfm(stem + ".value.pfm", r.value);
+  gi::writePfm(stem + ".depth.pfm", r.depth);
+  nlohmann::json meta = {{"scene", s.name},     {"quantity", ref::quantityName(k.quantity)},
+                         {"radius", k.radius},  {"width", o.width},
+                         {"height", o.height},  {"spp", r.spp},
+                         {"seed", o.refSeed},   {"mean_stderr", r.meanStdError},
+                         {"seconds", r.seconds}};
+  gi::bench::writeFileAtomic(stem + ".json", meta.dump(2) + "\n");
+  return r;
+}
+
+// ---- Progress ---------------------------------------------------------------------------------
+
+class ProgressBar {
+ public:
+  ProgressBar(bool enabled, std::string what, size_t total)
+      : enabled_(enabled && total > 0),
+        tty_(isatty(STDERR_FILENO) != 0),
+        what_(std::move(what)),
+        total_(total),
+        start_(std::chrono::steady_clock::now()) {}
+  void step(const std::string& label) {
+    ++done_;
+    if (!enabled_) return;
+    const double elapsed =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    const double eta = elapsed / double(done_) * double(total_ - done_);
+    const int width = 30, filled = int(double(width) * double(done_) / double(total_));
+    if (tty_) {
+      std::fprintf(stderr, "\r%s [%s%s] %zu/%zu  %.0fs elapsed, ETA %.0fs  %-40.40s", what_.c_str(),
+                   std::string(size_t(filled), '#').c_str(),
+                   std::string(size_t(width - filled), '.').c_str(), done_, total_, elapsed, eta,
+                   label.c_str());
+      if (done_ == total_) std::fputc('\n', stderr);
+    } else {
+      std::fprintf(stderr, "gi-bench: %s %zu/%zu (%s) %.1fs elapsed, ETA %.0fs\n", what_.c_str(),
+                   done_, total_, label.c_str(), elapsed, eta);
+    }
+    std::fflush(stderr);
+  }
+
+ private:
+  bool enabled_, tty_;
+  std::string what_;
+  size_t total_, done_ = 0;
+  std::chrono::steady_clock::time_point start_;
+};
+
+// ---- Configurations -----------------------------------------------------------------------------
+
+struct Grid {
+  std::string effect, key;  // "ssao", "samples"
+  std::vector<std::string> values;
+};
+
+struct Config {
+  size_t scene = 0;
+  std::vector<std::string> effectSet;
+  std::string effectLabel, preset, params, series, gridKey;
+  double gridValue = 0.0;
+  const gi::Preset* presetPtr = nullptr;
+  std::vector<gi::EffectConfig> effects;
+  Comparison comparison;
+};
+
+std::vector<std::string> splitPlus(const std::string& item) {
+  if (item == "none") return {};
+  std::vector<std::string> out;
+  std::string part;
+  std::istringstream in(item);
+  while (std::getline(in, part, '+'))
+    if (!part.empty()) out.push_back(part);
+  return out;
+}
+
+std::string knownEffects(const gi::EffectRegistry& registry) {
+  std::string s;
+  for (const auto& n : registry.names()) s += (s.empty() ? "" : ", ") + n;
+  return s.empty() ? "none found" : s;
+}
+
+// ---- Measuring one configuration
+// -----------------------------------------------------------------
+
+bool isEnginePass(const std::string& n) {
+  return n == "gbuffer" || n == "lighting" || n == "tonemap" || n == "floor" || n == "skinning";
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+}
+
+struct Measurement {
+  std::vector<std::pair<std::string, double>> passes;
+  double totalMs = 0.0, effectMs = 0.0, floorMs = 0.0, wallMs = 0.0;
+  gi::bench::Metrics metrics;
+};
+
+Measurement measure(gi::vk::Context& ctx, const gi::EffectRegistry& registry,
+                    const gi::Scene& scene, const std::vector<gi::EffectConfig>& effects,
+                    const Options& o, bool floorPass, const Comparison& cmp,
+                    const Reference& reference) {
+  gi::RenderSettings settings;
+  settings.width = o.width;
+  settings.height = o.height;
+  settings.floorPass = floorPass;
+  settings.effects = effects;
+  gi::Renderer renderer(ctx, scene, settings, &registry);
+  renderer.renderFrame();  // warm-up: first-use costs stay out of the medians
+  std::map<std::string, std::vector<double>> samples;
+  std::vector<double> wall;
+  for (int f = 0; f < o.frames; ++f) {
+    const auto t0 = std::chrono::steady_clock::now();
+    renderer.renderFrame();
+    wall.push_back(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    for (const auto& t : renderer.lastTimings()) samples[t.name].push_back(t.ms);
+  }
+  Measurement m;
+  m.wallMs = median(wall);
+  for (const std::string& name : renderer.passNames()) {
+    const double ms = median(samples[name]);
+    m.passes.emplace_back(name, ms);
+    if (name == "floor") {
+      m.floorMs = ms;
+      continue;
+    }
+    m.totalMs += ms;
+    if (!isEnginePass(name)) m.effectMs += ms;
+  }
+  // Error against the reference, over pixels that are geometry in both.
+  const gi::ImageRGBA32F out = renderer.readTarget(cmp.resource);
+  const gi::ImageRGBA32F depth = renderer.readTarget(gi::resources::kDepth);
+  const size_t n = size_t(o.width) * size_t(o.height);
+  std::vector<unsigned char> mask(n);
+  for (size_t i = 0; i < n; ++i)
+    mask[i] = reference.depth.pixels[i * 4 + 2] > 0.5f && depth.pixels[i * 4] > 0.0f;
+  const int w = int(o.width), h = int(o.height);
+  if (cmp.quantity == ref::Quantity::AO) {
+    m.metrics = gi::bench::compare(gi::bench::channel(w, h, out.pixels, 0),
+                                   gi::bench::channel(w, h, reference.value.pixels, 0), mask);
+  } else {
+    const gi::bench::Plane test = gi::bench::channel(w, h, out.pixels, -1);
+    const gi::bench::Plane truth = gi::bench::channel(w, h, reference.value.pixels, -1);
+    m.metrics = gi::bench::compare(test, truth, mask);
+    m.metrics.ssim =
+        gi::bench::ssim(gi::bench::reinhard(test), gi::bench::reinhard(truth), mask, 1.0);
+  }
+  return m;
+}
+
+std::string formatDouble(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+std::string nowString() {
+  const std::time_t t = std::time(nullptr);
+  char buf[64];
+  std::strftime(buf, sizeof buf, "%Y-%m-%d %H:%M:%S UTC", std::gmtime(&t));
+  return buf;
+}
+
+// ---- Sweep --------------------------------------------------------------------------------------
+
+struct Setup {
+  gi::EffectRegistry registry;
+  std::vector<LoadedScene> scenes;
+  std::vector<std::unique_ptr<gi::Preset>> presets;  // nullptr entries: "none"
+};
+
+void loadInputs(const Options& o, Setup& s) {
+  s.registry.scanDefaultLocations();
+  for (const std::string& name : o.scenes) {
+    LoadedScene ls{name, gi::loadScene(name), "default"};
+    if (name != "default") {
+      std::ifstream in(name, std::ios::binary);
+      std::ostringstream ss;
+      ss << in.rdbuf();
+      ls.contents = ss.str();
+    }
+    for (const std::string& w : ls.scene.warnings)
+      std::fprintf(stderr, "gi-bench: warning: %s\n", w.c_str());
+    s.scenes.push_back(std::move(ls));
+  }
+  for (const std::string& p : o.presets) {
+    if (p == "none") {
+      s.presets.emplace_back();
+      continue;
+    }
+    auto preset = std::make_unique<gi::Preset>(gi::loadPreset(p));
+    gi::validatePreset(*preset, s.registry);
+    s.presets.push_back(std::move(preset));
+  }
+}
+
+std::vector<std::string> effectItems(const Options& o, const gi::EffectRegistry& registry) {
+  std::vector<std::string> items;
+  if (o.effects)
+    items = *o.effects;
+  else
+    items = {registry.has("ssao") ? "ssao" : "none"};
+  if (items.empty()) items = {"none"};
+  for (const std::string& item : items)
+    for (const std::string& e : splitPlus(item))
+      if (!registry.has(e))
+        usageError("--effects", "unknown effect '" + e + "' (known: " + knownEffects(registry) +
+                                    "; plugins are loaded from <bin>/plugins and GI_PLUGIN_PATH)");
+  return items;
+}
+
+std::vector<Grid> parseGrids(const Options& o, const gi::EffectRegistry& registry,
+                             const std::vector<std::string>& items) {
+  std::vector<std::string> grids = o.grids;
+  if (o.quick && grids.empty() && std::find(items.begin(), items.end(), "ssao") != items.end())
+    grids.push_back("ssao.samples=4,16");
+  std::vector<Grid> out;
+  for (const std::string& g : grids) {
+    const size_t dot = g.find('.'), eq = g.find('=');
+    if (dot == std::string::npos || eq == std::string::npos || dot > eq || dot == 0 ||
+        eq == dot + 1)
+      usageError("--grid", "'" + g + "': expected EFFECT.KEY=V1,V2,...");
+    Grid grid{g.substr(0, dot), g.substr(dot + 1, eq - dot - 1), splitList(g.substr(eq + 1))};
+    if (grid.values.empty()) usageError("--grid", "'" + g + "': no values");
+    if (!registry.has(grid.effect))
+      usageError("--grid", "'" + g + "': unknown effect '" + grid.effect +
+                               "' (known: " + knownEffects(registry) + ")");
+    bool swept = false;
+    for (const auto& item : items)
+      for (const auto& e : splitPlus(item)) swept |= e == grid.effect;
+    if (!swept)
+      usageError("--grid", "'" + g + "': effect '" + grid.effect + "' is not in --effects");
+    registry.defaultSettings(grid.effect).desc(grid.key);  // throws for an unknown key
+    for (const auto& v : grid.values) {                    // throws for a bad value
+      gi::SettingValues probe = registry.defaultSettings(grid.effect);
+      probe.setFromString(grid.key, v, "--grid " + g);
+    }
+    out.push_back(std::move(grid));
+  }
+  return out;
+}
+
+std::vector<Config> buildConfigs(const Options& o, const Setup& s,
+                                 const std::vector<std::string>& items,
+                                 const std::vector<Grid>& grids) {
+  std::vector<Config> configs;
+  for (size_t si = 0; si < s.scenes.size(); ++si)
+    for (const std::string& item : items)
+      for (size_t pi = 0; pi < s.presets.size(); ++pi) {
+        const std::vector<std::string> set = splitPlus(item);
+        std::vector<const Grid*> active;
+        for (const Grid& g : grids)
+          if (std::find(set.begin(), set.end(), g.effect) != set.end()) active.push_back(&g);
+        std::vector<size_t> idx(active.size(), 0);
+        for (;;) {
+          Config c;
+          c.scene = si;
+          c.effectSet = set;
+          c.effectLabel = item;
+          c.preset = o.presets[pi];
+          c.presetPtr = s.presets[pi].get();
+          gi::EffectOverrides ov;
+          ov.effects = set;
+          c.series = c.preset;
+          for (size_t k = 0; k < active.size(); ++k) {
+            const std::string kv =
+                active[k]->effect + "." + active[k]->key + "=" + active[k]->values[idx[k]];
+            ov.sets.push_back(kv);
+            c.params += (c.params.empty() ? "" : " ") + kv;
+            if (k == 0) {
+              c.gridKey = active[k]->effect + "." + active[k]->key;
+              c.gridValue = std::strtod(active[k]->values[idx[k]].c_str(), nullptr);
+              if (active[k]->values[idx[k]] == "true") c.gridValue = 1;
+            } else {
+              c.series += " " + kv;
+            }
+          }
+          c.effects = gi::resolveEffects(s.scenes[si].scene, c.presetPtr, ov, s.registry);
+          c.comparison = comparisonFor(c.effects);
+          configs.push_back(std::move(c));
+          size_t k = 0;
+          for (; k < idx.size(); ++k) {
+            if (++idx[k] < active[k]->values.size()) break;
+            idx[k] = 0;
+          }
+          if (k == idx.size()) break;
+        }
+      }
+  return configs;
+}
+
+gi::vk::Context makeContext(const Options& o) {
+  gi::vk::ContextOptions opts = gi::vk::ContextOptions::fromEnvironment();
+  opts.validation = o.validation;
+  if (!o.device.empty()) opts.device = o.device;
+  return gi::vk::Context(opts);
+}
+
+std::map<ReferenceKey, Reference> computeReferences(const Options& o, const Setup& s,
+                                                    const std::vector<ReferenceKey>& keys) {
+  std::map<ReferenceKey, Reference> refs;
+  ProgressBar bar(o.progress, "references", keys.size());
+  for (const ReferenceKey& k : keys) {
+    if (refs.count(k)) continue;
+    refs[k] = computeReference(o, s.scenes[k.scene], k);
+    bar.step(s.scenes[k.scene].name + " " + ref::quantityName(k.quantity) +
+             (refs[k].cached ? " (cached)" : ""));
+  }
+  return refs;
+}
+
+void checkFinite(const Row& r) {
+  for (double v : {r.totalMs, r.effectMs, r.floorMs, r.wallMs, r.nrmse, r.ssim})
+    if (!std::isfinite(v))
+      throw gi::Error(gi::ErrorKind::NonFinite, r.scene,
+                      "non-finite measurement for " + r.effect + " " + r.params);
+}
+
+int runSweep(const Options& o) {
+  const auto start = std::chrono::steady_clock::now();
+  Setup s;
+  loadInputs(o, s);
+  const std::vector<std::string> items = effectItems(o, s.registry);
+  const std::vector<Grid> grids = parseGrids(o, s.registry, items);
+  const std::vector<Config> configs = buildConfigs(o, s, items, grids);
+  // Everything is validated; now the work.
+  std::vector<ReferenceKey> keys;
+  for (const Config& c : configs) {
+    ReferenceKey k{c.scene, c.comparison.quantity, c.comparison.radius};
+    if (std::find_if(keys.begin(), keys.end(),
+                     [&](const ReferenceKey& x) { return !(x < k) && !(k < x); }) == keys.end())
+      keys.push_back(k);
+  }
+  const std::map<ReferenceKey, Reference> refs = computeReferences(o, s, keys);
+  gi::vk::Context ctx = makeContext(o);
+  std::vector<Row> rows;
+  ProgressBar bar(o.progress, "configurations", configs.size());
+  for (const Config& c : configs) {
+    const Reference& reference =
+        refs.at(ReferenceKey{c.scene, c.comparison.quantity, c.comparison.radius});
+    const Measurement m = measure(ctx, s.registry, s.scenes[c.scene].scene, c.effects, o, true,
+                                  c.comparison, reference);
+    Row r;
+    r.scene = s.scenes[c.scene].name;
+    r.effect = c.effectLabel;
+    r.preset = c.preset;
+    r.params = c.params;
+    r.series = c.series;
+    r.gridKey = c.gridKey;
+    r.gridValue = c.gridValue;
+    r.width = o.width;
+    r.height = o.height;
+    r.frames = o.frames;
+    r.passes = m.passes;
+    r.totalMs = m.totalMs;
+    r.effectMs = m.effectMs;
+    r.floorMs = m.floorMs;
+    r.wallMs = m.wallMs;
+    r.compared = c.comparison.resource;
+    r.reference = referenceLabel(c.comparison, reference.spp);
+    r.referenceSpp = reference.spp;
+    r.referenceStdError = reference.meanStdError;
+    r.nrmse = m.metrics.nrmse;
+    r.ssim = m.metrics.ssim;
+    r.pixels = m.metrics.pixels;
+    checkFinite(r);
+    rows.push_back(std::move(r));
+    bar.step(rows.back().scene + " " + c.effectLabel + " " + c.params);
+  }
+  if (ctx.validationErrors() > 0) {
+    std::fprintf(stderr, "gi-bench: error: %u Vulkan validation error(s)\n",
+                 ctx.validationErrors());
+    return 3;
+  }
+  gi::bench::RunInfo info{
+      ctx.deviceName(), o.commandLine, nowString(),
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()};
+  gi::bench::writeResults(o.out, rows, info);
+  std::printf("%zu configuration(s) in %.1f s -> %s/report.md\n", rows.size(), info.seconds,
+              o.out.c_str());
+  return 0;
+}
+
+// ---- Calibration
+// ----------------------------------------------------------------------------------
+
+// The sample-count settings of an effect: integer settings whose name contains "samples".
+std::vector<gi::SettingDesc> sampleSettings(const gi::EffectRegistry& registry,
+                                            const std::string& effect) {
+  std::vector<gi::SettingDesc> out;
+  const gi::SettingValues defaults = registry.defaultSettings(effect);
+  for (const auto& d : defaults.descs())
+    if (d.type == gi::SettingType::Int && d.name.find("samples") != std::string::npos)
+      out.push_back(d);
+  return out;
+}
+
+std::vector<int> powersOfTwo(const gi::SettingDesc& d) {
+  std::vector<int> v;
+  const int lo = std::max(1, int(d.minValue)), hi = int(std::min(d.maxValue, 1024.0));
+  for (int x = 1; x <= hi; x *= 2)
+    if (x >= lo) v.push_back(x);
+  if (v.empty() || v.back() != hi) v.push_back(hi);
+  return v;
+}
+
+int runCalibrate(const Options& o) {
+  Setup s;
+  loadInputs(o, s);
+  if (s.scenes.size() != 1) usageError("--scene", "--calibrate measures one scene");
+  std::vector<std::string> effects;
+  if (o.effects) {
+    for (const auto& item : effectItems(o, s.registry))
+      for (const auto& e : splitPlus(item)) effects.push_back(e);
+  } else {
+    for (const auto& n : s.registry.names())
+      if (!sampleSettings(s.registry, n).empty()) effects.push_back(n);
+  }
+  // Candidates: the cartesian product of powers of two of every sample-count setting.
+  struct Knob {
+    std::string effect, key;
+    std::vector<int> values;
+  };
+  std::vector<Knob> knobs;
+  for (const auto& e : effects)
+    for (const auto& d : sampleSettings(s.registry, e))
+      knobs.push_back({e, d.name, powersOfTwo(d)});
+  if (knobs.empty())
+    usageError("--calibrate", "no effect with a sample-count setting to calibrate (effects: " +
+                                  knownEffects(s.registry) + ")");
+  std::vector<std::vector<int>> candidates(1);
+  for (const Knob& k : knobs) {
+    std::vector<std::vector<int>> next;
+    for (const auto& c : candidates)
+      for (int v : k.values) {
+        next.push_back(c);
+        next.back().push_back(v);
+      }
+    candidates = std::move(next);
+  }
+  const gi::Scene& scene = s.scenes[0].scene;
+  std::vector<gi::EffectConfig> base;
+  {
+    gi::EffectOverrides ov;
+    ov.effects = effects;
+    base = gi::resolveEffects(scene, nullptr, ov, s.registry);
+  }
+  const Comparison cmp = comparisonFor(base);
+  const std::map<ReferenceKey, Reference> refs =
+      computeReferences(o, s, {ReferenceKey{0, cmp.quantity, cmp.radius}});
+  const Reference& reference = refs.begin()->second;
+  gi::vk::Context ctx = makeContext(o);
+  const double limit = o.budgetMs * (1.0 - o.headroom);
+  std::printf("calibrating on %s: %s %ux%u, budget %.3f ms (measured time must stay under %.3f)\n",
+              ctx.deviceName().c_str(), s.scenes[0].name.c_str(), o.width, o.height, o.budgetMs,
+              limit);
+  std::printf("%-40s %12s %10s %8s\n", "settings", "frame ms", "NRMSE", "fits");
+  ProgressBar bar(o.progress, "candidates", candidates.size());
+  struct Choice {
+    size_t index = 0;
+    double ms = 0.0, nrmse = 0.0;
+  };
+  std::optional<Choice> best;
+  double cheapest = INFINITY;
+  for (size_t ci = 0; ci < candidates.size(); ++ci) {
+    gi::EffectOverrides ov;
+    ov.effects = effects;
+    std::string label;
+    for (size_t k = 0; k < knobs.size(); ++k) {
+      ov.sets.push_back(knobs[k].effect + "." + knobs[k].key + "=" +
+                        std::to_string(candidates[ci][k]));
+      label += (label.empty() ? "" : " ") + ov.sets.back();
+    }
+    const auto cfg = gi::resolveEffects(scene, nullptr, ov, s.registry);
+    const Measurement m = measure(ctx, s.registry, scene, cfg, o, false, cmp, reference);
+    const bool fits = m.totalMs <= limit;
+    cheapest = std::min(cheapest, m.totalMs);
+    std::printf("%-40s %12.3f %10.5f %8s\n", label.c_str(), m.totalMs, m.metrics.nrmse,
+                fits ? "yes" : "no");
+    if (fits && (!best || m.metrics.nrmse < best->nrmse - 1e-12))
+      best = Choice{ci, m.totalMs, m.metrics.nrmse};
+    bar.step(label);
+  }
+  if (!best)
+    throw gi::Error(gi::ErrorKind::InvalidData, o.out,
+                    "no configuration fits the budget of " + formatDouble(o.budgetMs) +
+                        " ms (cheapest measured: " + formatDouble(cheapest) +
+                        " ms at the lowest sample counts); nothing written");
+  nlohmann::json preset;
+  preset["name"] = fs::path(o.out).stem().string();
+  preset["description"] =
+      "Calibrated by gi-bench on " + ctx.deviceName() + " with " + s.scenes[0].name + " at " +
+      std::to_string(o.width) + "x" + std::to_string(o.height) + ": measured " +
+      formatDouble(best->ms) + " ms per frame, NRMSE " + formatDouble(best->nrmse) + " vs " +
+      referenceLabel(cmp, reference.spp) + " (the most accurate sample counts within " +
+      formatDouble(o.budgetMs) + " ms)";
+  preset["platform"] = ctx.deviceName();
+  preset["target_ms"] = o.budgetMs;
+  preset["reference_resolution"] = {o.width, o.height};
+  preset["effects"] = nlohmann::json::object();
+  for (size_t k = 0; k < knobs.size(); ++k)
+    preset["effects"][knobs[k].effect][knobs[k].key] = candidates[best->index][k];
+  // Written, then checked by the engine's own loader, then moved into place.
+  const std::string tmp = o.out + ".check.json";
+  gi::bench::writeFileAtomic(tmp, preset.dump(2) + "\n");
+  try {
+    gi::validatePreset(gi::loadPreset(tmp), s.registry);
+  } catch (...) {
+    fs::remove(tmp);
+    throw;
+  }
+  fs::rename(tmp, o.out);
+  std::printf("chose %s: %.3f ms (budget %.3f), NRMSE %.5f -> wrote %s\n",
+              preset["effects"].dump().c_str(), best->ms, o.budgetMs, best->nrmse, o.out.c_str());
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    const Options o = parseArgs(argc, argv);
+    return o.calibrate ? runCalibrate(o) : runSweep(o);
+  } catch (const gi::Error& e) {
+    std::fprintf(stderr, "gi-bench: error (%s): %s\n", gi::errorKindName(e.kind()), e.what());
+    return e.kind() == gi::ErrorKind::Usage ? 2 : 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "gi-bench: error: %s\n", e.what());
+    return 1;
+  }
+}

@@ -1,0 +1,46 @@
+// Image error metrics of gi-bench: NRMSE and SSIM between a test image and a reference, both
+// single-channel, over the pixels a mask keeps (sky pixels are masked out by the caller).
+//
+//  - NRMSE = sqrt(mean over kept pixels of (x - r)^2) / mean over kept pixels of |r|. Dividing
+//    by the reference's mean (not its range) keeps the value meaningful for HDR lighting, where
+//    a few bright pixels would dominate the range. A reference whose mean is (nearly) 0 is
+//    divided by 1 instead, so constant black images give a finite value.
+//  - SSIM (Wang et al. 2004): 11x11 Gaussian window (sigma 1.5), C1 = (0.01 L)^2, C2 =
+//    (0.03 L)^2 with L the dynamic range (1 for AO and for tonemapped lighting). Window
+//    statistics are weighted by the mask, so masked pixels contribute nothing; the result is
+//    the mean SSIM over the kept pixels.
+//  - No kept pixel at all: NRMSE 0, SSIM 1 and pixels 0 (never NaN).
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+namespace gi::bench {
+
+struct Plane {
+  int width = 0, height = 0;
+  std::vector<float> values;  // width * height, row 0 at the top
+};
+
+struct Metrics {
+  double nrmse = 0.0;
+  double rmse = 0.0;
+  double ssim = 1.0;
+  size_t pixels = 0;  // kept pixels
+};
+
+// `mask`: empty (keep everything) or width * height entries, nonzero = keep. Non-finite test
+// values count as the largest possible error (their pixels are compared as 0 vs the reference
+// plus 1e6), so a broken effect shows up instead of producing NaN.
+double nrmse(const Plane& test, const Plane& reference, const std::vector<unsigned char>& mask);
+double ssim(const Plane& test, const Plane& reference, const std::vector<unsigned char>& mask,
+            double dynamicRange = 1.0);
+Metrics compare(const Plane& test, const Plane& reference, const std::vector<unsigned char>& mask,
+                double dynamicRange = 1.0);
+
+// Channel c (0..3) of an RGBA float image; Rec. 709 luminance when c < 0.
+Plane channel(int width, int height, const std::vector<float>& rgba, int c);
+// x / (1 + x) per pixel: maps HDR radiance into [0, 1) for SSIM with L = 1.
+Plane reinhard(const Plane& p);
+
+}  // namespace gi::bench

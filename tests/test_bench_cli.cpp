@@ -1,0 +1,185 @@
+// gi-bench end to end: the --quick smoke sweep writes every output with finite metrics; bad
+// input fails before rendering and writes nothing; --calibrate writes a preset gi-render loads,
+// whose configuration measures within the budget.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "process.h"
+#include "test_support.h"
+
+namespace gi {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string bench(const std::string& args) {
+  return test::binPath("gi-bench") + " --validation --no-progress " + args;
+}
+
+std::string readAll(const std::string& path) {
+  std::ifstream in(path);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+bool hasSsao() {
+  return fs::exists(test::binPath("plugins/gi_effect_ssao.so"));
+}
+
+std::vector<std::string> splitCsvLine(const std::string& line) {
+  std::vector<std::string> out(1);
+  bool quoted = false;
+  for (char c : line) {
+    if (c == '"')
+      quoted = !quoted;
+    else if (c == ',' && !quoted)
+      out.emplace_back();
+    else
+      out.back() += c;
+  }
+  return out;
+}
+
+TEST(BenchCli, QuickSweepWritesFiniteResults) {
+  const std::string dir = test::makeTempDir("bench-quick");
+  const std::string out = dir + "/out";
+  auto r = test::runCommand(bench("--quick --cache '" + dir + "/cache' --out '" + out + "'"));
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  for (const char* f : {"results.csv", "results.json", "report.md"})
+    EXPECT_TRUE(fs::exists(out + "/" + f)) << f;
+  size_t svgs = 0;
+  for (const auto& e : fs::directory_iterator(out + "/plots")) {
+    EXPECT_EQ(e.path().extension(), ".svg");
+    EXPECT_NE(readAll(e.path().string()).find("</svg>"), std::string::npos);
+    ++svgs;
+  }
+  EXPECT_GE(svgs, 1u);
+  for (const auto& e : fs::recursive_directory_iterator(out))
+    EXPECT_EQ(e.path().string().find(".partial"), std::string::npos) << e.path();
+
+  // CSV: header + one row per configuration, every metric a finite number.
+  std::istringstream csv(readAll(out + "/results.csv"));
+  std::string line;
+  std::getline(csv, line);
+  const std::vector<std::string> header = splitCsvLine(line);
+  size_t rows = 0;
+  while (std::getline(csv, line)) {
+    const std::vector<std::string> cells = splitCsvLine(line);
+    ASSERT_EQ(cells.size(), header.size()) << line;
+    for (size_t i = 0; i < cells.size(); ++i)
+      if ((header[i].ends_with("_ms") && header[i] != "passes_ms") || header[i] == "nrmse" ||
+          header[i] == "ssim" || header[i].find("floor") != std::string::npos) {
+        const double v = std::stod(cells[i]);
+        EXPECT_TRUE(std::isfinite(v)) << header[i] << " in " << line;
+        EXPECT_GE(v, header[i] == "ssim" ? -1.0 : 0.0) << header[i];
+      }
+    EXPECT_EQ(line.find("nan"), std::string::npos) << line;
+    ++rows;
+  }
+  EXPECT_GE(rows, 1u);
+  if (hasSsao()) {
+    EXPECT_GE(rows, 2u) << "--quick sweeps ssao samples";
+  }
+
+  // JSON: the same rows, finite metrics, the floor pass measured.
+  const nlohmann::json j = nlohmann::json::parse(readAll(out + "/results.json"));
+  ASSERT_EQ(j["results"].size(), rows);
+  for (const auto& row : j["results"]) {
+    for (const char* k : {"nrmse", "ssim", "total_ms", "floor_ms", "total_over_floor"}) {
+      ASSERT_TRUE(row[k].is_number()) << k << " " << row.dump();
+      EXPECT_TRUE(std::isfinite(row[k].get<double>())) << k;
+    }
+    EXPECT_GT(row["floor_ms"].get<double>(), 0.0);
+    EXPECT_GT(row["pixels"].get<size_t>(), 0u);
+    EXPECT_LE(row["ssim"].get<double>(), 1.0 + 1e-9);
+  }
+  // A rerun uses the cached reference and gives the same errors.
+  auto again = test::runCommand(bench("--quick --cache '" + dir + "/cache' --out '" + out + "'"));
+  ASSERT_EQ(again.exitCode, 0) << again.output;
+  const nlohmann::json j2 = nlohmann::json::parse(readAll(out + "/results.json"));
+  for (size_t i = 0; i < rows; ++i)
+    EXPECT_DOUBLE_EQ(j2["results"][i]["nrmse"].get<double>(),
+                     j["results"][i]["nrmse"].get<double>());
+}
+
+TEST(BenchCli, BadInputFailsBeforeRendering) {
+  const std::string dir = test::makeTempDir("bench-bad");
+  const std::string out = dir + "/out";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"--scenes no_such_scene.json", "no_such_scene.json"},
+      {"--effects no_such_effect", "no_such_effect"},
+      {"--presets no_such_preset", "no_such_preset"},
+      {"--effects none --grid nodot=1", "nodot"},
+      {"--effects none --grid ssao.samples=4", "ssao"},
+      {"--frames 0", "--frames"},
+  };
+  for (const auto& [args, needle] : cases) {
+    auto r = test::runCommand(
+        bench("--quick " + args + " --cache '" + dir + "/cache' --out '" + out + "'"));
+    EXPECT_NE(r.exitCode, 0) << args << ": " << r.output;
+    EXPECT_LT(r.exitCode, 128) << args << ": " << r.output;
+    EXPECT_NE(r.output.find("error"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find(needle), std::string::npos) << args << ": " << r.output;
+    EXPECT_FALSE(fs::exists(out)) << args << ": output written";
+    EXPECT_FALSE(fs::exists(dir + "/cache")) << args << ": references computed";
+  }
+  if (hasSsao()) {
+    for (const char* grid : {"ssao.no_such_key=1", "ssao.samples=100000", "ssao.samples=abc"}) {
+      auto r = test::runCommand(bench(std::string("--quick --grid ") + grid + " --cache '" + dir +
+                                      "/cache' --out '" + out + "'"));
+      EXPECT_NE(r.exitCode, 0) << grid << ": " << r.output;
+      EXPECT_LT(r.exitCode, 128) << r.output;
+      EXPECT_FALSE(fs::exists(out)) << grid;
+      EXPECT_FALSE(fs::exists(dir + "/cache")) << grid;
+    }
+  }
+}
+
+TEST(BenchCli, CalibratedPresetLoadsAndFitsTheBudget) {
+  if (!hasSsao()) GTEST_SKIP() << "the ssao plugin is not built";
+  const std::string dir = test::makeTempDir("bench-calibrate");
+  const std::string preset = dir + "/calibrated.json";
+  const double budget = 400.0;
+  auto r = test::runCommand(bench("--calibrate --budget-ms " + std::to_string(budget) +
+                                  " --width 64 --height 48 --frames 3 --ref-spp 16 --effects ssao "
+                                  "--cache '" +
+                                  dir + "/cache' --out '" + preset + "'"));
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  const nlohmann::json j = nlohmann::json::parse(readAll(preset));
+  ASSERT_TRUE(j["effects"]["ssao"]["samples"].is_number_integer()) << j.dump();
+  EXPECT_EQ(j["target_ms"].get<double>(), budget);
+  EXPECT_EQ(j["reference_resolution"], nlohmann::json({64, 48}));
+
+  // gi-render loads it; the chosen configuration's measured frame time is within the budget.
+  auto g = test::runCommand(
+      test::binPath("gi-render") + " --validation --scene default --effects ssao --preset '" +
+      preset + "' --width 64 --height 48 --frames 3 --timings --out '" + dir + "/img.png'");
+  ASSERT_EQ(g.exitCode, 0) << g.output;
+  const size_t at = g.output.find("\ntotal");
+  ASSERT_NE(at, std::string::npos) << g.output;
+  const double total = std::stod(g.output.substr(at + 6));
+  EXPECT_GT(total, 0.0);
+  EXPECT_LE(total, budget) << g.output;
+
+  // An impossible budget fails and writes nothing.
+  const std::string none = dir + "/none.json";
+  auto bad = test::runCommand(
+      bench("--calibrate --budget-ms 0.000001 --width 64 --height 48 --frames 1 --ref-spp 4 "
+            "--effects ssao --cache '" +
+            dir + "/cache' --out '" + none + "'"));
+  EXPECT_NE(bad.exitCode, 0) << bad.output;
+  EXPECT_NE(bad.output.find("budget"), std::string::npos) << bad.output;
+  EXPECT_FALSE(fs::exists(none));
+  for (const auto& e : fs::directory_iterator(dir))
+    EXPECT_EQ(e.path().string().find(".check"), std::string::npos) << e.path();
+}
+
+}  // namespace
+}  // namespace gi

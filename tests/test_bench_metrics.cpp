@@ -1,0 +1,112 @@
+// gi-bench's error metrics: identity, known noise, masking and degenerate inputs.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "metrics.h"
+
+namespace gi::bench {
+namespace {
+
+Plane ramp(int w, int h) {
+  Plane p{w, h, std::vector<float>(size_t(w) * size_t(h))};
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      p.values[size_t(y * w + x)] =
+          0.25f + 0.5f * float(x) / float(w) + 0.1f * std::sin(0.3f * float(y));
+  return p;
+}
+
+double mean(const Plane& p) {
+  double s = 0;
+  for (float v : p.values) s += v;
+  return s / double(p.values.size());
+}
+
+TEST(BenchMetrics, IdentityIsPerfect) {
+  const Plane a = ramp(64, 48);
+  const Metrics m = compare(a, a, {});
+  EXPECT_EQ(m.nrmse, 0.0);
+  EXPECT_NEAR(m.ssim, 1.0, 1e-12);
+  EXPECT_EQ(m.pixels, 64u * 48u);
+}
+
+TEST(BenchMetrics, GaussianNoiseGivesExpectedNrmse) {
+  const Plane ref = ramp(256, 256);
+  for (double sigma : {0.01, 0.05, 0.2}) {
+    Plane noisy = ref;
+    std::mt19937 rng(42);
+    std::normal_distribution<float> noise(0.0f, float(sigma));
+    for (float& v : noisy.values) v += noise(rng);
+    const double expected = sigma / mean(ref);
+    const Metrics m = compare(noisy, ref, {});
+    EXPECT_NEAR(m.nrmse, expected, 0.03 * expected) << "sigma " << sigma;
+    EXPECT_NEAR(m.rmse, sigma, 0.03 * sigma);
+    EXPECT_LT(m.ssim, 1.0);
+    EXPECT_GT(m.ssim, -1.0);
+  }
+  // More noise, lower SSIM.
+  Plane a = ref, b = ref;
+  std::mt19937 rng(7);
+  std::normal_distribution<float> n1(0.0f, 0.02f), n2(0.0f, 0.2f);
+  for (size_t i = 0; i < a.values.size(); ++i) {
+    a.values[i] += n1(rng);
+    b.values[i] += n2(rng);
+  }
+  EXPECT_GT(ssim(a, ref, {}), ssim(b, ref, {}));
+}
+
+TEST(BenchMetrics, MaskExcludesPixels) {
+  const Plane ref = ramp(64, 48);
+  Plane test = ref;
+  std::vector<unsigned char> mask(ref.values.size(), 1);
+  // Garbage (including NaN and inf) in the right half, masked out.
+  for (int y = 0; y < 48; ++y)
+    for (int x = 32; x < 64; ++x) {
+      const size_t i = size_t(y * 64 + x);
+      test.values[i] = (x % 3 == 0) ? NAN : (x % 3 == 1) ? INFINITY : 100.0f;
+      mask[i] = 0;
+    }
+  const Metrics m = compare(test, ref, mask);
+  EXPECT_EQ(m.nrmse, 0.0);
+  EXPECT_NEAR(m.ssim, 1.0, 1e-12);
+  EXPECT_EQ(m.pixels, 32u * 48u);
+  // Unmasked, the same garbage is a large, finite error.
+  const Metrics u = compare(test, ref, {});
+  EXPECT_TRUE(std::isfinite(u.nrmse));
+  EXPECT_TRUE(std::isfinite(u.ssim));
+  EXPECT_GT(u.nrmse, 1.0);
+}
+
+TEST(BenchMetrics, DegenerateInputsAreFinite) {
+  const Plane zero{16, 16, std::vector<float>(256, 0.0f)};
+  const Plane one{16, 16, std::vector<float>(256, 1.0f)};
+  const Plane half{16, 16, std::vector<float>(256, 0.5f)};
+  for (const Plane* a : {&zero, &one, &half})
+    for (const Plane* b : {&zero, &one, &half}) {
+      const Metrics m = compare(*a, *b, {});
+      EXPECT_TRUE(std::isfinite(m.nrmse));
+      EXPECT_TRUE(std::isfinite(m.ssim));
+    }
+  EXPECT_NEAR(compare(one, one, {}).ssim, 1.0, 1e-12);
+  EXPECT_NEAR(compare(half, one, {}).nrmse, 0.5, 1e-9);
+  EXPECT_NEAR(compare(one, zero, {}).nrmse, 1.0, 1e-9);  // reference mean 0: divided by 1
+  const std::vector<unsigned char> none(256, 0);
+  const Metrics m = compare(half, one, none);
+  EXPECT_EQ(m.pixels, 0u);
+  EXPECT_EQ(m.nrmse, 0.0);
+  EXPECT_EQ(m.ssim, 1.0);
+}
+
+TEST(BenchMetrics, ChannelAndLuminance) {
+  const std::vector<float> rgba = {1, 0, 0, 1, 0, 1, 0, 1, 0, 0, 1, 1, 1, 1, 1, 1};
+  const Plane r = channel(2, 2, rgba, 0), l = channel(2, 2, rgba, -1);
+  EXPECT_EQ(r.values, (std::vector<float>{1, 0, 0, 1}));
+  EXPECT_NEAR(l.values[3], 1.0f, 1e-6f);
+  EXPECT_NEAR(l.values[1], 0.7152f, 1e-6f);
+  EXPECT_NEAR(reinhard(r).values[0], 0.5f, 1e-6f);
+}
+
+}  // namespace
+}  // namespace gi::bench
