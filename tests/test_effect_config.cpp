@@ -198,20 +198,21 @@ using Passes = std::vector<std::string>;
 TEST_F(EffectGraphTest, NoEffectsRunsOnlyTheEnginePasses) {
   auto r = make(scene, {});
   r->renderFrame();
-  EXPECT_EQ(r->passNames(), (Passes{"gbuffer", "lighting", "tonemap"}));
+  // The default scene's ceiling light casts shadows: one shadow pass, read by lighting.
+  EXPECT_EQ(r->passNames(), (Passes{"gbuffer", "shadow_0", "lighting", "tonemap"}));
   EXPECT_EQ(r->culledPassNames(), (Passes{"floor"}));
 }
 
 TEST_F(EffectGraphTest, AnAOEffectFeedsLighting) {
   auto r = make(scene, {"const_ao"});
   r->renderFrame();
-  EXPECT_EQ(r->passNames(), (Passes{"gbuffer", "const_ao", "lighting", "tonemap"}));
+  EXPECT_EQ(r->passNames(), (Passes{"gbuffer", "shadow_0", "const_ao", "lighting", "tonemap"}));
 }
 
 TEST_F(EffectGraphTest, RequestedEffectWhoseOutputReachesNothingIsCulled) {
   auto r = make(scene, {"const_ao", "orphan"});
   r->renderFrame();
-  EXPECT_EQ(r->passNames(), (Passes{"gbuffer", "const_ao", "lighting", "tonemap"}));
+  EXPECT_EQ(r->passNames(), (Passes{"gbuffer", "shadow_0", "const_ao", "lighting", "tonemap"}));
   EXPECT_EQ(r->culledPassNames(), (Passes{"orphan", "floor"}));
 }
 
@@ -260,6 +261,32 @@ TEST_F(EffectGraphTest, UniformOnlySettingsDoNotRecompile) {
 TEST_F(EffectGraphTest, UnknownViewListsTheAvailableOnes) {
   expectError([&] { make(scene, {}, "nope"); }, ErrorKind::Usage,
               {"unknown view 'nope'", "normal", "depth"});
+}
+
+// Every preset shipped in assets/presets names real effects and in-range settings, and is
+// found by name from the build tree.
+TEST(ShippedPresets, ValidateAgainstThePlugins) {
+  EffectRegistry registry;
+  registry.scanDirectory(test::binPath("plugins"));
+  ASSERT_TRUE(registry.has("ssao"))
+      << "the ssao plugin must be built into " << test::binPath("plugins");
+  size_t count = 0;
+  for (const auto& entry :
+       std::filesystem::directory_iterator(std::string(GI_SOURCE_DIR) + "/assets/presets")) {
+    Preset p = loadPreset(entry.path().string());
+    EXPECT_NO_THROW(validatePreset(p, registry)) << entry.path();
+    EXPECT_GT(p.targetMs, 0.0) << entry.path();
+    EXPECT_GT(p.referenceWidth, 0u) << entry.path();
+    ++count;
+  }
+  EXPECT_GE(count, 5u);
+  for (const char* name : {"low", "medium", "high", "ultra", "lavapipe"}) {
+    auto r = test::runCommand(test::binPath("gi-render") +
+                              " --scene default --width 64 --height 48 --effects ssao --out "
+                              "/tmp/gi-preset.png --preset " +
+                              name);
+    EXPECT_EQ(r.exitCode, 0) << name << ": " << r.output;
+  }
 }
 
 TEST(GiRenderEffects, CommandLineErrorsAreClear) {

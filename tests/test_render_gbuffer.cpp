@@ -189,7 +189,7 @@ TEST_F(GBufferTest, TimingsCoverExecutedPasses) {
   rs.floorPass = true;
   Renderer r(ctx(), scene, rs);
   r.renderFrame();
-  const std::vector<std::string> expected = {"gbuffer", "lighting", "tonemap", "floor"};
+  const std::vector<std::string> expected = {"gbuffer", "shadow_0", "lighting", "tonemap", "floor"};
   EXPECT_EQ(r.passNames(), expected);
   ASSERT_EQ(r.lastTimings().size(), expected.size());
   for (const auto& t : r.lastTimings()) {

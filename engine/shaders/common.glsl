@@ -13,9 +13,11 @@ struct FrameUniforms {
   vec4 viewport;      // width, height, 1/width, 1/height
   vec4 cameraPos;     // world space
   vec4 skyZenith;     // rgb, intensity
-  vec4 skyHorizon;    // rgb, environment kind (0 sky, 1 constant)
+  vec4 skyHorizon;    // rgb, environment kind (0 sky, 1 constant, 2 equirect map)
   vec4 skyGround;     // rgb, unused
   vec4 params;        // exposure, light count, near, far
+  vec4 irradianceSH[9];  // rgb: SH9 of the environment's irradiance (cosine lobe convolved,
+                         // intensity included), world space; see gi/environment.h
 };
 
 // Guard: normalising a zero or non-finite vector returns the fallback instead of NaN.
@@ -34,22 +36,36 @@ vec3 viewPositionFromDepth(mat4 invProj, vec2 uv, float depth) {
 // Sky pixels keep depth 0 (the reverse-Z far plane clear value).
 bool isSky(float depth) { return depth <= 0.0; }
 
-// Procedural sky radiance in world direction `dir` (or the constant environment).
+// Irradiance arriving at a surface with world normal n / pi (SH9, exact for constant
+// environments, the usual ~1-3% approximation for skies and maps).
+vec3 environmentIrradianceOverPi(FrameUniforms f, vec3 n) {
+  float x = n.x, y = n.y, z = n.z;
+  vec3 e = f.irradianceSH[0].rgb * 0.282095 + f.irradianceSH[1].rgb * (0.488603 * y) +
+           f.irradianceSH[2].rgb * (0.488603 * z) + f.irradianceSH[3].rgb * (0.488603 * x) +
+           f.irradianceSH[4].rgb * (1.092548 * x * y) + f.irradianceSH[5].rgb * (1.092548 * y * z) +
+           f.irradianceSH[6].rgb * (0.315392 * (3.0 * z * z - 1.0)) +
+           f.irradianceSH[7].rgb * (1.092548 * x * z) +
+           f.irradianceSH[8].rgb * (0.546274 * (x * x - y * y));
+  return max(e, vec3(0.0)) * (1.0 / 3.14159265358979);
+}
+
+// Equirect mapping of gi/environment.h: u = atan(z, x) / 2pi in [0, 1), v = acos(y) / pi.
+vec2 equirectUV(vec3 d) {
+  d = safeNormalize(d, vec3(0, 1, 0));
+  float u = atan(d.z, d.x) * (1.0 / (2.0 * 3.14159265358979));
+  return vec2(u < 0.0 ? u + 1.0 : u, acos(clamp(d.y, -1.0, 1.0)) * (1.0 / 3.14159265358979));
+}
+
+// Procedural sky radiance in world direction `dir` (or the constant environment). Shaders
+// without the map texture get its low-frequency (SH) approximation for kind 2; lighting.comp
+// samples the map itself.
 vec3 environmentRadiance(FrameUniforms f, vec3 dir) {
+  if (f.skyHorizon.w > 1.5) return environmentIrradianceOverPi(f, dir);
   if (f.skyHorizon.w > 0.5) return f.skyGround.rgb * f.skyZenith.w;
   float y = clamp(dir.y, -1.0, 1.0);
   vec3 c = y >= 0.0 ? mix(f.skyHorizon.rgb, f.skyZenith.rgb, sqrt(y))
                     : mix(f.skyHorizon.rgb, f.skyGround.rgb, sqrt(-y));
   return c * f.skyZenith.w;
-}
-
-// Cosine-weighted average of the environment around world normal n (irradiance / pi),
-// a closed-form approximation good for smooth gradient skies.
-vec3 environmentIrradianceOverPi(FrameUniforms f, vec3 n) {
-  if (f.skyHorizon.w > 0.5) return f.skyGround.rgb * f.skyZenith.w;
-  vec3 up = 0.5 * (f.skyZenith.rgb + f.skyHorizon.rgb);
-  vec3 down = 0.5 * (f.skyGround.rgb + f.skyHorizon.rgb);
-  return mix(down, up, 0.5 + 0.5 * clamp(n.y, -1.0, 1.0)) * f.skyZenith.w;
 }
 
 #endif

@@ -25,6 +25,10 @@ struct RenderSettings {
   uint32_t width = 640, height = 480;
   float exposure = 1.0f;
   bool floorPass = false;  // also keep the floor pass (for timing baselines)
+  // Shadow maps: texels per side of a directional/spot map and of each point-light cube face
+  // (a point light renders its 6 faces into one 3x2 atlas). Up to 4 lights cast shadows (the
+  // first 4 with castsShadows, in scene node order); one "shadow_<light index>" pass each.
+  uint32_t shadowMapSize = 1024;
   std::string view =
       "output";  // the resource the frame delivers (a G-buffer channel, an effect's view)
   std::vector<EffectConfig> effects;

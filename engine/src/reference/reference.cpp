@@ -8,6 +8,7 @@
 #include <thread>
 #include <vector>
 
+#include "gi/environment.h"
 #include "gi/errors.h"
 #include "gi/reference/ray_scene.h"
 
@@ -415,12 +416,7 @@ const char* membershipName(Membership m) {
 }
 
 glm::vec3 environmentRadiance(const Environment& env, const glm::vec3& dir) {
-  const float intensity = std::max(env.intensity, 0.0f);
-  if (env.kind == Environment::Kind::Constant) return env.constantColor * intensity;
-  const float y = std::isfinite(dir.y) ? std::clamp(dir.y, -1.0f, 1.0f) : 0.0f;
-  const glm::vec3 c = y >= 0.0f ? glm::mix(env.horizonColor, env.zenithColor, std::sqrt(y))
-                                : glm::mix(env.horizonColor, env.groundColor, std::sqrt(-y));
-  return c * intensity;
+  return environmentLookup(env, dir);  // sky, constant or equirect map (gi/environment.h)
 }
 
 Result render(const Scene& scene, const Settings& settings) {

@@ -5,9 +5,13 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <limits>
+
+#include <glm/gtc/matrix_transform.hpp>
 
 #include "gi/animation.h"
 #include "gi/effect.h"
+#include "gi/environment.h"
 #include "gi/errors.h"
 #include "gi/graph/frame_graph.h"
 #include "gi/vk/common.h"
@@ -42,6 +46,16 @@ uint32_t groups(uint32_t n) {
 
 TextureDesc outputRelative(VkFormat format) {
   return TextureDesc{format};
+}
+
+constexpr uint32_t kMaxShadowMaps = 4;  // lighting.comp binds shadowMap0..3
+
+// Reverse-Z orthographic projection (Vulkan clip space): depth 1 at znear, 0 at zfar.
+glm::mat4 orthoReverseZ(float l, float r, float b, float t, float znear, float zfar) {
+  glm::mat4 flip(1.0f);
+  flip[2][2] = -1.0f;
+  flip[3][2] = 1.0f;  // z' = w - z
+  return flip * glm::orthoRH_ZO(l, r, b, t, znear, zfar);
 }
 
 }  // namespace
@@ -84,8 +98,23 @@ struct Renderer::Impl : EffectContext {
   Image whiteTexture, neutralAO, output;
   Sampler linearRepeat, linearClamp, nearestClamp;
   uint32_t lightCount = 0;
+  // Shadows: one map per shadowed light (slot), rendered as one or six views.
+  struct ShadowMap {
+    uint32_t light = 0;  // index into the lights buffer (names the pass)
+    uint32_t width = 0, height = 0;
+    struct View {
+      glm::mat4 viewProj;  // world -> light clip
+      VkRect2D rect;
+    };
+    std::vector<View> views;
+  };
+  std::vector<ShadowMap> shadowMaps;
+  Buffer shadowViewBuffer;
+  Pipeline shadowPipeline;
+  Image environmentMap;
 
   Pipeline gbufferPipeline, lightingPipeline, tonemapPipeline, floorPipeline;
+  SH9 irradiance{};
   struct ActiveEffect {
     std::unique_ptr<Effect> effect;
     EffectInfo info;
@@ -114,6 +143,8 @@ struct Renderer::Impl : EffectContext {
     if (settings.width == 0 || settings.height == 0 || settings.width > 16384 ||
         settings.height > 16384)
       throw Error(ErrorKind::Usage, "", "image size must be between 1x1 and 16384x16384");
+    if (settings.shadowMapSize < 16 || settings.shadowMapSize > 8192)
+      throw Error(ErrorKind::Usage, "", "shadow map size must be between 16 and 8192");
     cameraView = activeCamera(scene, float(settings.width) / float(settings.height));
     uploadScene();
     updateDeformations();  // joint matrices of the scene as loaded
@@ -291,6 +322,10 @@ struct Renderer::Impl : EffectContext {
     nearestClamp = Sampler(ctx, VK_FILTER_NEAREST, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE);
 
     std::vector<gpu::Light> lights;
+    std::vector<gpu::ShadowView> shadowViews;
+    glm::vec3 bmin, bmax;
+    scene.worldBounds(bmin, bmax);
+    const bool hasBounds = bmin.x <= bmax.x;
     for (const Node& node : scene.nodes) {
       if (node.light < 0) continue;
       const Light& l = scene.lights[node.light];
@@ -304,12 +339,34 @@ struct Renderer::Impl : EffectContext {
       g.directionType = glm::vec4(dir, type);
       g.radiance = glm::vec4(l.color * std::max(l.intensity, 0.0f), 0.0f);
       g.cone = glm::vec4(std::cos(l.innerConeAngle), std::cos(l.outerConeAngle), 0, 0);
+      g.shadow = glm::vec4(-1.0f, 0.0f, 0.0f, 0.0f);
+      if (l.castsShadows && hasBounds && shadowMaps.size() < kMaxShadowMaps) {
+        const float first = float(shadowViews.size());
+        if (addShadowMap(l, node.world, uint32_t(lights.size()), bmin, bmax, shadowViews))
+          g.shadow = glm::vec4(first, std::max(l.shadowBias.constant, 0.0f),
+                               std::max(l.shadowBias.slope, 0.0f), float(shadowMaps.size() - 1));
+      }
       lights.push_back(g);
     }
     lightCount = uint32_t(lights.size());
     if (lights.empty()) lights.emplace_back();
     lightBuffer = createDeviceBuffer(ctx, lights.data(), lights.size() * sizeof(gpu::Light),
                                      VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    if (shadowViews.empty()) shadowViews.emplace_back();
+    shadowViewBuffer =
+        createDeviceBuffer(ctx, shadowViews.data(), shadowViews.size() * sizeof(gpu::ShadowView),
+                           VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+
+    const Environment& env = scene.environment;
+    irradiance = irradianceSH(env);
+    if (env.kind == Environment::Kind::Map && env.mapWidth > 0 && env.mapHeight > 0 &&
+        env.mapRGB.size() == size_t(env.mapWidth) * env.mapHeight * 3) {
+      std::vector<float> rgba(size_t(env.mapWidth) * env.mapHeight * 4, 1.0f);
+      for (size_t i = 0; i < size_t(env.mapWidth) * env.mapHeight; ++i)
+        for (int c = 0; c < 3; ++c) rgba[i * 4 + c] = env.mapRGB[i * 3 + c];
+      environmentMap = makeTexture(VK_FORMAT_R32G32B32A32_SFLOAT, uint32_t(env.mapWidth),
+                                   uint32_t(env.mapHeight), rgba.data(), rgba.size() * 4);
+    }
     frameBuffer = Buffer(ctx, sizeof(gpu::FrameUniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true);
 
     ImageDesc od;
@@ -319,6 +376,84 @@ struct Renderer::Impl : EffectContext {
     od.usage =
         VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
     output = Image(ctx, od);
+  }
+
+  // Plans the shadow map of one light: its views (1, or 6 cube faces in a 3x2 atlas) fitted to
+  // the scene bounds. Returns false when the light cannot see the scene (nothing to render).
+  bool addShadowMap(const Light& l, const glm::mat4& world, uint32_t lightIndex,
+                    const glm::vec3& bmin, const glm::vec3& bmax,
+                    std::vector<gpu::ShadowView>& out) {
+    const uint32_t res = settings.shadowMapSize;
+    const glm::mat4 invView = glm::inverse(cameraView.view);
+    const glm::vec3 pos = glm::vec3(world * glm::vec4(0, 0, 0, 1));
+    const glm::vec3 dir = safeDir(glm::vec3(world * glm::vec4(0, 0, -1, 0)));
+    std::array<glm::vec3, 8> corners;
+    for (int i = 0; i < 8; ++i)
+      corners[i] =
+          glm::vec3(i & 1 ? bmax.x : bmin.x, i & 2 ? bmax.y : bmin.y, i & 4 ? bmax.z : bmin.z);
+    ShadowMap map;
+    map.light = lightIndex;
+    auto upFor = [](const glm::vec3& d) {
+      return std::abs(d.y) > 0.99f ? glm::vec3(0, 0, 1) : glm::vec3(0, 1, 0);
+    };
+    auto addView = [&](const glm::mat4& viewProj, const glm::vec4& params, glm::uvec2 offset) {
+      map.views.push_back({viewProj, VkRect2D{{int32_t(offset.x), int32_t(offset.y)}, {res, res}}});
+      out.push_back({viewProj * invView, params, glm::vec4(offset.x, offset.y, res, 0.0f)});
+    };
+    if (l.type == LightType::Directional) {
+      // Orthographic, fitted to the light-space bounds of the scene's box.
+      const glm::vec3 centre = 0.5f * (bmin + bmax);
+      const float radius = std::max(0.5f * glm::length(bmax - bmin), 1e-3f);
+      const glm::mat4 view = glm::lookAt(centre - dir * (2.0f * radius), centre, upFor(dir));
+      glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+      for (const glm::vec3& c : corners) {
+        const glm::vec3 v = glm::vec3(view * glm::vec4(c, 1.0f));
+        lo = glm::min(lo, v);
+        hi = glm::max(hi, v);
+      }
+      const float margin = 0.01f * radius;
+      lo -= margin;
+      hi += margin;
+      const float znear = std::max(-hi.z, 1e-4f), zfar = -lo.z;
+      const float extent = std::max(hi.x - lo.x, hi.y - lo.y);
+      const glm::mat4 proj = orthoReverseZ(lo.x, lo.x + extent, lo.y, lo.y + extent, znear, zfar);
+      map.width = map.height = res;
+      addView(proj * view, glm::vec4(0.0f, znear, zfar, extent / float(res)), {0, 0});
+    } else {
+      // Perspective from the light's position; far: the farthest corner (or the range).
+      float zfar = 0.0f;
+      for (const glm::vec3& c : corners) zfar = std::max(zfar, glm::length(c - pos));
+      if (l.range > 0.0f) zfar = std::min(zfar, l.range);
+      if (!(zfar > 0.0f)) return false;
+      zfar *= 1.01f;
+      const float znear = std::max(zfar * 1e-3f, 0.01f);
+      if (znear >= zfar) return false;
+      if (l.type == LightType::Spot) {
+        const float fov =
+            std::min(2.0f * l.outerConeAngle + glm::radians(2.0f), glm::radians(170.0f));
+        const glm::mat4 view = glm::lookAt(pos, pos + dir, upFor(dir));
+        map.width = map.height = res;
+        addView(perspectiveReverseZ(fov, 1.0f, znear, zfar) * view,
+                glm::vec4(1.0f, znear, zfar, 2.0f * std::tan(0.5f * fov) / float(res)), {0, 0});
+      } else {
+        // Cube faces +x, -x, +y, -y, +z, -z (the order lighting.comp picks them in).
+        const glm::vec3 axes[6] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
+                                   {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
+        const glm::mat4 proj = perspectiveReverseZ(glm::radians(90.0f), 1.0f, znear, zfar);
+        map.width = 3 * res;
+        map.height = 2 * res;
+        for (uint32_t f = 0; f < 6; ++f)
+          addView(proj * glm::lookAt(pos, pos + axes[f], upFor(axes[f])),
+                  glm::vec4(1.0f, znear, zfar, 2.0f / float(res)), {(f % 3) * res, (f / 3) * res});
+      }
+    }
+    shadowMaps.push_back(std::move(map));
+    return true;
+  }
+
+  static glm::vec3 safeDir(const glm::vec3& v) {
+    const float len = glm::length(v);
+    return len > 1e-12f && std::isfinite(len) ? v / len : glm::vec3(0, -1, 0);
   }
 
   void createPipelines() {
@@ -348,7 +483,24 @@ struct Renderer::Impl : EffectContext {
                                           {5, tex},
                                           {6, ssbo},
                                           {7, img},
-                                          {8, tex}});
+                                          {8, tex},
+                                          {9, tex},
+                                          {10, tex},
+                                          {11, tex},
+                                          {12, tex},
+                                          {13, ssbo},
+                                          {14, tex}});
+    if (!shadowMaps.empty()) {
+      GraphicsDesc sd;
+      sd.vertex = loadSpirv("shadow.vert");
+      sd.fragment = loadSpirv("shadow.frag");
+      sd.bindings = {{0, ssbo}};
+      sd.pushConstantBytes = sizeof(glm::mat4) + sizeof(uint32_t);
+      sd.vertexLayout.stride = sizeof(Vertex);
+      sd.vertexLayout.attributes = {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, position)}};
+      sd.depthFormat = VK_FORMAT_D32_SFLOAT;  // reverse-Z like the G-buffer (compare >=)
+      shadowPipeline = Pipeline::graphics(ctx, sd);
+    }
     tonemapPipeline =
         Pipeline::compute(ctx, loadSpirv("tonemap.comp"), {{0, ubo}, {1, tex}, {2, img}});
     floorPipeline = Pipeline::compute(ctx, loadSpirv("floor.comp"), {{0, ubo}, {1, tex}, {2, img}});
@@ -446,6 +598,7 @@ struct Renderer::Impl : EffectContext {
       bb.put(kVertices, vertices);
     }
     addGBufferPass(bb);
+    addShadowPasses(bb);
     addEffects(EffectStage::BeforeLighting);
     addLightingPass(bb);
     addEffects(EffectStage::AfterLighting);
@@ -574,9 +727,77 @@ struct Renderer::Impl : EffectContext {
                             &set, 0, nullptr);
   }
 
+  // One "shadow_<light index>" pass per shadowed light, writing "shadow_map_<slot>" (D32,
+  // reverse-Z, cleared to 0 = nothing). Only lighting reads them: culled along with it.
+  void addShadowPasses(Blackboard& bb) {
+    for (uint32_t slot = 0; slot < shadowMaps.size(); ++slot) {
+      const ShadowMap& map = shadowMaps[slot];
+      TextureDesc desc{VK_FORMAT_D32_SFLOAT};
+      desc.sizeClass = SizeClass::Absolute;
+      desc.width = map.width;
+      desc.height = map.height;
+      auto io = std::make_shared<TextureHandle>();
+      const std::string name = "shadow_map_" + std::to_string(slot);
+      graph.addPass(
+          "shadow_" + std::to_string(map.light),
+          [&](PassBuilder& b) {
+            if (BufferHandle v = bb.buffer(kVertices); v.valid()) b.read(v, BufferUsage::Vertex);
+            *io = b.write(b.create(name, desc), TextureUsage::DepthAttachment);
+          },
+          [this, io, slot](PassContext& pc) { recordShadowMap(pc, *io, shadowMaps[slot]); });
+      bb.put(name, *io);
+    }
+  }
+
+  void recordShadowMap(PassContext& pc, TextureHandle target, const ShadowMap& map) {
+    VkCommandBuffer c = pc.cmd();
+    VkRenderingAttachmentInfo depth{VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+    depth.imageView = pc.view(target);
+    depth.imageLayout = VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL;
+    depth.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+    depth.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+    depth.clearValue.depthStencil = {0.0f, 0};  // reverse-Z far plane: no occluder
+    VkRenderingInfo info{VK_STRUCTURE_TYPE_RENDERING_INFO};
+    info.renderArea = {{0, 0}, {map.width, map.height}};
+    info.layerCount = 1;
+    info.pDepthAttachment = &depth;
+    vkCmdBeginRendering(c, &info);
+    DescriptorWriter w;
+    w.buffer(0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, instanceBuffer.handle());
+    bind(c, shadowPipeline, w);
+    if (!draws.empty()) {
+      VkDeviceSize offset = 0;
+      VkBuffer vb = vertexBuffer.handle();
+      vkCmdBindVertexBuffers(c, 0, 1, &vb, &offset);
+      vkCmdBindIndexBuffer(c, indexBuffer.handle(), 0, VK_INDEX_TYPE_UINT32);
+    }
+    for (const ShadowMap::View& v : map.views) {
+      VkViewport viewport{float(v.rect.offset.x),
+                          float(v.rect.offset.y),
+                          float(v.rect.extent.width),
+                          float(v.rect.extent.height),
+                          0.0f,
+                          1.0f};
+      vkCmdSetViewport(c, 0, 1, &viewport);
+      vkCmdSetScissor(c, 0, 1, &v.rect);
+      struct {
+        glm::mat4 viewProj;
+        uint32_t instance;
+      } push{v.viewProj, 0};
+      for (const Draw& d : draws) {
+        push.instance = d.instance;
+        vkCmdPushConstants(c, shadowPipeline.layout(), VK_SHADER_STAGE_ALL, 0,
+                           sizeof(glm::mat4) + sizeof(uint32_t), &push);
+        vkCmdDrawIndexed(c, d.indexCount, 1, d.firstIndex, d.vertexOffset, 0);
+      }
+    }
+    vkCmdEndRendering(c);
+  }
+
   void addLightingPass(Blackboard& bb) {
     struct Io {
       TextureHandle depth, normal, albedo, material, emission, ao, lit;
+      std::vector<TextureHandle> shadows;
     };
     auto io = std::make_shared<Io>();
     // Optional input: AO from whichever effect published it, else the neutral white texture.
@@ -594,6 +815,8 @@ struct Renderer::Impl : EffectContext {
           io->material = b.read(bb.texture(res::kMaterial));
           io->emission = b.read(bb.texture(res::kEmission));
           io->ao = b.read(ao);
+          for (uint32_t slot = 0; slot < shadowMaps.size(); ++slot)
+            io->shadows.push_back(b.read(bb.texture("shadow_map_" + std::to_string(slot))));
           io->lit = b.write(b.create(res::kLit, outputRelative(VK_FORMAT_R16G16B16A16_SFLOAT)),
                             TextureUsage::StorageWrite);
         },
@@ -608,6 +831,13 @@ struct Renderer::Impl : EffectContext {
               .buffer(6, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, lightBuffer.handle())
               .storageImage(7, pc.view(io->lit))
               .sampled(8, pc.view(io->ao), linearClamp.handle());
+          for (uint32_t slot = 0; slot < kMaxShadowMaps; ++slot)
+            w.sampled(9 + slot,
+                      slot < io->shadows.size() ? pc.view(io->shadows[slot]) : neutralAO.view(),
+                      nearestClamp.handle());
+          w.buffer(13, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, shadowViewBuffer.handle())
+              .sampled(14, environmentMap.handle() ? environmentMap.view() : neutralAO.view(),
+                       linearRepeat.handle());
           bind(pc.cmd(), lightingPipeline, w);
           vkCmdDispatch(pc.cmd(), groups(settings.width), groups(settings.height), 1);
         });
@@ -670,10 +900,12 @@ struct Renderer::Impl : EffectContext {
     f.cameraPos = glm::vec4(c.position, 1.0f);
     const Environment& e = scene.environment;
     const bool constant = e.kind == Environment::Kind::Constant;
+    const float kind = constant ? 1.0f : environmentMap.handle() ? 2.0f : 0.0f;
     f.skyZenith = glm::vec4(e.zenithColor, std::max(e.intensity, 0.0f));
-    f.skyHorizon = glm::vec4(e.horizonColor, constant ? 1.0f : 0.0f);
+    f.skyHorizon = glm::vec4(e.horizonColor, kind);
     f.skyGround = glm::vec4(constant ? e.constantColor : e.groundColor, 0.0f);
     f.params = glm::vec4(settings.exposure, float(lightCount), c.znear, c.zfar);
+    for (int i = 0; i < 9; ++i) f.irradianceSH[i] = glm::vec4(irradiance[i], 0.0f);
     frameBuffer.write(&f, sizeof f);
   }
 

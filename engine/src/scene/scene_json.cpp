@@ -30,8 +30,10 @@
 //                 "color": [1, 1, 1], "intensity": 1 (candela; lux for directional),
 //                 "range": 0 (0: infinite), "inner_cone_deg": 0, "outer_cone_deg": 45,
 //                 "casts_shadows": true } ],
-//   "environment": { "type": "sky" | "constant", "intensity": 1,
+//   "environment": { "type": "sky" | "constant" | "map", "intensity": 1,
 //                    "color": [r, g, b] (constant only),
+//                    "file": "sky.hdr" (map only, required: equirectangular Radiance .hdr,
+//                            relative to the scene file; ${GI_SHARED_ASSETS} expands),
 //                    "zenith_color", "horizon_color", "ground_color": [r, g, b] (sky only) },
 //   "effects": [ "ssao", { "name": "bloom", "settings": { ... } } ]
 // }
@@ -49,6 +51,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 
+#include "gi/environment.h"
 #include "gi/errors.h"
 #include "gi/scene_io.h"
 #include "json_check.h"
@@ -346,7 +349,8 @@ class SceneJsonLoader {
   }
 
   void readEnvironment(const JsonObject& e) {
-    e.allowOnly({"type", "intensity", "color", "zenith_color", "horizon_color", "ground_color"});
+    e.allowOnly(
+        {"type", "intensity", "color", "zenith_color", "horizon_color", "ground_color", "file"});
     Environment& env = scene_.environment;
     const std::string type = e.string("type").value_or("sky");
     if (type == "sky") {
@@ -360,9 +364,23 @@ class SceneJsonLoader {
       for (const char* k : {"zenith_color", "horizon_color", "ground_color"})
         if (e.has(k)) e.schemaError(k, "only for \"type\": \"sky\"");
       env.constantColor = nonNegativeColor(e, "color", env.constantColor);
+    } else if (type == "map") {
+      for (const char* k : {"color", "zenith_color", "horizon_color", "ground_color"})
+        if (e.has(k)) e.schemaError(k, "not for \"type\": \"map\"");
+      const std::string file = e.requireString("file");
+      const fs::path resolved = expandModelPath(file, fs::path(path_).parent_path(), e, path_);
+      std::error_code ec;
+      if (!fs::exists(resolved, ec))
+        throw Error(
+            ErrorKind::MissingResource, path_,
+            e.pathOf("file") + ": environment map '" + resolved.string() + "' does not exist");
+      if (detail::lowerExtension(resolved.string()) != ".hdr")
+        e.schemaError("file", "'" + file + "' is not a Radiance .hdr file");
+      loadEnvironmentMap(env, resolved.string());
     } else {
-      e.schemaError("type", "unknown environment type '" + type + "' (sky or constant)");
+      e.schemaError("type", "unknown environment type '" + type + "' (sky, constant or map)");
     }
+    if (type != "map" && e.has("file")) e.schemaError("file", "only for \"type\": \"map\"");
     env.intensity = nonNegative(e, "intensity", env.intensity);
   }
 

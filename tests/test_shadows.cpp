@@ -1,0 +1,195 @@
+// Shadow maps: a box above a plane under directional, spot and point lights darkens the
+// analytically expected footprint and nothing else; no acne on the lit plane at the default
+// bias; shadow passes exist only for shadow-casting lights whose result lighting reads.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+
+#include "gi/renderer.h"
+#include "gi/scene_io.h"
+#include "process.h"
+#include "vulkan_fixture.h"
+
+namespace gi {
+namespace {
+
+using test::VulkanTest;
+
+const glm::vec3 kBoxMin(-0.25f, 0.75f, -0.25f), kBoxMax(0.25f, 1.25f, 0.25f);
+
+std::string lightJson(const std::string& type) {
+  if (type == "directional")
+    return R"({"type": "directional", "direction": [1, -2, 0], "intensity": 3})";
+  if (type == "spot")
+    return R"({"type": "spot", "position": [-1.2, 3, 0.2], "direction": [0.45, -1, -0.07],
+               "outer_cone_deg": 60, "inner_cone_deg": 50, "intensity": 30})";
+  return R"({"type": "point", "position": [-1.0, 2.5, 0.3], "intensity": 20})";
+}
+
+// Plane y = 0 (5 x 5), a 0.5 box floating at y = 1, camera straight above, dim constant sky.
+Scene boxScene(const std::string& light) {
+  const std::string dir = test::makeTempDir("shadow-scene");
+  const std::string path = dir + "/scene.json";
+  std::ofstream(path) << R"({
+    "models": [
+      {"primitive": "plane", "size": 5, "material": {"base_color": [0.8, 0.8, 0.8]}},
+      {"primitive": "box", "size": 0.5, "translation": [0, 1, 0]}],
+    "camera": {"position": [0, 5, 0], "target": [0, 0, 0], "up": [0, 0, -1], "yfov_deg": 60},
+    "lights": [)" + lightJson(light) +
+                             R"(],
+    "environment": {"type": "constant", "color": [1, 1, 1], "intensity": 0.02}})";
+  return loadScene(path);
+}
+
+bool rayHitsBox(const glm::vec3& o, const glm::vec3& d, float tMax) {
+  float t0 = 1e-4f, t1 = tMax;
+  for (int a = 0; a < 3; ++a) {
+    if (std::abs(d[a]) < 1e-12f) {
+      if (o[a] < kBoxMin[a] || o[a] > kBoxMax[a]) return false;
+      continue;
+    }
+    float ta = (kBoxMin[a] - o[a]) / d[a], tb = (kBoxMax[a] - o[a]) / d[a];
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+  }
+  return t0 <= t1;
+}
+
+struct Frame {
+  ImageRGBA32F lit, depth;
+  CameraView camera;
+};
+
+Frame render(vk::Context& ctx, const Scene& scene, uint32_t shadowSize = 512) {
+  RenderSettings rs;
+  rs.width = 160;
+  rs.height = 120;
+  rs.view = "lit";
+  rs.shadowMapSize = shadowSize;
+  Renderer r(ctx, scene, rs);
+  r.renderFrame();
+  return {r.readTarget("lit"), r.readTarget("depth"), r.camera()};
+}
+
+glm::vec3 worldPosition(const Frame& f, int x, int y) {
+  const float d = f.depth.pixels[(size_t(y) * f.depth.width + x) * 4];
+  const glm::vec2 uv((x + 0.5f) / f.depth.width, (y + 0.5f) / f.depth.height);
+  glm::vec4 v = glm::inverse(f.camera.proj) * glm::vec4(uv * 2.0f - 1.0f, d, 1.0f);
+  v /= v.w;
+  return glm::vec3(glm::inverse(f.camera.view) * v);
+}
+
+class ShadowTest : public VulkanTest, public ::testing::WithParamInterface<std::string> {};
+
+TEST_P(ShadowTest, BoxShadowFallsOnTheExpectedPixelsOnly) {
+  const std::string type = GetParam();
+  Scene scene = boxScene(type);
+  const Frame shadowed = render(ctx(), scene);
+  for (Light& l : scene.lights) l.castsShadows = false;
+  const Frame open = render(ctx(), scene);
+
+  const Node* lightNode = nullptr;
+  for (const Node& n : scene.nodes)
+    if (n.light >= 0) lightNode = &n;
+  ASSERT_NE(lightNode, nullptr);
+  const glm::vec3 lightPos(lightNode->world[3]);
+  const glm::vec3 lightDir = glm::normalize(glm::vec3(lightNode->world * glm::vec4(0, 0, -1, 0)));
+
+  int inside = 0, outside = 0, darkInside = 0;
+  std::vector<float> ratios;
+  for (int y = 0; y < shadowed.lit.height; ++y)
+    for (int x = 0; x < shadowed.lit.width; ++x) {
+      const glm::vec3 p = worldPosition(shadowed, x, y);
+      if (std::abs(p.y) > 1e-3f || std::abs(p.x) > 2.4f || std::abs(p.z) > 2.4f) continue;
+      // Classify with a margin around the footprint's edge (PCF and texel quantisation).
+      auto occluded = [&](const glm::vec3& q) {
+        if (type == "directional") return rayHitsBox(q, -lightDir, 100.0f);
+        const glm::vec3 toLight = lightPos - q;
+        return rayHitsBox(q, toLight / glm::length(toLight), glm::length(toLight));
+      };
+      int hits = 0;
+      const float m = 0.06f;
+      for (glm::vec2 o :
+           {glm::vec2(0), glm::vec2(m, 0), glm::vec2(-m, 0), glm::vec2(0, m), glm::vec2(0, -m),
+            glm::vec2(m, m), glm::vec2(-m, -m), glm::vec2(m, -m), glm::vec2(-m, m)})
+        hits += occluded(p + glm::vec3(o.x, 0, o.y)) ? 1 : 0;
+      const size_t i = (size_t(y) * shadowed.lit.width + x) * 4;
+      const float s = shadowed.lit.pixels[i + 1], u = open.lit.pixels[i + 1];
+      if (hits == 9) {
+        ++inside;
+        // Only the ambient term remains (0.02 * albedo): far below the direct light.
+        if (s < 0.2f * u) ++darkInside;
+      } else if (hits == 0 && u > 0.05f) {
+        ++outside;
+        ratios.push_back(s / u);
+      }
+    }
+  EXPECT_GT(inside, 30) << "footprint not on screen";
+  EXPECT_GT(outside, 1000);
+  EXPECT_EQ(darkInside, inside) << type << ": pixels inside the footprint left lit";
+  // No acne: the lit plane equals the unshadowed render within a tight tolerance.
+  size_t bad = 0;
+  for (float r : ratios)
+    if (std::abs(r - 1.0f) > 0.005f) ++bad;
+  EXPECT_EQ(bad, 0u) << type << ": " << bad << " of " << ratios.size()
+                     << " lit plane pixels differ from the unshadowed render";
+}
+
+INSTANTIATE_TEST_SUITE_P(LightTypes, ShadowTest, ::testing::Values("directional", "spot", "point"));
+
+using Passes = std::vector<std::string>;
+
+class ShadowGraphTest : public VulkanTest {};
+
+TEST_F(ShadowGraphTest, ShadowPassOnlyForShadowCastingLightsThatLightingReads) {
+  Scene scene = boxScene("spot");
+  RenderSettings rs;
+  rs.width = 64;
+  rs.height = 48;
+  rs.shadowMapSize = 256;
+  {
+    Renderer r(ctx(), scene, rs);
+    r.renderFrame();
+    EXPECT_EQ(r.passNames(), (Passes{"gbuffer", "shadow_0", "lighting", "tonemap"}));
+    const ImageRGBA32F map = r.readTarget("shadow_map_0");
+    EXPECT_EQ(map.width, 256);
+    float maxDepth = 0.0f;
+    for (size_t i = 0; i < map.pixels.size(); i += 4) maxDepth = std::max(maxDepth, map.pixels[i]);
+    EXPECT_GT(maxDepth, 0.0f) << "nothing rendered into the shadow map";
+  }
+  {
+    RenderSettings normal = rs;
+    normal.view = "normal";  // lighting culled: its shadow pass too
+    Renderer r(ctx(), scene, normal);
+    r.renderFrame();
+    EXPECT_EQ(r.passNames(), (Passes{"gbuffer"}));
+    const Passes culled = r.culledPassNames();
+    EXPECT_NE(std::find(culled.begin(), culled.end(), "shadow_0"), culled.end());
+  }
+  scene.lights[0].castsShadows = false;
+  {
+    Renderer r(ctx(), scene, rs);
+    r.renderFrame();
+    EXPECT_EQ(r.passNames(), (Passes{"gbuffer", "lighting", "tonemap"}));
+    EXPECT_TRUE(r.culledPassNames().size() == 1u);  // floor
+  }
+}
+
+TEST_F(ShadowGraphTest, PointLightRendersSixFacesIntoOneAtlas) {
+  Scene scene = boxScene("point");
+  RenderSettings rs;
+  rs.width = 64;
+  rs.height = 48;
+  rs.shadowMapSize = 128;
+  Renderer r(ctx(), scene, rs);
+  r.renderFrame();
+  const ImageRGBA32F map = r.readTarget("shadow_map_0");
+  EXPECT_EQ(map.width, 3 * 128);
+  EXPECT_EQ(map.height, 2 * 128);
+}
+
+}  // namespace
+}  // namespace gi
