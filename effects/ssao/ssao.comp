@@ -1,0 +1,110 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#include "common.glsl"
+
+// Screen-space ambient occlusion (RTR 11.3.6, seed 001 §4.2-4.3). The estimator, kernel
+// distribution and interleaving are described in ssao_kernel.h. Reads the reverse-Z depth and
+// the view-space normal; writes AO (1 = open) per pixel.
+//
+// Assumes a perspective projection (clip.w = view distance), as every engine camera has.
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
+// Keep in sync with gi::ssao::Uniforms (ssao_kernel.h).
+layout(set = 0, binding = 1) uniform SsaoParams {
+  vec4 params;   // radius, bias (world), intensity, blur depth tolerance (world)
+  ivec4 counts;  // samples, blur radius
+  vec4 rotation[16];
+  vec4 kernel[64];
+} ssao;
+layout(set = 0, binding = 2) uniform sampler2D gDepth;
+layout(set = 0, binding = 3) uniform sampler2D gNormal;
+layout(set = 0, binding = 4, r16f) uniform writeonly image2D outAO;
+
+// Guard: taps at or behind the camera plane (clip.w below this) are untestable: open.
+const float kMinClipW = 1e-20;
+// Guard: the texel-centre slide (below) is skipped when the tap's tangent-parallel plane passes
+// this close to the camera (|N.Q| below kSlideMinK x view distance): it would be ill-conditioned.
+const float kSlideMinK = 1e-4;
+
+void main() {
+  ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+  ivec2 size = ivec2(frame.viewport.xy);
+  if (p.x >= size.x || p.y >= size.y) return;
+
+  float depth = texelFetch(gDepth, p, 0).r;
+  vec4 normalTexel = texelFetch(gNormal, p, 0);
+  // Guard: sky / far-plane pixels (depth 0) and pixels without geometry are open; no taps.
+  if (isSky(depth) || !(normalTexel.w > 0.5)) {
+    imageStore(outAO, p, vec4(1.0));
+    return;
+  }
+
+  vec2 uv = (vec2(p) + 0.5) * frame.viewport.zw;
+  vec3 P = viewPositionFromDepth(frame.invProj, uv, depth);
+  // Guard: a zero or NaN normal falls back to facing the camera.
+  vec3 N = safeNormalize(normalTexel.xyz, safeNormalize(-P, vec3(0.0, 0.0, 1.0)));
+
+  // Tangent frame without a helper axis (Duff et al. 2017, "Building an orthonormal basis,
+  // revisited"): |s + N.z| >= 1, so it never degenerates, whatever the normal's direction.
+  float s = N.z >= 0.0 ? 1.0 : -1.0;
+  float a = -1.0 / (s + N.z);
+  float b = N.x * N.y * a;
+  vec3 T = vec3(1.0 + s * N.x * N.x * a, s * b, -s * N.x);
+  vec3 B = vec3(b, s + N.y * N.y * a, -N.y);
+  vec2 rot = ssao.rotation[(p.y & 3) * 4 + (p.x & 3)].xy;  // interleave: 16 rotations
+  vec3 Tr = rot.x * T + rot.y * B;
+  vec3 Br = rot.x * B - rot.y * T;
+
+  // Taps are projected incrementally: clip(Q) = clip(P) + x clip(R T') + y clip(R B') + z clip(R N)
+  // (x, y and w rows only; w is the view distance).
+  float R = ssao.params.x;
+  mat4 proj = frame.proj;
+  vec4 c0 = proj * vec4(P, 1.0), cT = proj * vec4(R * Tr, 0.0), cB = proj * vec4(R * Br, 0.0),
+       cN = proj * vec4(R * N, 0.0);
+  vec3 clipP = c0.xyw, clipT = cT.xyw, clipB = cB.xyw, clipN = cN.xyw;
+
+  // Reverse-Z depth to inverse view distance: 1/z = (d + P22) / P32 (affine in d). Guard: a
+  // degenerate projection (P32 = 0) must not divide by zero.
+  float p32 = abs(proj[3][2]) > 1e-30 ? proj[3][2] : 1e-30;
+  float invP32 = 1.0 / p32, p22 = proj[2][2];
+
+  // Texel-centre slide: the depth buffer is read at the centre of the texel a tap falls in, so
+  // the tap is moved, parallel to the tangent plane, onto that centre's view ray before the
+  // comparison. A flat surface then never occludes itself at any viewing angle (a half-texel
+  // offset along a grazing plane is otherwise a large depth error). On the plane N.X = K the
+  // inverse distance is affine in NDC: 1/z(ndc') = 1/z(ndc) + (g . (ndc' - ndc)) / K with
+  // g = (N.x / P00, N.y / P11).
+  vec2 g = vec2(N.x / (abs(proj[0][0]) > 1e-30 ? proj[0][0] : 1e-30),
+                N.y / (abs(proj[1][1]) > 1e-30 ? proj[1][1] : 1e-30));
+  float NP = dot(N, P);
+  float minK = -kSlideMinK * max(-P.z, 1e-20);  // strictly negative: min(K, minK) != 0
+
+  vec2 halfSize = 0.5 * vec2(size), texelToNdc = 2.0 * frame.viewport.zw;
+  float bias = ssao.params.y;
+  int count = clamp(ssao.counts.x, 1, 64);
+  float occluded = 0.0;
+  for (int i = 0; i < count; ++i) {
+    vec3 k = ssao.kernel[i].xyz;
+    vec3 c = clipP + clipT * k.x + clipB * k.y + clipN * k.z;
+    float invW = 1.0 / max(c.z, kMinClipW);
+    vec2 ndc = c.xy * invW;
+    vec2 pix = ndc * halfSize + halfSize;
+    // Guard: taps behind the camera or off screen count as unoccluded.
+    bool valid = c.z > kMinClipW && pix.x >= 0.0 && pix.y >= 0.0 && pix.x < float(size.x) &&
+                 pix.y < float(size.y);
+    ivec2 t = ivec2(clamp(pix, vec2(0.0), vec2(size - 1)));
+    float iS = (texelFetch(gDepth, t, 0).r + p22) * invP32;  // stored surface, 1 / distance
+
+    float K = NP + R * k.z;  // N . Q (the rotation about N leaves it unchanged)
+    vec2 dn = (vec2(t) + 0.5) * texelToNdc - 1.0 - ndc;
+    float slid = invW + dot(g, dn) / min(K, minK);
+    float iQ = (K < minK && slid > 0.0) ? slid : invW;  // tap, 1 / distance
+
+    // bias < zQ - zS < R, in inverse distances (both positive): no division needed.
+    float diff = iS - iQ, prod = iS * iQ;
+    occluded += (valid && diff > bias * prod && diff < R * prod) ? 1.0 : 0.0;
+  }
+  float ao = clamp(1.0 - ssao.params.z * occluded / float(count), 0.0, 1.0);
+  imageStore(outAO, p, vec4(ao));
+}

@@ -1,0 +1,162 @@
+// Screen-space ambient occlusion (RTR 11.3.6; seed 001 §4.2-4.3): normal-oriented hemisphere
+// taps tested against the depth buffer with a range check, 4x4 interleaved kernel rotations,
+// and a depth-aware blur that removes the interleave pattern. Publishes "ao", which the
+// lighting pass applies to the environment term. Estimator and kernel: ssao_kernel.h.
+#include <algorithm>
+#include <memory>
+#include <vector>
+
+#include "gi/effect.h"
+#include "gi/effect_registry.h"
+#include "gi/vk/pipeline.h"
+#include "gi/vk/resources.h"
+#include "ssao.comp.h"       // const uint32_t ssao_comp[]
+#include "ssao_blur.comp.h"  // const uint32_t ssao_blur_comp[]
+#include "ssao_kernel.h"
+
+namespace {
+
+namespace res = gi::resources;
+using gi::SettingType;
+
+constexpr VkFormat kAOFormat = VK_FORMAT_R16_SFLOAT;
+
+uint32_t groupsOf(uint32_t n, uint32_t size) {
+  return (n + size - 1) / size;
+}
+
+class SsaoEffect : public gi::Effect {
+ public:
+  gi::EffectInfo info() const override {
+    gi::EffectInfo i;
+    i.name = "ssao";
+    i.version = "1.0";
+    i.description =
+        "screen-space ambient occlusion (hemisphere taps, 4x4 interleave, "
+        "depth-aware blur)";
+    i.stage = gi::EffectStage::BeforeLighting;
+    i.reads = {res::kDepth, res::kNormal};
+    i.writes = {res::kAO};
+    i.debugView = res::kAO;
+    return i;
+  }
+
+  std::vector<gi::SettingDesc> settings() const override {
+    return {
+        {"radius", SettingType::Float, 0.5, 1e-4, 1e4,
+         "world-space radius R of the sampled hemisphere (scale it with the scene)", false},
+        {"samples", SettingType::Int, 16, 1, gi::ssao::kMaxSamples, "taps per pixel", false},
+        {"bias", SettingType::Float, 0.025, 0.0, 0.5,
+         "an occluder must be this far in front of a tap, as a fraction of the radius", false},
+        {"intensity", SettingType::Float, 1.0, 0.0, 4.0,
+         "AO = 1 - intensity x occluded fraction (clamped to [0, 1])", false},
+        {"blur_radius", SettingType::Int, 2, 0, gi::ssao::kMaxBlurRadius,
+         "depth-aware blur radius in pixels (0: no blur pass; even radii cancel the 4x4 "
+         "interleave pattern exactly)",
+         true},
+        {"interleave", SettingType::Bool, 1, 0, 1,
+         "rotate the kernel in a 4x4 pixel pattern (16 rotations) for the blur to average", false},
+    };
+  }
+
+  void prepare(gi::EffectContext& ctx, const gi::SettingValues&) override {
+    gi::vk::Context& vk = ctx.vulkan();
+    const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
+               tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+               img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+    ssao_ = gi::vk::Pipeline::compute(vk, {std::begin(ssao_comp), std::end(ssao_comp)},
+                                      {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, img}});
+    blur_ = gi::vk::Pipeline::compute(vk, {std::begin(ssao_blur_comp), std::end(ssao_blur_comp)},
+                                      {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, tex}, {5, img}});
+    if (!uniforms_)
+      uniforms_ =
+          gi::vk::Buffer(vk, sizeof(gi::ssao::Uniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true);
+  }
+
+  void addPasses(gi::FrameGraph& graph, gi::EffectContext& ctx,
+                 const gi::SettingValues& settings) override {
+    struct Io {
+      gi::TextureHandle depth, normal, raw, ao;
+    };
+    auto io = std::make_shared<Io>();
+    gi::Blackboard& bb = graph.blackboard();
+    const int blurRadius = settings.integer("blur_radius");  // changesGraph: fixed per graph
+    const VkBuffer frame = ctx.frameUniforms();
+    const VkSampler nearest = ctx.nearestSampler();
+
+    // The renderer keeps `settings` alive for the graph's life and updates it in place, so
+    // uniform-only settings are read (and uploaded) when the pass is recorded, every frame.
+    graph.addPass(
+        "ssao",
+        [&](gi::PassBuilder& b) {
+          io->depth = b.read(bb.texture(res::kDepth));
+          io->normal = b.read(bb.texture(res::kNormal));
+          io->raw =
+              b.write(b.create(blurRadius > 0 ? "ssao_raw" : res::kAO, gi::TextureDesc{kAOFormat}),
+                      gi::TextureUsage::StorageWrite);
+        },
+        [this, io, values = &settings, frame, nearest](gi::PassContext& pc) {
+          upload(*values);
+          gi::vk::DescriptorWriter w;
+          w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame)
+              .buffer(1, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms_.handle())
+              .sampled(2, pc.view(io->depth), nearest)
+              .sampled(3, pc.view(io->normal), nearest)
+              .storageImage(4, pc.view(io->raw));
+          const VkExtent2D e = pc.extent(io->raw);
+          dispatch(pc, ssao_, w, groupsOf(e.width, 8), groupsOf(e.height, 8));
+        });
+
+    io->ao = io->raw;
+    if (blurRadius > 0) {
+      graph.addPass(
+          "ssao_blur",
+          [&](gi::PassBuilder& b) {
+            io->depth = b.read(io->depth);
+            io->normal = b.read(io->normal);
+            io->raw = b.read(io->raw);
+            io->ao = b.write(b.create(res::kAO, gi::TextureDesc{kAOFormat}),
+                             gi::TextureUsage::StorageWrite);
+          },
+          [this, io, frame, nearest](gi::PassContext& pc) {
+            gi::vk::DescriptorWriter w;
+            w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame)
+                .buffer(1, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms_.handle())
+                .sampled(2, pc.view(io->depth), nearest)
+                .sampled(3, pc.view(io->normal), nearest)
+                .sampled(4, pc.view(io->raw), nearest)
+                .storageImage(5, pc.view(io->ao));
+            const VkExtent2D e = pc.extent(io->ao);
+            dispatch(pc, blur_, w, groupsOf(e.width, 16), groupsOf(e.height, 16));
+          });
+    }
+    bb.put(res::kAO, io->ao);
+  }
+
+ private:
+  // Host-visible and written while recording: the renderer waits for each frame before it
+  // records the next, so the GPU is not reading it. (Frames in flight would need one per frame.)
+  void upload(const gi::SettingValues& s) {
+    const gi::ssao::Uniforms u = gi::ssao::makeUniforms(
+        s.number("radius"), s.number("bias"), s.number("intensity"), s.integer("samples"),
+        s.integer("blur_radius"), s.flag("interleave"));
+    uniforms_.write(&u, sizeof u);
+  }
+
+  static void dispatch(gi::PassContext& pc, const gi::vk::Pipeline& p, gi::vk::DescriptorWriter& w,
+                       uint32_t x, uint32_t y) {
+    VkDescriptorSet set = pc.descriptors().allocate(p.setLayout());
+    w.update(pc.context().device(), set);
+    vkCmdBindPipeline(pc.cmd(), VK_PIPELINE_BIND_POINT_COMPUTE, p.handle());
+    vkCmdBindDescriptorSets(pc.cmd(), VK_PIPELINE_BIND_POINT_COMPUTE, p.layout(), 0, 1, &set, 0,
+                            nullptr);
+    vkCmdDispatch(pc.cmd(), x, y, 1);
+  }
+
+  gi::vk::Pipeline ssao_, blur_;
+  gi::vk::Buffer uniforms_;
+};
+
+}  // namespace
+
+GI_EFFECT_MODULE(SsaoEffect)
