@@ -237,6 +237,20 @@ TEST_F(SsaoTest, NoHaloAcrossDepthDiscontinuities) {
   }
 }
 
+TEST_F(SsaoTest, SsaoOnlyPassList) {
+  EffectOverrides cli;
+  cli.effects = std::vector<std::string>{"ssao"};
+  RenderSettings rs;
+  rs.width = kW;
+  rs.height = kH;
+  Scene scene = cornerScene();  // no lights: no shadow pass
+  rs.effects = resolveEffects(scene, nullptr, cli, registry);
+  Renderer r(ctx(), scene, rs, &registry);
+  r.renderFrame();
+  EXPECT_EQ(r.passNames(),
+            (std::vector<std::string>{"gbuffer", "ssao", "ssao_blur", "lighting", "tonemap"}));
+}
+
 TEST_F(SsaoTest, DebugViewRunsOnlyWhatFeedsIt) {
   EffectOverrides cli;
   cli.effects = std::vector<std::string>{"ssao"};

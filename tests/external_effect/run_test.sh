@@ -105,4 +105,12 @@ render both vignette,ext_grey
 expect "$tmp/both.log" "^  \[run\] +vignette$" "vignette pass not executed"
 expect "$tmp/both.log" "^  \[run\] +ext_grey$" "ext_grey pass not executed"
 render grey_view ext_grey --view ext_grey
+
+step "SSAO (in-tree plugin) together with the out-of-tree vignette: exact executed passes"
+if [ -f "$(dirname "$gi")/plugins/gi_effect_ssao.so" ]; then
+  render ssao_vignette ssao,vignette
+  got=$(sed -n 's/^  \[run\] *//p' "$tmp/ssao_vignette.log" | tr '\n' ' ')
+  want="gbuffer shadow_0 ssao ssao_blur lighting vignette tonemap "
+  [ "$got" = "$want" ] || fail "executed passes: got '$got', want '$want'"
+fi
 step "passed"
