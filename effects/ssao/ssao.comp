@@ -15,7 +15,7 @@ layout(set = 0, binding = 1) uniform SsaoParams {
   vec4 params;   // radius, bias (world), intensity, blur depth tolerance (world)
   ivec4 counts;  // samples, blur radius
   vec4 rotation[16];
-  vec4 kernel[64];
+  uvec4 kernel[16];  // tap i: kernel[i / 4][i % 4], 11/11/10 bits (gi::ssao::packTap)
 } ssao;
 layout(set = 0, binding = 2) uniform sampler2D gDepth;
 layout(set = 0, binding = 3) uniform sampler2D gNormal;
@@ -56,13 +56,16 @@ void main() {
   vec3 Tr = rot.x * T + rot.y * B;
   vec3 Br = rot.x * B - rot.y * T;
 
-  // Taps are projected incrementally: clip(Q) = clip(P) + x clip(R T') + y clip(R B') + z clip(R N)
-  // (x, y and w rows only; w is the view distance).
+  // Taps are projected incrementally: clip(Q) = clip(P) + x clip(R T') + y clip(R B') + z clip(R N),
+  // keeping only x, y and w (the view distance), with x and y already mapped to pixels:
+  // pixel = (x + w) / w * size / 2.
   float R = ssao.params.x;
   mat4 proj = frame.proj;
   vec4 c0 = proj * vec4(P, 1.0), cT = proj * vec4(R * Tr, 0.0), cB = proj * vec4(R * Br, 0.0),
        cN = proj * vec4(R * N, 0.0);
-  vec3 clipP = c0.xyw, clipT = cT.xyw, clipB = cB.xyw, clipN = cN.xyw;
+  vec2 halfSize = 0.5 * vec2(size);
+  vec3 clipP = vec3((c0.xy + c0.w) * halfSize, c0.w), clipT = vec3((cT.xy + cT.w) * halfSize, cT.w),
+       clipB = vec3((cB.xy + cB.w) * halfSize, cB.w), clipN = vec3((cN.xy + cN.w) * halfSize, cN.w);
 
   // Reverse-Z depth to inverse view distance: 1/z = (d + P22) / P32 (affine in d). Guard: a
   // degenerate projection (P32 = 0) must not divide by zero.
@@ -74,31 +77,33 @@ void main() {
   // comparison. A flat surface then never occludes itself at any viewing angle (a half-texel
   // offset along a grazing plane is otherwise a large depth error). On the plane N.X = K the
   // inverse distance is affine in NDC: 1/z(ndc') = 1/z(ndc) + (g . (ndc' - ndc)) / K with
-  // g = (N.x / P00, N.y / P11).
+  // g = (N.x / P00, N.y / P11); here in pixel units (g scaled by 2 / size).
   vec2 g = vec2(N.x / (abs(proj[0][0]) > 1e-30 ? proj[0][0] : 1e-30),
-                N.y / (abs(proj[1][1]) > 1e-30 ? proj[1][1] : 1e-30));
+                N.y / (abs(proj[1][1]) > 1e-30 ? proj[1][1] : 1e-30)) *
+           2.0 * frame.viewport.zw;
   float NP = dot(N, P);
   float minK = -kSlideMinK * max(-P.z, 1e-20);  // strictly negative: min(K, minK) != 0
 
-  vec2 halfSize = 0.5 * vec2(size), texelToNdc = 2.0 * frame.viewport.zw;
+  vec2 sizeF = vec2(size);
   float bias = ssao.params.y;
   int count = clamp(ssao.counts.x, 1, 64);
   float occluded = 0.0;
   for (int i = 0; i < count; ++i) {
-    vec3 k = ssao.kernel[i].xyz;
+    uint code = ssao.kernel[i >> 2][i & 3];
+    vec3 k = vec3(float(code & 2047u) * (2.0 / 2047.0) - 1.0,
+                  float((code >> 11) & 2047u) * (2.0 / 2047.0) - 1.0,
+                  float(code >> 22) * (1.0 / 1023.0));
     vec3 c = clipP + clipT * k.x + clipB * k.y + clipN * k.z;
     float invW = 1.0 / max(c.z, kMinClipW);
-    vec2 ndc = c.xy * invW;
-    vec2 pix = ndc * halfSize + halfSize;
+    vec2 pix = c.xy * invW;
     // Guard: taps behind the camera or off screen count as unoccluded.
-    bool valid = c.z > kMinClipW && pix.x >= 0.0 && pix.y >= 0.0 && pix.x < float(size.x) &&
-                 pix.y < float(size.y);
-    ivec2 t = ivec2(clamp(pix, vec2(0.0), vec2(size - 1)));
+    bool valid = c.z > kMinClipW && pix.x >= 0.0 && pix.y >= 0.0 && pix.x < sizeF.x &&
+                 pix.y < sizeF.y;
+    ivec2 t = ivec2(clamp(pix, vec2(0.0), sizeF - 1.0));
     float iS = (texelFetch(gDepth, t, 0).r + p22) * invP32;  // stored surface, 1 / distance
 
     float K = NP + R * k.z;  // N . Q (the rotation about N leaves it unchanged)
-    vec2 dn = (vec2(t) + 0.5) * texelToNdc - 1.0 - ndc;
-    float slid = invW + dot(g, dn) / min(K, minK);
+    float slid = invW + dot(g, vec2(t) + 0.5 - pix) / min(K, minK);
     float iQ = (K < minK && slid > 0.0) ? slid : invW;  // tap, 1 / distance
 
     // bias < zQ - zS < R, in inverse distances (both positive): no division needed.

@@ -67,7 +67,8 @@ class SsaoEffect : public gi::Effect {
     ssao_ = gi::vk::Pipeline::compute(vk, {std::begin(ssao_comp), std::end(ssao_comp)},
                                       {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, img}});
     blur_ = gi::vk::Pipeline::compute(vk, {std::begin(ssao_blur_comp), std::end(ssao_blur_comp)},
-                                      {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, tex}, {5, img}});
+                                      {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, tex}, {5, img}},
+                                      2 * sizeof(int32_t));  // the blur axis
     if (!uniforms_)
       uniforms_ =
           gi::vk::Buffer(vk, sizeof(gi::ssao::Uniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true);
@@ -76,7 +77,7 @@ class SsaoEffect : public gi::Effect {
   void addPasses(gi::FrameGraph& graph, gi::EffectContext& ctx,
                  const gi::SettingValues& settings) override {
     struct Io {
-      gi::TextureHandle depth, normal, raw, ao;
+      gi::TextureHandle depth, normal, raw, half, ao;
     };
     auto io = std::make_shared<Io>();
     gi::Blackboard& bb = graph.blackboard();
@@ -109,25 +110,37 @@ class SsaoEffect : public gi::Effect {
 
     io->ao = io->raw;
     if (blurRadius > 0) {
+      // Separable: along x into `half`, then along y into "ao", two dispatches in one pass.
       graph.addPass(
           "ssao_blur",
           [&](gi::PassBuilder& b) {
             io->depth = b.read(io->depth);
             io->normal = b.read(io->normal);
             io->raw = b.read(io->raw);
+            io->half = b.write(b.create("ssao_blur_x", gi::TextureDesc{kAOFormat}),
+                               gi::TextureUsage::StorageWrite);
             io->ao = b.write(b.create(res::kAO, gi::TextureDesc{kAOFormat}),
                              gi::TextureUsage::StorageWrite);
           },
           [this, io, frame, nearest](gi::PassContext& pc) {
-            gi::vk::DescriptorWriter w;
-            w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame)
-                .buffer(1, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms_.handle())
-                .sampled(2, pc.view(io->depth), nearest)
-                .sampled(3, pc.view(io->normal), nearest)
-                .sampled(4, pc.view(io->raw), nearest)
-                .storageImage(5, pc.view(io->ao));
             const VkExtent2D e = pc.extent(io->ao);
-            dispatch(pc, blur_, w, groupsOf(e.width, 16), groupsOf(e.height, 16));
+            auto axis = [&](VkImageView in, VkImageLayout inLayout, VkImageView out, int dx) {
+              gi::vk::DescriptorWriter w;
+              w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame)
+                  .buffer(1, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms_.handle())
+                  .sampled(2, pc.view(io->depth), nearest)
+                  .sampled(3, pc.view(io->normal), nearest)
+                  .sampled(4, in, nearest, inLayout)
+                  .storageImage(5, out);
+              const int32_t direction[2] = {dx, 1 - dx};
+              dispatch(pc, blur_, w, groupsOf(e.width, 8), groupsOf(e.height, 8), direction,
+                       sizeof direction);
+            };
+            axis(pc.view(io->raw), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, pc.view(io->half), 1);
+            // The graph orders passes, not dispatches inside one: the y dispatch reads what the
+            // x dispatch wrote (the image stays GENERAL, as storage images are).
+            imageBarrier(pc.cmd(), pc.image(io->half));
+            axis(pc.view(io->half), VK_IMAGE_LAYOUT_GENERAL, pc.view(io->ao), 0);
           });
     }
     bb.put(res::kAO, io->ao);
@@ -144,13 +157,31 @@ class SsaoEffect : public gi::Effect {
   }
 
   static void dispatch(gi::PassContext& pc, const gi::vk::Pipeline& p, gi::vk::DescriptorWriter& w,
-                       uint32_t x, uint32_t y) {
+                       uint32_t x, uint32_t y, const void* push = nullptr, uint32_t pushBytes = 0) {
     VkDescriptorSet set = pc.descriptors().allocate(p.setLayout());
     w.update(pc.context().device(), set);
     vkCmdBindPipeline(pc.cmd(), VK_PIPELINE_BIND_POINT_COMPUTE, p.handle());
     vkCmdBindDescriptorSets(pc.cmd(), VK_PIPELINE_BIND_POINT_COMPUTE, p.layout(), 0, 1, &set, 0,
                             nullptr);
+    if (pushBytes > 0)
+      vkCmdPushConstants(pc.cmd(), p.layout(), VK_SHADER_STAGE_ALL, 0, pushBytes, push);
     vkCmdDispatch(pc.cmd(), x, y, 1);
+  }
+
+  // Compute write -> compute sampled read of a storage image that stays in GENERAL.
+  static void imageBarrier(VkCommandBuffer cmd, VkImage image) {
+    VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
+    b.srcStageMask = b.dstStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+    b.srcAccessMask = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
+    b.dstAccessMask = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT;
+    b.oldLayout = b.newLayout = VK_IMAGE_LAYOUT_GENERAL;
+    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    b.image = image;
+    b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+    VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+    dep.imageMemoryBarrierCount = 1;
+    dep.pImageMemoryBarriers = &b;
+    vkCmdPipelineBarrier2(cmd, &dep);
   }
 
   gi::vk::Pipeline ssao_, blur_;

@@ -20,11 +20,14 @@
 // distance d along w, the taps beyond d are inside it: fraction 1 - d / R).
 //
 // Interleaving (seed 001 §4.2): pixel (x, y) uses rotation table entry (y & 3) * 4 + (x & 3);
-// the 16 entries are the angles 2 pi j / (16 n), j taken from a 4x4 Bayer matrix so that
-// neighbours differ most. Together the 16 rotated kernels stratify the azimuth 16n ways, and a
-// 4x4 box over the pattern averages all of them.
+// entry j (ranked by a 4x4 Bayer matrix, so that neighbours differ most) rotates the kernel by
+// 2 pi j (n + 1) / (16 n) = 2 pi j / 16 + 2 pi j / (16 n). The first term sends each tap's 16
+// copies round the whole circle (a 4x4 box then averages every tap over all azimuths instead of
+// showing one shifted silhouette per tap); the second keeps the 16 n azimuths of the union
+// distinct: for even n they are exactly the 16 n strata 2 pi (k + 0.5) / (16 n).
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -46,10 +49,10 @@ struct Uniforms {
   int32_t samples;      // taps used, 1..kMaxSamples
   int32_t blurRadius;   // 0..kMaxBlurRadius
   int32_t pad[2];
-  float rotation[16][4];         // cos, sin of each 4x4 phase's kernel rotation, 0, 0
-  float kernel[kMaxSamples][4];  // x, y, z (tangent space, unit radius), 0
+  float rotation[16][4];                // cos, sin of each 4x4 phase's kernel rotation, 0, 0
+  uint32_t kernel[kMaxSamples / 4][4];  // tap i at [i / 4][i % 4], packed by packTap()
 };
-static_assert(sizeof(Uniforms) == 32 + 16 * 16 + kMaxSamples * 16, "std140 layout");
+static_assert(sizeof(Uniforms) == 32 + 16 * 16 + kMaxSamples * 4, "std140 layout");
 
 inline double radicalInverse(uint32_t i, uint32_t base) {
   double inv = 1.0 / base, f = inv, r = 0.0;
@@ -69,12 +72,34 @@ inline Tap tapFromUniform(double u, double v, double w) {
           float(w * cosTheta)};
 }
 
-inline Tap kernelTap(int i, int n) {
+// One tap in 32 bits: x and y in [-1, 1] with 11 bits each, z in [0, 1] with 10 bits (steps
+// of 1e-3 R at most). The shader unpacks one uint per tap: llvmpipe gathers a UBO value indexed
+// by the loop counter lane by lane, so three floats per tap cost three gathers.
+inline uint32_t packTap(Tap t) {
+  auto q = [](float v, float lo, float hi, uint32_t maxCode) {
+    const float c = std::round((std::clamp(v, lo, hi) - lo) / (hi - lo) * float(maxCode));
+    return uint32_t(c);
+  };
+  return q(t.x, -1.0f, 1.0f, 2047) | q(t.y, -1.0f, 1.0f, 2047) << 11 |
+         q(t.z, 0.0f, 1.0f, 1023) << 22;
+}
+// Exactly what ssao.comp decodes.
+inline Tap unpackTap(uint32_t p) {
+  return {float(p & 2047u) * (2.0f / 2047.0f) - 1.0f,
+          float((p >> 11) & 2047u) * (2.0f / 2047.0f) - 1.0f, float(p >> 22) * (1.0f / 1023.0f)};
+}
+
+// Tap i of the n-tap kernel before quantization: the shifted 3-D Hammersley point, mapped.
+inline Tap exactKernelTap(int i, int n) {
   const double shift = 0.5 / n;
   const double u = (i + 0.5) / n;
   const double v = std::fmod(radicalInverse(uint32_t(i), 2) + shift, 1.0);
   const double w = std::fmod(radicalInverse(uint32_t(i), 3) + shift, 1.0);
   return tapFromUniform(u, v, w);
+}
+// Tap i of the n-tap kernel as the shader sees it (quantized by packTap).
+inline Tap kernelTap(int i, int n) {
+  return unpackTap(packTap(exactKernelTap(i, n)));
 }
 
 // 4x4 Bayer order: entry (y & 3) * 4 + (x & 3) holds the phase's rank j in 0..15.
@@ -85,7 +110,7 @@ inline constexpr std::array<int, 16> kBayer4 = {0, 8,  2, 10, 12, 4, 14, 6,
 inline double rotationAngle(int x, int y, int n, bool interleave) {
   if (!interleave) return 0.0;
   const int j = kBayer4[size_t((y & 3) * 4 + (x & 3))];
-  return 2.0 * 3.14159265358979323846 * j / (16.0 * n);
+  return 2.0 * 3.14159265358979323846 * j * (n + 1) / (16.0 * n);
 }
 
 inline Uniforms makeUniforms(double radius, double bias, double intensity, int samples,
@@ -103,12 +128,7 @@ inline Uniforms makeUniforms(double radius, double bias, double intensity, int s
     u.rotation[e][0] = float(std::cos(a));
     u.rotation[e][1] = float(std::sin(a));
   }
-  for (int i = 0; i < n; ++i) {
-    const Tap t = kernelTap(i, n);
-    u.kernel[i][0] = t.x;
-    u.kernel[i][1] = t.y;
-    u.kernel[i][2] = t.z;
-  }
+  for (int i = 0; i < n; ++i) u.kernel[i / 4][i % 4] = packTap(exactKernelTap(i, n));
   return u;
 }
 
