@@ -11,7 +11,7 @@ GI_PACKAGES=(
   glslang-tools glslang-dev libshaderc-dev spirv-tools
   libglm-dev libtinygltf-dev nlohmann-json3-dev libopenmesh-dev libglfw3-dev libimgui-dev
   libstb-dev libembree-dev libgtest-dev libbenchmark-dev clang-format clang-tidy
-  assimp-testmodels
+  assimp-testmodels python3  # python3: the external-effect test checks images with it
   xvfb xauth  # test_window runs gi-render --window on a virtual X server
 )
 
