@@ -36,6 +36,8 @@ const char* kUsage =
     "  --time T               animation clock in seconds (default 0)\n"
     "  --time-step S          advance the clock by S seconds per frame (default 0)\n"
     "  --timings              print the median GPU time of each pass and peak memory\n"
+    "  --isolate-passes       submit and wait after each pass (exact per-pass timings on\n"
+    "                         drivers that overlap passes, e.g. lavapipe)\n"
     "  --view NAME            write a raw resource instead of the final image: output, lit,\n"
     "                         depth, normal, albedo, material, emission, motion, floor, or an\n"
     "                         effect's name for its debug view (e.g. ssao)\n"
@@ -46,6 +48,7 @@ const char* kUsage =
     "  --print-graph          print the compiled frame graph (executed and culled passes)\n"
     "  --graph-dot FILE       write the frame graph as Graphviz dot\n"
     "  --exposure E           exposure before tonemapping (default 1)\n"
+    "  --surface-points N     keep N area-uniform surface points (view them: --view points)\n"
     "  --validation           enable Vulkan validation layers (also GI_VALIDATION=1)\n"
     "  --device NAME          pick the Vulkan device by name or index (also GI_DEVICE)\n";
 
@@ -53,11 +56,11 @@ struct Options {
   std::string scene, out, view = "output", device, preset, graphDot;
   gi::EffectOverrides overrides;
   bool listEffects = false, printGraph = false;
-  uint32_t width = 640, height = 480;
+  uint32_t width = 640, height = 480, surfacePoints = 0;
   int frames = 0;  // 0: not given (one frame, or until the window closes)
   double time = 0.0, timeStep = 0.0;
   float exposure = 1.0f;
-  bool timings = false, validation = false, window = false;
+  bool timings = false, validation = false, window = false, isolatePasses = false;
 };
 
 [[noreturn]] void usageError(const std::string& message) {
@@ -101,12 +104,16 @@ Options parseArgs(int argc, char** argv) {
       o.timeStep = parseNumber(a, value(), -1e6, 1e6);
     else if (a == "--exposure")
       o.exposure = float(parseNumber(a, value(), 0, 1e6));
+    else if (a == "--surface-points")
+      o.surfacePoints = uint32_t(parseNumber(a, value(), 0, 1 << 24));
     else if (a == "--view")
       o.view = value();
     else if (a == "--device")
       o.device = value();
     else if (a == "--timings")
       o.timings = true;
+    else if (a == "--isolate-passes")
+      o.isolatePasses = true;
     else if (a == "--validation")
       o.validation = true;
     else if (a == "--window")
@@ -216,6 +223,8 @@ int run(const Options& o) {
   settings.exposure = o.exposure;
   settings.floorPass = o.timings;
   settings.view = view;
+  settings.surfacePoints = o.surfacePoints;
+  settings.isolatePasses = o.isolatePasses;
   settings.effects = effects;
   gi::Renderer renderer(ctx, scene, settings, &registry);
   if (o.printGraph) std::printf("%s", renderer.graphDescription().c_str());

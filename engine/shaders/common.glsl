@@ -20,6 +20,14 @@ struct FrameUniforms {
                          // intensity included), world space; see gi/environment.h
 };
 
+// One drawn mesh instance. Keep in sync with gpu::Instance in engine/src/render/gpu_types.h.
+struct Instance {
+  mat4 model;
+  mat4 prevModel;
+  mat4 normalMatrix;  // cofactor of the model's 3x3: finite even for singular transforms
+  uvec4 material;     // x: material index, y: first vertex of its (deformed) vertices
+};
+
 // Guard: normalising a zero or non-finite vector returns the fallback instead of NaN.
 vec3 safeNormalize(vec3 v, vec3 fallback) {
   float len2 = dot(v, v);

@@ -6,13 +6,6 @@ layout(location = 0) in vec3 inPosition;
 layout(location = 1) in vec3 inNormal;
 layout(location = 2) in vec2 inUV;
 
-struct Instance {
-  mat4 model;
-  mat4 prevModel;
-  mat4 normalMatrix;  // cofactor of the model's 3x3: finite even for singular transforms
-  uvec4 material;     // x: material index
-};
-
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 layout(set = 0, binding = 1, std430) readonly buffer Instances { Instance instances[]; };
 layout(push_constant) uniform Push { uint instance; } pc;

@@ -1,15 +1,10 @@
 #version 460
 // Depth-only rendering of mesh instances into a shadow map (or one cube face of a point
 // light's 3x2 atlas). Reverse-Z like the G-buffer: depth 1 at the light's near plane.
+#extension GL_GOOGLE_include_directive : require
+#include "common.glsl"
 
 layout(location = 0) in vec3 inPosition;
-
-struct Instance {
-  mat4 model;
-  mat4 prevModel;
-  mat4 normalMatrix;
-  uvec4 material;
-};
 
 layout(set = 0, binding = 0, std430) readonly buffer Instances { Instance instances[]; };
 layout(push_constant) uniform Push {

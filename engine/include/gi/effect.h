@@ -16,7 +16,7 @@
 
 // Bumped whenever this header, settings.h, frame_graph.h or the shader interface change in a
 // way that breaks compiled modules; the registry refuses modules built against another value.
-#define GI_EFFECT_ABI_VERSION 1u
+#define GI_EFFECT_ABI_VERSION 2u
 
 namespace gi {
 
@@ -36,6 +36,12 @@ inline constexpr const char* kLit = "lit";            // RGBA16F direct lighting
 inline constexpr const char* kAO = "ao";              // R8/R16F ambient occlusion, 1 = open
 inline constexpr const char* kOutput = "output";      // RGBA8 tonemapped final image
 inline constexpr const char* kFloor = "floor";        // RGBA8 cost-floor pass output
+// Buffer: the point representation (gi/surface_points.h), two vec4 per point: world
+// position + represented area, world normal + material index. Exists when an effect asked
+// for points (EffectContext::requestSurfacePoints); re-evaluated every frame from the
+// deformed vertices, so points follow animated meshes.
+inline constexpr const char* kSurfacePoints = "surface_points";
+inline constexpr const char* kPointsView = "points";  // RGBA16F debug view of the points
 }  // namespace resources
 
 // When an effect's passes are added: before the lighting pass (it can feed lighting, e.g.
@@ -62,6 +68,9 @@ class EffectContext {
   virtual VkSampler nearestSampler() = 0;  // clamp to edge
   virtual VkSampler linearSampler() = 0;   // clamp to edge
   virtual VkExtent2D outputExtent() = 0;
+  // Asks for the point representation (resources::kSurfacePoints) with at least `count`
+  // points; call from prepare(). The engine samples max(requests) points once per renderer.
+  virtual void requestSurfacePoints(uint32_t count) = 0;
 };
 
 class Effect {

@@ -11,6 +11,7 @@
 #include "gi/image_io.h"
 #include "gi/scene.h"
 #include "gi/settings.h"
+#include "gi/surface_points.h"
 #include "gi/vk/context.h"
 
 namespace gi {
@@ -29,6 +30,14 @@ struct RenderSettings {
   // (a point light renders its 6 faces into one 3x2 atlas). Up to 4 lights cast shadows (the
   // first 4 with castsShadows, in scene node order); one "shadow_<light index>" pass each.
   uint32_t shadowMapSize = 1024;
+  // Point representation (gi/surface_points.h): at least this many points (effects may ask
+  // for more), placed with this seed. 0 and no effect asking: no points, no pass.
+  uint32_t surfacePoints = 0;
+  // Profiling: submit each pass on its own and wait for it, so each pass's timestamps cover
+  // exactly its own work. A CPU driver (lavapipe) otherwise lets a pass's work spill into the
+  // timing of the next pass that waits for it. Costs one submission per pass.
+  bool isolatePasses = false;
+  uint64_t surfacePointSeed = 1;
   std::string view =
       "output";  // the resource the frame delivers (a G-buffer channel, an effect's view)
   std::vector<EffectConfig> effects;
@@ -63,6 +72,10 @@ class Renderer {
     std::vector<Vertex> vertices;
   };
   std::vector<DeformedMesh> readDeformedMeshes();
+  // The point representation: the samples (empty set when there are none) and the world
+  // positions/normals the "surface_points" pass wrote in the last frame that ran it.
+  const SurfacePointSet& surfacePoints() const;
+  std::vector<SurfacePointSample> readSurfacePoints();
   const std::vector<PassTiming>& lastTimings() const;
   std::vector<std::string> passNames() const;        // passes the graph executes, in order
   std::vector<std::string> culledPassNames() const;  // passes declared but culled

@@ -512,7 +512,7 @@ void FrameGraph::allocateTransients() {
 }
 
 void FrameGraph::execute(VkCommandBuffer cmd, vk::DescriptorArena& descriptors,
-                         vk::GpuTimer* timer) {
+                         vk::GpuTimer* timer, const PassBoundary& afterPass) {
   if (!compiled_) throw Error(ErrorKind::Usage, "", "frame graph: execute() before compile()");
   // Transient contents never survive a frame: they start undefined.
   for (auto& r : resources_)
@@ -605,6 +605,7 @@ void FrameGraph::execute(VkCommandBuffer cmd, vk::DescriptorArena& descriptors,
     if (timer) timer->begin(cmd, p->name);
     p->execute(pc);
     if (timer) timer->end(cmd);
+    if (afterPass) pc.cmd_ = cmd = afterPass(cmd);
   }
   // Leave imported images in the layout their owner asked for.
   for (auto& r : resources_) {

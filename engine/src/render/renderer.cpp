@@ -19,6 +19,8 @@
 #include "gi/vk/pipeline.h"
 #include "gi/vk/resources.h"
 #include "gpu_types.h"
+#include "light_setup.h"
+#include "surface_points_pass.h"
 
 namespace gi {
 
@@ -46,16 +48,6 @@ uint32_t groups(uint32_t n) {
 
 TextureDesc outputRelative(VkFormat format) {
   return TextureDesc{format};
-}
-
-constexpr uint32_t kMaxShadowMaps = 4;  // lighting.comp binds shadowMap0..3
-
-// Reverse-Z orthographic projection (Vulkan clip space): depth 1 at znear, 0 at zfar.
-glm::mat4 orthoReverseZ(float l, float r, float b, float t, float znear, float zfar) {
-  glm::mat4 flip(1.0f);
-  flip[2][2] = -1.0f;
-  flip[3][2] = 1.0f;  // z' = w - z
-  return flip * glm::orthoRH_ZO(l, r, b, t, znear, zfar);
 }
 
 }  // namespace
@@ -93,24 +85,22 @@ struct Renderer::Impl : EffectContext {
   Buffer restBuffer, jointIndexBuffer, jointWeightBuffer, jointBuffer;
   Pipeline skinningPipeline;
   uint32_t skinnedThisFrame = 0;
+  // Point representation: created when settings or an effect ask for points.
+  uint32_t pointsRequested = 0;
+  std::vector<SurfacePointsPass::InstanceRef> instanceRefs;
+  std::unique_ptr<SurfacePointsPass> surfacePoints;
   std::vector<Material> sceneMaterials;
   std::vector<Image> textures;
   Image whiteTexture, neutralAO, output;
   Sampler linearRepeat, linearClamp, nearestClamp;
   uint32_t lightCount = 0;
+  LightSetup lightSetup;
+  glm::mat4 prevViewProj{1.0f};  // the camera of the previous frame (motion vectors)
   // Shadows: one map per shadowed light (slot), rendered as one or six views.
-  struct ShadowMap {
-    uint32_t light = 0;  // index into the lights buffer (names the pass)
-    uint32_t width = 0, height = 0;
-    struct View {
-      glm::mat4 viewProj;  // world -> light clip
-      VkRect2D rect;
-    };
-    std::vector<View> views;
-  };
   std::vector<ShadowMap> shadowMaps;
   Buffer shadowViewBuffer;
   Pipeline shadowPipeline;
+  bool shadowPipelineReady = false;  // createPipelines() ran: later shadow maps create it too
   Image environmentMap;
 
   Pipeline gbufferPipeline, lightingPipeline, tonemapPipeline, floorPipeline;
@@ -137,6 +127,7 @@ struct Renderer::Impl : EffectContext {
         settings(rs),
         scene(s),
         registry(reg),
+        pointsRequested(rs.surfacePoints),
         graph(c, {rs.width, rs.height}),
         descriptors(c),
         timer(c) {
@@ -157,6 +148,7 @@ struct Renderer::Impl : EffectContext {
       a.effect->prepare(*this, a.settings);
       effects.push_back(std::move(a));
     }
+    updateSurfacePoints();
     buildGraph();
     // Raw handles last: nothing after them may throw (~Impl does not run if the ctor throws).
     VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
@@ -185,6 +177,18 @@ struct Renderer::Impl : EffectContext {
   VkSampler nearestSampler() override { return nearestClamp.handle(); }
   VkSampler linearSampler() override { return linearClamp.handle(); }
   VkExtent2D outputExtent() override { return {settings.width, settings.height}; }
+  void requestSurfacePoints(uint32_t count) override {
+    pointsRequested = std::max(pointsRequested, count);
+  }
+
+  // (Re)samples the points when more are asked for than exist (at the scene as loaded).
+  void updateSurfacePoints() {
+    if (pointsRequested == 0 || (surfacePoints && surfacePoints->count() >= pointsRequested))
+      return;
+    surfacePoints.reset();
+    surfacePoints = std::make_unique<SurfacePointsPass>(ctx, scene, pointsRequested,
+                                                        settings.surfacePointSeed, instanceRefs);
+  }
 
   Image makeTexture(VkFormat format, uint32_t w, uint32_t h, const void* pixels, size_t bytes) {
     ImageDesc desc;
@@ -257,7 +261,8 @@ struct Renderer::Impl : EffectContext {
         inst.normalMatrix = normalMatrixOf(node.world);
         const uint32_t materialIndex =
             std::min<uint32_t>(mesh.material, uint32_t(sceneMaterials.size() - 1));
-        inst.material = glm::uvec4(materialIndex, 0, 0, 0);
+        inst.material = glm::uvec4(materialIndex, uint32_t(vertexOffset), 0, 0);
+        instanceRefs.push_back({int(n), m, uint32_t(instances.size()), ranges[m].firstIndex / 3});
         draws.push_back({ranges[m].firstIndex, ranges[m].indexCount, vertexOffset,
                          uint32_t(instances.size()), materialIndex});
         instances.push_back(inst);
@@ -321,42 +326,10 @@ struct Renderer::Impl : EffectContext {
     linearClamp = Sampler(ctx, VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE);
     nearestClamp = Sampler(ctx, VK_FILTER_NEAREST, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE);
 
-    std::vector<gpu::Light> lights;
-    std::vector<gpu::ShadowView> shadowViews;
-    glm::vec3 bmin, bmax;
-    scene.worldBounds(bmin, bmax);
-    const bool hasBounds = bmin.x <= bmax.x;
-    for (const Node& node : scene.nodes) {
-      if (node.light < 0) continue;
-      const Light& l = scene.lights[node.light];
-      gpu::Light g{};
-      glm::vec3 pos = glm::vec3(cameraView.view * node.world * glm::vec4(0, 0, 0, 1));
-      glm::vec3 dir = glm::vec3(cameraView.view * node.world * glm::vec4(0, 0, -1, 0));
-      float type = l.type == LightType::Directional ? 0.0f
-                   : l.type == LightType::Point     ? 1.0f
-                                                    : 2.0f;
-      g.positionRange = glm::vec4(pos, std::max(l.range, 0.0f));
-      g.directionType = glm::vec4(dir, type);
-      g.radiance = glm::vec4(l.color * std::max(l.intensity, 0.0f), 0.0f);
-      g.cone = glm::vec4(std::cos(l.innerConeAngle), std::cos(l.outerConeAngle), 0, 0);
-      g.shadow = glm::vec4(-1.0f, 0.0f, 0.0f, 0.0f);
-      if (l.castsShadows && hasBounds && shadowMaps.size() < kMaxShadowMaps) {
-        const float first = float(shadowViews.size());
-        if (addShadowMap(l, node.world, uint32_t(lights.size()), bmin, bmax, shadowViews))
-          g.shadow = glm::vec4(first, std::max(l.shadowBias.constant, 0.0f),
-                               std::max(l.shadowBias.slope, 0.0f), float(shadowMaps.size() - 1));
-      }
-      lights.push_back(g);
-    }
-    lightCount = uint32_t(lights.size());
-    if (lights.empty()) lights.emplace_back();
-    lightBuffer = createDeviceBuffer(ctx, lights.data(), lights.size() * sizeof(gpu::Light),
-                                     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-    if (shadowViews.empty()) shadowViews.emplace_back();
-    shadowViewBuffer =
-        createDeviceBuffer(ctx, shadowViews.data(), shadowViews.size() * sizeof(gpu::ShadowView),
-                           VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-
+    pose.cameras = scene.cameras;
+    pose.activeCameraNode = scene.activeCameraNode;
+    prevViewProj = cameraView.proj * cameraView.view;
+    updateLights();
     const Environment& env = scene.environment;
     irradiance = irradianceSH(env);
     if (env.kind == Environment::Kind::Map && env.mapWidth > 0 && env.mapHeight > 0 &&
@@ -378,82 +351,75 @@ struct Renderer::Impl : EffectContext {
     output = Image(ctx, od);
   }
 
-  // Plans the shadow map of one light: its views (1, or 6 cube faces in a 3x2 atlas) fitted to
-  // the scene bounds. Returns false when the light cannot see the scene (nothing to render).
-  bool addShadowMap(const Light& l, const glm::mat4& world, uint32_t lightIndex,
-                    const glm::vec3& bmin, const glm::vec3& bmax,
-                    std::vector<gpu::ShadowView>& out) {
-    const uint32_t res = settings.shadowMapSize;
-    const glm::mat4 invView = glm::inverse(cameraView.view);
-    const glm::vec3 pos = glm::vec3(world * glm::vec4(0, 0, 0, 1));
-    const glm::vec3 dir = safeDir(glm::vec3(world * glm::vec4(0, 0, -1, 0)));
-    std::array<glm::vec3, 8> corners;
-    for (int i = 0; i < 8; ++i)
-      corners[i] =
-          glm::vec3(i & 1 ? bmax.x : bmin.x, i & 2 ? bmax.y : bmin.y, i & 4 ? bmax.z : bmin.z);
-    ShadowMap map;
-    map.light = lightIndex;
-    auto upFor = [](const glm::vec3& d) {
-      return std::abs(d.y) > 0.99f ? glm::vec3(0, 0, 1) : glm::vec3(0, 1, 0);
-    };
-    auto addView = [&](const glm::mat4& viewProj, const glm::vec4& params, glm::uvec2 offset) {
-      map.views.push_back({viewProj, VkRect2D{{int32_t(offset.x), int32_t(offset.y)}, {res, res}}});
-      out.push_back({viewProj * invView, params, glm::vec4(offset.x, offset.y, res, 0.0f)});
-    };
-    if (l.type == LightType::Directional) {
-      // Orthographic, fitted to the light-space bounds of the scene's box.
-      const glm::vec3 centre = 0.5f * (bmin + bmax);
-      const float radius = std::max(0.5f * glm::length(bmax - bmin), 1e-3f);
-      const glm::mat4 view = glm::lookAt(centre - dir * (2.0f * radius), centre, upFor(dir));
-      glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
-      for (const glm::vec3& c : corners) {
-        const glm::vec3 v = glm::vec3(view * glm::vec4(c, 1.0f));
-        lo = glm::min(lo, v);
-        hi = glm::max(hi, v);
-      }
-      const float margin = 0.01f * radius;
-      lo -= margin;
-      hi += margin;
-      const float znear = std::max(-hi.z, 1e-4f), zfar = -lo.z;
-      const float extent = std::max(hi.x - lo.x, hi.y - lo.y);
-      const glm::mat4 proj = orthoReverseZ(lo.x, lo.x + extent, lo.y, lo.y + extent, znear, zfar);
-      map.width = map.height = res;
-      addView(proj * view, glm::vec4(0.0f, znear, zfar, extent / float(res)), {0, 0});
-    } else {
-      // Perspective from the light's position; far: the farthest corner (or the range).
-      float zfar = 0.0f;
-      for (const glm::vec3& c : corners) zfar = std::max(zfar, glm::length(c - pos));
-      if (l.range > 0.0f) zfar = std::min(zfar, l.range);
-      if (!(zfar > 0.0f)) return false;
-      zfar *= 1.01f;
-      const float znear = std::max(zfar * 1e-3f, 0.01f);
-      if (znear >= zfar) return false;
-      if (l.type == LightType::Spot) {
-        const float fov =
-            std::min(2.0f * l.outerConeAngle + glm::radians(2.0f), glm::radians(170.0f));
-        const glm::mat4 view = glm::lookAt(pos, pos + dir, upFor(dir));
-        map.width = map.height = res;
-        addView(perspectiveReverseZ(fov, 1.0f, znear, zfar) * view,
-                glm::vec4(1.0f, znear, zfar, 2.0f * std::tan(0.5f * fov) / float(res)), {0, 0});
-      } else {
-        // Cube faces +x, -x, +y, -y, +z, -z (the order lighting.comp picks them in).
-        const glm::vec3 axes[6] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
-                                   {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
-        const glm::mat4 proj = perspectiveReverseZ(glm::radians(90.0f), 1.0f, znear, zfar);
-        map.width = 3 * res;
-        map.height = 2 * res;
-        for (uint32_t f = 0; f < 6; ++f)
-          addView(proj * glm::lookAt(pos, pos + axes[f], upFor(axes[f])),
-                  glm::vec4(1.0f, znear, zfar, 2.0f / float(res)), {(f % 3) * res, (f / 3) * res});
-      }
-    }
-    shadowMaps.push_back(std::move(map));
-    return true;
+  // Depth-only pipeline of the shadow passes (created once the first shadow map exists).
+  void createShadowPipeline() {
+    if (shadowMaps.empty() || shadowPipeline.handle() != VK_NULL_HANDLE) return;
+    const auto ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    GraphicsDesc sd;
+    sd.vertex = loadSpirv("shadow.vert");
+    sd.fragment = loadSpirv("shadow.frag");
+    sd.bindings = {{0, ssbo}};
+    sd.pushConstantBytes = sizeof(glm::mat4) + sizeof(uint32_t);
+    sd.vertexLayout.stride = sizeof(Vertex);
+    sd.vertexLayout.attributes = {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, position)}};
+    sd.depthFormat = VK_FORMAT_D32_SFLOAT;  // reverse-Z like the G-buffer (compare >=)
+    shadowPipeline = Pipeline::graphics(ctx, sd);
   }
 
-  static glm::vec3 safeDir(const glm::vec3& v) {
-    const float len = glm::length(v);
-    return len > 1e-12f && std::isfinite(len) ? v / len : glm::vec3(0, -1, 0);
+  // World bounds of the posed geometry: each instance's mesh box under its node's transform;
+  // a skinned instance's box under every joint's skinning transform instead (a skinned vertex
+  // is a weighted mean of those transforms of itself, so it stays inside their union).
+  void posedBounds(glm::vec3& lo, glm::vec3& hi) const {
+    lo = glm::vec3(std::numeric_limits<float>::max());
+    hi = -lo;
+    auto addBox = [&](const Mesh& mesh, const glm::mat4& m) {
+      for (int i = 0; i < 8; ++i) {
+        const glm::vec3 c(i & 1 ? mesh.boundsMax.x : mesh.boundsMin.x,
+                          i & 2 ? mesh.boundsMax.y : mesh.boundsMin.y,
+                          i & 4 ? mesh.boundsMax.z : mesh.boundsMin.z);
+        const glm::vec3 w = glm::vec3(m * glm::vec4(c, 1.0f));
+        if (!std::isfinite(w.x) || !std::isfinite(w.y) || !std::isfinite(w.z)) continue;
+        lo = glm::min(lo, w);
+        hi = glm::max(hi, w);
+      }
+    };
+    for (size_t n = 0; n < pose.nodes.size(); ++n)
+      for (int m : pose.nodes[n].meshes) {
+        const Mesh& mesh = scene.meshes[m];
+        const glm::mat4& world = pose.nodes[n].world;
+        const std::vector<glm::mat4> joints =
+            mesh.skinned() ? jointMatrices(pose, int(n)) : std::vector<glm::mat4>{};
+        if (joints.empty()) addBox(mesh, world);
+        for (const glm::mat4& j : joints) addBox(mesh, world * j);
+      }
+    if (lo.x > hi.x) {  // no geometry: a unit box keeps the shadow fit finite
+      lo = glm::vec3(-1.0f);
+      hi = glm::vec3(1.0f);
+    }
+  }
+
+  // Plans the lights and shadow views of the current pose and camera and uploads them. When a
+  // light starts or stops casting into the scene the layout changes and the graph is rebuilt.
+  void updateLights() {
+    glm::vec3 lo, hi;
+    posedBounds(lo, hi);
+    LightSetup next = planLights(scene, pose.nodes, cameraView, lo, hi, settings.shadowMapSize);
+    if (!lightBuffer || !next.sameLayout(lightSetup)) {
+      lightBuffer = Buffer(ctx, std::max<size_t>(next.lights.size(), 1) * sizeof(gpu::Light),
+                           VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true);
+      shadowViewBuffer =
+          Buffer(ctx, std::max<size_t>(next.views.size(), 1) * sizeof(gpu::ShadowView),
+                 VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true);
+      graphDirty = true;
+    }
+    if (!next.lights.empty())
+      lightBuffer.write(next.lights.data(), next.lights.size() * sizeof(gpu::Light));
+    if (!next.views.empty())
+      shadowViewBuffer.write(next.views.data(), next.views.size() * sizeof(gpu::ShadowView));
+    lightCount = uint32_t(next.lights.size());
+    shadowMaps = next.maps;
+    lightSetup = std::move(next);
+    if (shadowPipelineReady) createShadowPipeline();
   }
 
   void createPipelines() {
@@ -490,17 +456,8 @@ struct Renderer::Impl : EffectContext {
                                           {12, tex},
                                           {13, ssbo},
                                           {14, tex}});
-    if (!shadowMaps.empty()) {
-      GraphicsDesc sd;
-      sd.vertex = loadSpirv("shadow.vert");
-      sd.fragment = loadSpirv("shadow.frag");
-      sd.bindings = {{0, ssbo}};
-      sd.pushConstantBytes = sizeof(glm::mat4) + sizeof(uint32_t);
-      sd.vertexLayout.stride = sizeof(Vertex);
-      sd.vertexLayout.attributes = {{0, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, position)}};
-      sd.depthFormat = VK_FORMAT_D32_SFLOAT;  // reverse-Z like the G-buffer (compare >=)
-      shadowPipeline = Pipeline::graphics(ctx, sd);
-    }
+    shadowPipelineReady = true;
+    createShadowPipeline();
     tonemapPipeline =
         Pipeline::compute(ctx, loadSpirv("tonemap.comp"), {{0, ubo}, {1, tex}, {2, img}});
     floorPipeline = Pipeline::compute(ctx, loadSpirv("floor.comp"), {{0, ubo}, {1, tex}, {2, img}});
@@ -526,6 +483,11 @@ struct Renderer::Impl : EffectContext {
     }
     instancesDirty = true;
     updateDeformations();
+    // Animated cameras and lights: the camera of the last frame feeds the motion vectors.
+    prevViewProj = cameraView.proj * cameraView.view;
+    if (scene.activeCameraNode >= 0)
+      cameraView = activeCamera(pose, float(settings.width) / float(settings.height));
+    updateLights();
   }
 
   void updateDeformations() {
@@ -598,6 +560,11 @@ struct Renderer::Impl : EffectContext {
       bb.put(kVertices, vertices);
     }
     addGBufferPass(bb);
+    if (surfacePoints)
+      surfacePoints->addPasses(
+          graph, vertices,
+          {vertexBuffer.handle(), indexBuffer.handle(), instanceBuffer.handle(),
+           frameBuffer.handle(), nearestClamp.handle()});
     addShadowPasses(bb);
     addEffects(EffectStage::BeforeLighting);
     addLightingPass(bb);
@@ -894,7 +861,7 @@ struct Renderer::Impl : EffectContext {
     f.viewProj = c.proj * c.view;
     f.invView = glm::inverse(c.view);
     f.invProj = glm::inverse(c.proj);
-    f.prevViewProj = f.viewProj;  // static camera until animation exists
+    f.prevViewProj = prevViewProj;
     f.viewport =
         glm::vec4(settings.width, settings.height, 1.0f / settings.width, 1.0f / settings.height);
     f.cameraPos = glm::vec4(c.position, 1.0f);
@@ -907,6 +874,19 @@ struct Renderer::Impl : EffectContext {
     f.params = glm::vec4(settings.exposure, float(lightCount), c.znear, c.zfar);
     for (int i = 0; i < 9; ++i) f.irradianceSH[i] = glm::vec4(irradiance[i], 0.0f);
     frameBuffer.write(&f, sizeof f);
+  }
+
+  // Ends `c`, submits it and waits for it to complete.
+  void submitAndWait(VkCommandBuffer c) {
+    check(vkEndCommandBuffer(c), "vkEndCommandBuffer");
+    VkCommandBufferSubmitInfo cmdInfo{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
+    cmdInfo.commandBuffer = c;
+    VkSubmitInfo2 submit{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
+    submit.commandBufferInfoCount = 1;
+    submit.pCommandBufferInfos = &cmdInfo;
+    check(vkResetFences(ctx.device(), 1, &fence), "vkResetFences");
+    check(vkQueueSubmit2(ctx.queue(), 1, &submit, fence), "vkQueueSubmit2");
+    check(vkWaitForFences(ctx.device(), 1, &fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
   }
 
   void renderFrame() {
@@ -922,17 +902,16 @@ struct Renderer::Impl : EffectContext {
     begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
     check(vkBeginCommandBuffer(cmd, &begin), "vkBeginCommandBuffer");
     timer.beginFrame(cmd);
-    graph.execute(cmd, descriptors, &timer);
-    check(vkEndCommandBuffer(cmd), "vkEndCommandBuffer");
-
-    VkCommandBufferSubmitInfo cmdInfo{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
-    cmdInfo.commandBuffer = cmd;
-    VkSubmitInfo2 submit{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
-    submit.commandBufferInfoCount = 1;
-    submit.pCommandBufferInfos = &cmdInfo;
-    check(vkResetFences(ctx.device(), 1, &fence), "vkResetFences");
-    check(vkQueueSubmit2(ctx.queue(), 1, &submit, fence), "vkQueueSubmit2");
-    check(vkWaitForFences(ctx.device(), 1, &fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
+    FrameGraph::PassBoundary isolate;
+    if (settings.isolatePasses)
+      isolate = [this, &begin](VkCommandBuffer c) {
+        submitAndWait(c);
+        check(vkResetCommandBuffer(c, 0), "vkResetCommandBuffer");
+        check(vkBeginCommandBuffer(c, &begin), "vkBeginCommandBuffer");
+        return c;
+      };
+    graph.execute(cmd, descriptors, &timer, isolate);
+    submitAndWait(cmd);
     timings.clear();
     for (auto& [name, ms] : timer.collect()) timings.push_back({name, ms});
   }
@@ -946,6 +925,7 @@ struct Renderer::Impl : EffectContext {
         vkDeviceWaitIdle(ctx.device());
         graph.reset();  // the effect may replace pipelines the old graph's passes refer to
         a.effect->prepare(*this, a.settings);
+        updateSurfacePoints();
         graphDirty = true;
       }
       return;
@@ -1068,6 +1048,14 @@ std::vector<Renderer::DeformedMesh> Renderer::readDeformedMeshes() {
   for (const Impl::Deformed& d : m.deformed)
     out.push_back({d.node, d.mesh, {all + d.dstFirst, all + d.dstFirst + d.count}});
   return out;
+}
+const SurfacePointSet& Renderer::surfacePoints() const {
+  static const SurfacePointSet kNone;
+  return impl_->surfacePoints ? impl_->surfacePoints->set() : kNone;
+}
+std::vector<SurfacePointSample> Renderer::readSurfacePoints() {
+  if (!impl_->surfacePoints) return {};
+  return impl_->surfacePoints->read(impl_->ctx);
 }
 const std::vector<PassTiming>& Renderer::lastTimings() const {
   return impl_->timings;

@@ -8,7 +8,7 @@ namespace gi::vk {
 GpuTimer::GpuTimer(Context& ctx, uint32_t maxScopes) : ctx_(ctx), maxScopes_(maxScopes) {
   VkQueryPoolCreateInfo info{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
   info.queryType = VK_QUERY_TYPE_TIMESTAMP;
-  info.queryCount = maxScopes * 2;
+  info.queryCount = maxScopes * 3;  // begin, end, and the flush write after each begin
   check(vkCreateQueryPool(ctx.device(), &info, nullptr, &pool_), "vkCreateQueryPool");
 }
 
@@ -18,7 +18,7 @@ GpuTimer::~GpuTimer() {
 
 void GpuTimer::beginFrame(VkCommandBuffer cmd) {
   names_.clear();
-  vkCmdResetQueryPool(cmd, pool_, 0, maxScopes_ * 2);
+  vkCmdResetQueryPool(cmd, pool_, 0, maxScopes_ * 3);
 }
 
 void GpuTimer::begin(VkCommandBuffer cmd, const std::string& name) {
@@ -26,6 +26,11 @@ void GpuTimer::begin(VkCommandBuffer cmd, const std::string& name) {
   if (names_.size() >= maxScopes_) throw Error(ErrorKind::Usage, "", "GpuTimer: too many scopes");
   vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, pool_,
                        static_cast<uint32_t>(names_.size() * 2));
+  // A second write, never read: lavapipe resolves a pending timestamp only at its next flush
+  // (which every ALL_COMMANDS write does first), so without it the begin value would be taken
+  // after the scope's compute work instead of before. Free on GPUs.
+  vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, pool_,
+                       static_cast<uint32_t>(maxScopes_ * 2 + names_.size()));
   names_.push_back(name);
   open_ = true;
 }

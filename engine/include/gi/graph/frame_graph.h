@@ -121,8 +121,13 @@ class FrameGraph {
   VkExtent2D outputExtent() const { return outputExtent_; }
 
   void compile();
-  // Records every kept pass into `cmd` (after compile()); timer may be null.
-  void execute(VkCommandBuffer cmd, vk::DescriptorArena& descriptors, vk::GpuTimer* timer);
+  // Records every kept pass into `cmd` (after compile()); timer may be null. `afterPass`,
+  // when given, runs after each pass with the command buffer recorded so far and returns the
+  // one to record the next pass into (a profiler submits and waits there, so that each pass
+  // runs alone: drivers that overlap or defer work then still time each pass correctly).
+  using PassBoundary = std::function<VkCommandBuffer(VkCommandBuffer)>;
+  void execute(VkCommandBuffer cmd, vk::DescriptorArena& descriptors, vk::GpuTimer* timer,
+               const PassBoundary& afterPass = {});
   // Drops all passes and resources declared so far and frees transient memory.
   void reset();
 

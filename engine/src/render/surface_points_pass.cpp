@@ -1,0 +1,144 @@
+#include "render/surface_points_pass.h"
+
+#include <cstring>
+#include <map>
+#include <memory>
+
+#include "gi/effect.h"
+#include "gi/errors.h"
+
+namespace gi {
+namespace {
+
+constexpr VkDeviceSize kPointBytes = 2 * sizeof(glm::vec4);
+
+void bindCompute(PassContext& pc, const vk::Pipeline& p, vk::DescriptorWriter& w) {
+  VkDescriptorSet set = pc.descriptors().allocate(p.setLayout());
+  w.update(pc.context().device(), set);
+  vkCmdBindPipeline(pc.cmd(), VK_PIPELINE_BIND_POINT_COMPUTE, p.handle());
+  vkCmdBindDescriptorSets(pc.cmd(), VK_PIPELINE_BIND_POINT_COMPUTE, p.layout(), 0, 1, &set, 0,
+                          nullptr);
+}
+
+uint32_t groups64(uint64_t n) {
+  return uint32_t((n + 63) / 64);
+}
+
+}  // namespace
+
+SurfacePointsPass::SurfacePointsPass(vk::Context& ctx, const Scene& scene, uint32_t count,
+                                     uint64_t seed, const std::vector<InstanceRef>& instances)
+    : set_(sampleSurfacePoints(scene, count, seed)) {
+  std::map<std::pair<int, int>, const InstanceRef*> byNodeMesh;
+  for (const InstanceRef& r : instances) byNodeMesh[{r.node, r.mesh}] = &r;
+  std::vector<glm::uvec4> packed;
+  packed.reserve(set_.points.size());
+  for (const SurfacePoint& p : set_.points) {
+    auto it = byNodeMesh.find({int(p.node), int(p.mesh)});
+    if (it == byNodeMesh.end())
+      throw Error(ErrorKind::InvalidData, scene.sourcePath,
+                  "surface point on a mesh instance the renderer does not draw");
+    glm::uvec4 s(it->second->instance, it->second->firstTriangle + p.triangle, 0u, 0u);
+    std::memcpy(&s.z, &p.barycentric.x, 4);
+    std::memcpy(&s.w, &p.barycentric.y, 4);
+    packed.push_back(s);
+  }
+  // Keep the buffers non-empty so the descriptors stay valid for a scene without area.
+  if (packed.empty()) packed.emplace_back(0u);
+  samples_ = vk::createDeviceBuffer(ctx, packed.data(), packed.size() * sizeof(glm::uvec4),
+                                    VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  points_ =
+      vk::Buffer(ctx, packed.size() * kPointBytes,
+                 VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT, false);
+  const auto ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+  update_ = vk::Pipeline::compute(ctx, vk::loadSpirv("surface_points.comp"),
+                                  {{0, ssbo}, {1, ssbo}, {2, ssbo}, {3, ssbo}, {4, ssbo}}, 8);
+  view_ = vk::Pipeline::compute(ctx, vk::loadSpirv("points_view.comp"),
+                                {{0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
+                                 {1, ssbo},
+                                 {2, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER},
+                                 {3, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE}},
+                                8);
+}
+
+void SurfacePointsPass::addPasses(FrameGraph& graph, BufferHandle vertices, const Buffers& in) {
+  Blackboard& bb = graph.blackboard();
+  BufferHandle points =
+      graph.importBuffer(resources::kSurfacePoints, points_.handle(), points_.size());
+  auto out = std::make_shared<BufferHandle>();
+  graph.addPass(
+      "surface_points",
+      [&](PassBuilder& b) {
+        if (vertices.valid()) b.read(vertices, BufferUsage::StorageRead);
+        *out = b.write(points, BufferUsage::StorageWrite);
+      },
+      [this, in](PassContext& pc) {
+        vk::DescriptorWriter w;
+        w.buffer(0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, samples_.handle())
+            .buffer(1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, in.instances)
+            .buffer(2, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, in.indices)
+            .buffer(3, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, in.vertices)
+            .buffer(4, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, points_.handle());
+        bindCompute(pc, update_, w);
+        struct {
+          uint32_t count;
+          float areaPerPoint;
+        } push{count(), count() ? float(set_.totalArea / count()) : 0.0f};
+        vkCmdPushConstants(pc.cmd(), update_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof push, &push);
+        if (count() > 0) vkCmdDispatch(pc.cmd(), groups64(count()), 1, 1);
+      });
+  bb.put(resources::kSurfacePoints, *out);
+
+  struct ViewIo {
+    BufferHandle points;
+    TextureHandle depth, image;
+  };
+  auto view = std::make_shared<ViewIo>();
+  graph.addPass(
+      "points_view",
+      [&](PassBuilder& b) {
+        view->points = b.read(*out, BufferUsage::StorageRead);
+        view->depth = b.read(bb.texture(resources::kDepth));
+        TextureDesc desc{VK_FORMAT_R16G16B16A16_SFLOAT};
+        view->image = b.write(b.create(resources::kPointsView, desc), TextureUsage::StorageWrite);
+      },
+      [this, in, view](PassContext& pc) {
+        vk::DescriptorWriter w;
+        w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, in.frameUniforms)
+            .buffer(1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, pc.buffer(view->points))
+            .sampled(2, pc.view(view->depth), in.nearest)
+            .storageImage(3, pc.view(view->image));
+        bindCompute(pc, view_, w);
+        const VkExtent2D e = pc.extent(view->image);
+        const uint32_t clear[2] = {0u, 1u};
+        vkCmdPushConstants(pc.cmd(), view_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof clear, clear);
+        vkCmdDispatch(pc.cmd(), groups64(uint64_t(e.width) * e.height), 1, 1);
+        // The splats overwrite cleared texels: order the two dispatches.
+        VkMemoryBarrier2 barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER_2};
+        barrier.srcStageMask = barrier.dstStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+        barrier.srcAccessMask = barrier.dstAccessMask = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
+        VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+        dep.memoryBarrierCount = 1;
+        dep.pMemoryBarriers = &barrier;
+        vkCmdPipelineBarrier2(pc.cmd(), &dep);
+        const uint32_t splat[2] = {count(), 0u};
+        vkCmdPushConstants(pc.cmd(), view_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof splat, splat);
+        if (count() > 0) vkCmdDispatch(pc.cmd(), groups64(count()), 1, 1);
+      });
+  bb.put(resources::kPointsView, view->image);
+}
+
+std::vector<SurfacePointSample> SurfacePointsPass::read(vk::Context& ctx) const {
+  std::vector<SurfacePointSample> out(count());
+  if (out.empty()) return out;
+  vk::Buffer staging(ctx, points_.size(), VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
+  ctx.submitAndWait([&](VkCommandBuffer c) {
+    VkBufferCopy copy{0, 0, points_.size()};
+    vkCmdCopyBuffer(c, points_.handle(), staging.handle(), 1, &copy);
+  });
+  static_assert(sizeof(SurfacePointSample) == kPointBytes);
+  std::memcpy(out.data(), staging.mapped(), out.size() * sizeof(SurfacePointSample));
+  return out;
+}
+
+}  // namespace gi

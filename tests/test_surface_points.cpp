@@ -1,0 +1,148 @@
+// The "surface_points" GPU pass: points evaluated from the deformed vertices equal the CPU
+// reference and stay on the skinned surface after several animation steps; the pass exists
+// only when points were asked for and something reads them; the "points" view shows them.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "gi/animation.h"
+#include "gi/renderer.h"
+#include "gi/scene_io.h"
+#include "gi/surface_points.h"
+#include "test_support.h"
+#include "vulkan_fixture.h"
+
+namespace gi {
+namespace {
+
+using test::VulkanTest;
+
+class SurfacePointsGpuTest : public VulkanTest {};
+
+bool contains(const std::vector<std::string>& names, const std::string& name) {
+  return std::find(names.begin(), names.end(), name) != names.end();
+}
+
+bool finite(const glm::vec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+double sceneSize(const Scene& s) {
+  glm::vec3 lo, hi;
+  s.worldBounds(lo, hi);
+  return glm::length(hi - lo);
+}
+
+// Renders the points view at each time and compares every GPU point with the CPU reference
+// on the same pose: same position within 1e-4 of the scene size, same normal within 1e-3.
+void expectGpuPointsMatchCpu(vk::Context& ctx, const Scene& scene, uint32_t count,
+                             const std::vector<double>& times) {
+  RenderSettings rs;
+  rs.width = 96;
+  rs.height = 72;
+  rs.surfacePoints = count;
+  rs.view = "points";
+  Renderer r(ctx, scene, rs);
+  ASSERT_TRUE(contains(r.passNames(), "surface_points"));
+  const SurfacePointSet& set = r.surfacePoints();
+  ASSERT_EQ(set.points.size(), count);
+  const double size = sceneSize(scene);
+  Scene cpu = scene;
+  for (double t : times) {
+    r.setTime(t);
+    r.renderFrame();
+    cpu.animate(t);
+    const std::vector<SurfacePointSample> gpu = r.readSurfacePoints();
+    const std::vector<SurfacePointSample> want = evaluateSurfacePoints(cpu, set);
+    ASSERT_EQ(gpu.size(), want.size());
+    double worstPos = 0.0, worstNormal = 0.0;
+    for (size_t i = 0; i < gpu.size(); ++i) {
+      ASSERT_TRUE(finite(gpu[i].position) && finite(gpu[i].normal)) << i;
+      worstPos = std::max(worstPos, double(glm::length(gpu[i].position - want[i].position)));
+      worstNormal = std::max(worstNormal, double(glm::length(gpu[i].normal - want[i].normal)));
+      ASSERT_EQ(gpu[i].material, want[i].material);
+      ASSERT_NEAR(gpu[i].area, want[i].area, 1e-6 * want[i].area);
+    }
+    EXPECT_LE(worstPos, 1e-4 * size) << "time " << t;
+    EXPECT_LE(worstNormal, 1e-3) << "time " << t;
+  }
+}
+
+TEST_F(SurfacePointsGpuTest, FollowSimpleSkin) {
+  expectGpuPointsMatchCpu(ctx(), loadGltf(test::assimpModel("glTF2/simple_skin/simple_skin.gltf")),
+                          20000, {0.0, 0.6, 1.4, 3.1});
+}
+
+TEST_F(SurfacePointsGpuTest, FollowCesiumMan) {
+  GI_REQUIRE_SHARED_ASSET(path, "cesium_man/glTF/CesiumMan.gltf");
+  expectGpuPointsMatchCpu(ctx(), loadGltf(path), 100000, {0.25, 0.9, 1.7});
+}
+
+TEST_F(SurfacePointsGpuTest, FollowMorphTargets) {
+  expectGpuPointsMatchCpu(
+      ctx(),
+      loadGltf(test::assimpModel(
+          "glTF2/glTF-Sample-Models/AnimatedMorphCube-glTF/AnimatedMorphCube.gltf")),
+      5000, {0.0, 0.5, 1.0});
+}
+
+TEST_F(SurfacePointsGpuTest, RigidSceneMatchesCpu) {
+  expectGpuPointsMatchCpu(ctx(), makeDefaultScene(), 30000, {0.0, 0.7});
+}
+
+TEST_F(SurfacePointsGpuTest, PassOnlyWhenAskedForAndRead) {
+  const Scene scene = makeDefaultScene();
+  RenderSettings rs;
+  rs.width = 64;
+  rs.height = 48;
+  {
+    Renderer none(ctx(), scene, rs);  // nobody asked for points
+    EXPECT_FALSE(contains(none.passNames(), "surface_points"));
+    EXPECT_FALSE(contains(none.culledPassNames(), "surface_points"));
+    EXPECT_TRUE(none.surfacePoints().points.empty());
+  }
+  rs.surfacePoints = 1000;
+  {
+    Renderer unread(ctx(), scene, rs);  // points exist but the final image does not read them
+    EXPECT_FALSE(contains(unread.passNames(), "surface_points"));
+    EXPECT_TRUE(contains(unread.culledPassNames(), "surface_points"));
+    EXPECT_TRUE(contains(unread.culledPassNames(), "points_view"));
+  }
+  rs.view = "points";
+  Renderer viewed(ctx(), scene, rs);
+  const std::vector<std::string> want = {"gbuffer", "surface_points", "points_view"};
+  EXPECT_EQ(viewed.passNames(), want);
+}
+
+// The debug view: points are splatted where they lie on visible surfaces. On the default
+// room (every pixel covered by a surface) with 4 points per pixel, most pixels receive one,
+// the splat colours are the normals' (finite, in [0, 1]), and no sky pixel is touched.
+TEST_F(SurfacePointsGpuTest, ViewShowsPointsOnVisibleSurfaces) {
+  const Scene scene = makeDefaultScene();
+  RenderSettings rs;
+  rs.width = 80;
+  rs.height = 60;
+  rs.view = "points";
+  rs.surfacePoints = 200000;
+  Renderer r(ctx(), scene, rs);
+  r.renderFrame();
+  const ImageRGBA32F img = r.readTarget("points");
+  const ImageRGBA32F depth = r.readTarget("depth");
+  size_t covered = 0, surface = 0;
+  for (size_t i = 0; i < size_t(img.width) * img.height; ++i) {
+    const float* p = &img.pixels[i * 4];
+    const bool hit = p[0] + p[1] + p[2] > 0.0f;
+    for (int c = 0; c < 3; ++c) ASSERT_TRUE(p[c] >= 0.0f && p[c] <= 1.0f) << i;
+    if (depth.pixels[i * 4] <= 0.0f) {
+      EXPECT_FALSE(hit) << "sky pixel " << i;
+      continue;
+    }
+    ++surface;
+    covered += hit;
+  }
+  EXPECT_GT(double(covered), 0.9 * double(surface));
+}
+
+}  // namespace
+}  // namespace gi
