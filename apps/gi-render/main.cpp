@@ -260,6 +260,11 @@ int run(const Options& o) {
     std::string culled;
     for (const std::string& c : renderer.culledPassNames()) culled += " " + c;
     std::printf("culled passes:%s\n", culled.empty() ? " none" : culled.c_str());
+    if (renderer.lastSkinnedVertexCount() > 0)
+      std::printf("skinning: %u vertices deformed in the last frame\n",
+                  renderer.lastSkinnedVertexCount());
+    if (!renderer.surfacePoints().points.empty())
+      std::printf("surface points: %zu\n", renderer.surfacePoints().points.size());
     std::printf("frame graph compile %.3f ms (CPU), plugin loading %.3f ms (%zu effect(s))\n",
                 renderer.lastCompileMs(), pluginLoadMs, registry.names().size());
     rusage usage{};
