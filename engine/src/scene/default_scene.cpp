@@ -1,4 +1,5 @@
-// The built-in scene (a Cornell-box-like room) and the defaults added to bare model files.
+// The built-in scene (a Cornell-box-like room with a bouncing sphere) and the defaults added to
+// bare model files.
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "gi/scene_io.h"
@@ -36,6 +37,35 @@ glm::mat4 rotate(float degrees, glm::vec3 axis) {
   return glm::rotate(glm::mat4(1.0f), glm::radians(degrees), axis);
 }
 
+// The moving object: `node` (at rest at `rest`, given by translate(rest)) bounces straight up
+// and back every kBouncePeriod seconds on a parabola y = rest.y + 4 h u (1 - u), u = t / period,
+// h = kBounceHeight: one CUBICSPLINE segment whose tangents +-4h/period make it exactly that
+// parabola. At t = 0 (and every whole period) it is exactly at `rest`, so still images of the
+// scene at time 0 do not change.
+constexpr float kBouncePeriod = 2.0f;
+constexpr float kBounceHeight = 0.3f;
+
+void addBounce(Scene& s, int node, const glm::vec3& rest) {
+  Node& n = s.nodes[node];
+  n.hasTRS = true;
+  n.translation = rest;
+  const float slope = 4.0f * kBounceHeight / kBouncePeriod;  // dy/dt at take-off
+  AnimationSampler up;
+  up.interpolation = Interpolation::CubicSpline;
+  up.components = 3;
+  up.times = {0.0f, kBouncePeriod};
+  // Per key: in-tangent, value, out-tangent.
+  const glm::vec3 none(0.0f), takeOff(0.0f, slope, 0.0f), landing(0.0f, -slope, 0.0f);
+  for (const glm::vec3& v : {none, rest, takeOff, landing, rest, none})
+    up.values.insert(up.values.end(), {v.x, v.y, v.z});
+  AnimationClip clip;
+  clip.name = "sphere bounce";
+  clip.samplers.push_back(std::move(up));
+  clip.channels.push_back({0, node, AnimationPath::Translation});
+  clip.duration = kBouncePeriod;
+  s.animations.push_back(std::move(clip));
+}
+
 }  // namespace
 
 Scene makeDefaultScene() {
@@ -63,8 +93,10 @@ Scene makeDefaultScene() {
               translate({0.33f, -0.7f, 0.3f}) * rotate(-17, {0, 1, 0}));
   addMeshNode(s, "tall block", detail::makeBox({0.6f, 1.2f, 0.6f}), white,
               translate({-0.35f, -0.4f, -0.35f}) * rotate(17, {0, 1, 0}));
-  addMeshNode(s, "sphere", detail::makeSphere(0.25f, 32, 16), sphere,
-              translate({0.33f, -0.4f + 0.25f, 0.3f}));
+  const glm::vec3 rest(0.33f, -0.4f + 0.25f, 0.3f);
+  const int ball =
+      addMeshNode(s, "sphere", detail::makeSphere(0.25f, 32, 16), sphere, translate(rest));
+  addBounce(s, ball, rest);
 
   // Lamp: a small emissive quad just under the ceiling plus a point light below it (the
   // rasteriser's direct lighting comes from the point light; the quad is what is seen).

@@ -111,25 +111,45 @@ std::optional<int> JsonObject::integer(const char* key) const {
   return static_cast<int>(i);
 }
 
-std::optional<std::vector<float>> JsonObject::numbers(const char* key,
-                                                      std::initializer_list<size_t> sizes) const {
-  if (!has(key)) return std::nullopt;
-  const json& v = value_.at(key);
+float numberValue(const json& v, const std::string& path, const std::string& file) {
+  if (!v.is_number())
+    throw Error(ErrorKind::Schema, file, path + ": expected a number, got " + typeName(v));
+  std::optional<float> f = asFloat(v);
+  if (!f) throw Error(ErrorKind::InvalidData, file, path + ": number out of range");
+  return *f;
+}
+
+std::vector<float> numberList(const json& v, const std::string& path, const std::string& file,
+                              std::initializer_list<size_t> sizes) {
+  auto fail = [&](ErrorKind kind, const std::string& where, const std::string& problem) {
+    throw Error(kind, file, where + ": " + problem);
+  };
   std::string expected;
   for (size_t n : sizes) expected += (expected.empty() ? "" : " or ") + std::to_string(n);
-  if (!v.is_array() || std::find(sizes.begin(), sizes.end(), v.size()) == sizes.end())
-    schemaError(key, "expected an array of " + expected + " numbers, got " +
-                         (v.is_array() ? std::to_string(v.size()) + " elements" : typeName(v)));
+  if (!v.is_array())
+    fail(ErrorKind::Schema, path,
+         "expected an array of " + (expected.empty() ? std::string() : expected + " ") +
+             "numbers, got " + typeName(v));
+  if (sizes.size() && std::find(sizes.begin(), sizes.end(), v.size()) == sizes.end())
+    fail(ErrorKind::Schema, path,
+         "expected an array of " + expected + " numbers, got " + std::to_string(v.size()) +
+             " elements");
   std::vector<float> out;
   for (size_t i = 0; i < v.size(); ++i) {
+    const std::string where = path + "[" + std::to_string(i) + "]";
     if (!v[i].is_number())
-      schemaError(std::string(key) + "[" + std::to_string(i) + "]",
-                  std::string("expected a number, got ") + typeName(v[i]));
+      fail(ErrorKind::Schema, where, std::string("expected a number, got ") + typeName(v[i]));
     std::optional<float> f = asFloat(v[i]);
-    if (!f) invalid(std::string(key) + "[" + std::to_string(i) + "]", "number out of range");
+    if (!f) fail(ErrorKind::InvalidData, where, "number out of range");
     out.push_back(*f);
   }
   return out;
+}
+
+std::optional<std::vector<float>> JsonObject::numbers(const char* key,
+                                                      std::initializer_list<size_t> sizes) const {
+  if (!has(key)) return std::nullopt;
+  return numberList(value_.at(key), pathOf(key), file_, sizes);
 }
 
 std::optional<glm::vec3> JsonObject::vec3(const char* key) const {

@@ -7,11 +7,22 @@
 #include <initializer_list>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 
 namespace gi::detail {
+
+// The numbers of the JSON array `value` found at `path` of `file`: Schema error unless it is an
+// array whose length is one of `sizes` (any length when `sizes` is empty) holding only numbers,
+// InvalidData for a number beyond float range. Elements are named "<path>[i]".
+std::vector<float> numberList(const nlohmann::json& value, const std::string& path,
+                              const std::string& file, std::initializer_list<size_t> sizes = {});
+
+// A JSON number at `path` as a finite float: Schema error for another type, InvalidData beyond
+// float range.
+float numberValue(const nlohmann::json& value, const std::string& path, const std::string& file);
 
 class JsonObject {
  public:
@@ -24,6 +35,9 @@ class JsonObject {
   const nlohmann::json& at(const char* key) const { return value_.at(key); }
   // Path of a key below this object ("lights[0]" + "color" -> "lights[0].color").
   std::string pathOf(const std::string& key) const;
+  // This object's own path ("" at the top level) and the file, for messages about the whole.
+  const std::string& path() const { return path_; }
+  const std::string& file() const { return file_; }
 
   // Optional typed values: std::nullopt when absent, Schema error when of the wrong type.
   std::optional<std::string> string(const char* key) const;

@@ -71,12 +71,13 @@ void addProcessedMeshes(Scene& scene, std::vector<Mesh> meshes, const std::strin
   if (kept == 0) throw Error(ErrorKind::InvalidData, path, "no triangles (no usable geometry)");
 }
 
-void mergeScene(Scene& scene, Scene model, const std::string& name, const glm::mat4& transform) {
+int mergeScene(Scene& scene, Scene model, const std::string& name, const glm::mat4& transform) {
   const int meshOffset = static_cast<int>(scene.meshes.size());
   const int materialOffset = static_cast<int>(scene.materials.size());
   const int textureOffset = static_cast<int>(scene.textures.size());
   const int cameraOffset = static_cast<int>(scene.cameras.size());
   const int lightOffset = static_cast<int>(scene.lights.size());
+  const int skinOffset = static_cast<int>(scene.skins.size());
   const int parent = scene.addNode(name, transform);
   const int nodeOffset = static_cast<int>(scene.nodes.size());
 
@@ -97,12 +98,25 @@ void mergeScene(Scene& scene, Scene model, const std::string& name, const glm::m
     for (int& m : n.meshes) m += meshOffset;
     if (n.camera >= 0) n.camera += cameraOffset;
     if (n.light >= 0) n.light += lightOffset;
-    scene.nodes.push_back(std::move(n));
+    if (n.skin >= 0) n.skin += skinOffset;
+    scene.nodes.push_back(std::move(n));  // morph weights travel with the node
+  }
+  // Skins and clips refer to nodes by index; -1 (a joint outside the displayed scene) stays.
+  for (Skin& skin : model.skins) {
+    for (int& j : skin.joints)
+      if (j >= 0) j += nodeOffset;
+    scene.skins.push_back(std::move(skin));
+  }
+  for (AnimationClip& clip : model.animations) {
+    for (AnimationChannel& ch : clip.channels)
+      if (ch.node >= 0) ch.node += nodeOffset;
+    scene.animations.push_back(std::move(clip));
   }
   for (int r : model.roots) scene.nodes[parent].children.push_back(r + nodeOffset);
   if (scene.activeCameraNode < 0 && model.activeCameraNode >= 0)
     scene.activeCameraNode = model.activeCameraNode + nodeOffset;
   for (std::string& w : model.warnings) scene.warnings.push_back(std::move(w));
+  return parent;
 }
 
 }  // namespace gi::detail

@@ -33,9 +33,11 @@ void addProcessedMeshes(Scene& scene, std::vector<Mesh> meshes, const std::strin
 Scene loadMeshFileOnly(const std::string& path);
 
 // Appends `model` to `scene` under a new root node (`name`, `transform`), offsetting its mesh,
-// material, texture, camera, light and node indices. The model's environment and effects are
-// dropped; its warnings, cameras and lights are kept. World transforms are not updated.
-void mergeScene(Scene& scene, Scene model, const std::string& name, const glm::mat4& transform);
+// material, texture, camera, light, skin and node indices (skin joints, node skins, animation
+// channel targets). The model's environment and effects are dropped; its warnings, cameras,
+// lights, skins, animation clips and morph weights are kept. World transforms are not updated.
+// Returns the new root node's index.
+int mergeScene(Scene& scene, Scene model, const std::string& name, const glm::mat4& transform);
 
 // Built-in primitives (object space, y up, outward normals, uv in [0,1]), already processed.
 Mesh makePlane(float sizeX, float sizeZ);                // in y = 0, facing +y, centred

@@ -14,22 +14,25 @@
 //       "translation": [0, 0, 0],
 //       "rotation": [0, 0, 0, 1],          // quaternion [x, y, z, w], or Euler degrees [x, y, z]
 //                                          // applied about X, then Y, then Z (fixed axes)
-//       "scale": 1.0 },                    // or [sx, sy, sz]; no zero components
+//       "scale": 1.0,                      // or [sx, sy, sz]; no zero components
+//       "clip": "Walk" | 0,                // keep only this animation clip of the file
+//       "animation": { ... } },            // see below
 //     { "primitive": "plane" | "box" | "sphere",   // instead of "file"
 //       "size": 4.0,                       // plane: number or [x, z]; box: number or [x, y, z]
 //       "radius": 0.5, "segments": 32, "rings": 16,  // sphere only
 //       "material": { "name": "...", "base_color": [r, g, b(, a)], "emission": [r, g, b],
 //                     "roughness": 0.8, "metallic": 0.0 },
-//       "name", "translation", "rotation", "scale" as above }
+//       "name", "translation", "rotation", "scale", "animation" as above }
 //   ],
 //   "camera": { "position": [x, y, z] (required), "target": [x, y, z] (required),
-//               "up": [0, 1, 0], "yfov_deg": 45, "near": 0.05, "far": 1000, "name": "..." },
+//               "up": [0, 1, 0], "yfov_deg": 45, "near": 0.05, "far": 1000, "name": "...",
+//               "animation": { ... } },
 //   "lights": [ { "type": "point" | "spot" | "directional" (required), "name": "...",
 //                 "position": [x, y, z] (required for point and spot),
 //                 "direction": [0, -1, 0] (spot and directional: where the light travels),
 //                 "color": [1, 1, 1], "intensity": 1 (candela; lux for directional),
 //                 "range": 0 (0: infinite), "inner_cone_deg": 0, "outer_cone_deg": 45,
-//                 "casts_shadows": true } ],
+//                 "casts_shadows": true, "animation": { ... } } ],
 //   "environment": { "type": "sky" | "constant" | "map", "intensity": 1,
 //                    "color": [r, g, b] (constant only),
 //                    "file": "sky.hdr" (map only, required: equirectangular Radiance .hdr,
@@ -38,16 +41,30 @@
 //   "effects": [ "ssao", { "name": "bloom", "settings": { ... } } ]
 // }
 //
+// "animation" (models, lights, camera): a looping clip of its own driving the entry's node:
+//   { "translation" | "rotation" | "scale" | "direction" (spot/directional lights):
+//       { "times": [...] (>= 0, strictly increasing), "values": [...] (one per key; in-tangent,
+//         value, out-tangent per key for cubicspline), "interpolation": "linear" | "step" |
+//         "cubicspline" },
+//     "orbit": { "center": [x, y, z] (camera default: its target), "axis": [0, 1, 0],
+//                "period": seconds } }
+// Tracks replace that part of the entry's own transform (translation keys are absolute);
+// parts without a track keep the entry's value. An orbit turns the whole transform about the
+// axis through the centre (a camera orbiting its target keeps looking at it).
+//
 // ${GI_SHARED_ASSETS} expands to the environment variable of that name when set, else to the
 // nearest "shared/assets" folder found walking up from the scene file's folder (the checkout's
 // ../shared/assets). ${ASSIMP_MODELS} expands to $ASSIMP_MODELS, else /usr/share/assimp/models.
 //
 // Without a "camera" (and no camera in the models) the scene is framed automatically; without
 // any light a sun is added (addDefaultCameraAndLight). The JSON camera becomes the active one.
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <optional>
 
+#include <glm/gtc/constants.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 
@@ -125,6 +142,72 @@ glm::mat4 readTransform(const JsonObject& o) {
   return t;
 }
 
+// A rotation given as a quaternion [x, y, z, w] (normalised) or Euler degrees [x, y, z] (about
+// X, then Y, then Z: the rotation readTransform builds); `where` names it in errors.
+glm::quat rotationOf(const std::vector<float>& r, const std::string& where,
+                     const std::string& file) {
+  if (r.size() == 4) {
+    const glm::quat q(r[3], r[0], r[1], r[2]);
+    if (!(glm::length(q) >= 1e-6f))
+      throw Error(ErrorKind::InvalidData, file, where + ": quaternion has zero length");
+    return glm::normalize(q);
+  }
+  return glm::angleAxis(glm::radians(r[2]), glm::vec3(0, 0, 1)) *
+         glm::angleAxis(glm::radians(r[1]), glm::vec3(0, 1, 0)) *
+         glm::angleAxis(glm::radians(r[0]), glm::vec3(1, 0, 0));
+}
+
+// An entry's own transform as translation, rotation, scale: what its animation starts from.
+struct TRS {
+  glm::vec3 translation{0.0f};
+  glm::quat rotation{1.0f, 0.0f, 0.0f, 0.0f};
+  glm::vec3 scale{1.0f};
+  glm::mat4 matrix() const {
+    return glm::translate(glm::mat4(1.0f), translation) * glm::mat4_cast(rotation) *
+           glm::scale(glm::mat4(1.0f), scale);
+  }
+};
+
+// The TRS of a model entry (readTransform has validated the keys already).
+TRS readTRS(const JsonObject& o) {
+  TRS trs;
+  trs.translation = o.vec3("translation").value_or(glm::vec3(0.0f));
+  if (auto r = o.numbers("rotation", {3, 4}))
+    trs.rotation = rotationOf(*r, o.pathOf("rotation"), o.file());
+  if (o.has("scale"))
+    trs.scale = o.at("scale").is_number() ? glm::vec3(*o.number("scale")) : *o.vec3("scale");
+  return trs;
+}
+
+// TRS of a rigid matrix (a light's or camera's inverse look-at matrix).
+TRS rigidTRS(const glm::mat4& m) {
+  TRS trs;
+  trs.translation = glm::vec3(m[3]);
+  trs.rotation = glm::normalize(glm::quat_cast(glm::mat3(m)));
+  return trs;
+}
+
+// Rotation turning a node's -z (where lights shine) towards `dir` (non-zero): as readLights
+// orients light nodes.
+glm::quat rotationTowards(const glm::vec3& dir) {
+  const glm::vec3 d = glm::normalize(dir);
+  const glm::vec3 up = std::abs(d.y) > 0.99f ? glm::vec3(0, 0, 1) : glm::vec3(0, 1, 0);
+  return rigidTRS(glm::inverse(glm::lookAt(glm::vec3(0.0f), d, up))).rotation;
+}
+
+// The shortest rotation taking unit vector `a` to unit vector `b` (half a turn about some axis
+// perpendicular to `a` when they are opposite).
+glm::quat shortestArc(const glm::vec3& a, const glm::vec3& b) {
+  const float d = glm::dot(a, b);
+  if (d < -0.999999f) {
+    glm::vec3 axis = glm::cross(glm::vec3(1, 0, 0), a);
+    if (glm::length(axis) < 1e-3f) axis = glm::cross(glm::vec3(0, 1, 0), a);
+    return glm::angleAxis(glm::pi<float>(), glm::normalize(axis));
+  }
+  const glm::vec3 c = glm::cross(a, b);
+  return glm::normalize(glm::quat(1.0f + d, c.x, c.y, c.z));
+}
+
 glm::vec3 nonNegativeColor(const JsonObject& o, const char* key, glm::vec3 fallback) {
   glm::vec3 c = o.vec3(key).value_or(fallback);
   if (c.x < 0 || c.y < 0 || c.z < 0) o.invalid(key, "colour components must not be negative");
@@ -159,7 +242,8 @@ Scene makePrimitive(const JsonObject& o, const std::string& file) {
   const std::string kind = o.requireString("primitive");
   Mesh mesh;
   if (kind == "plane" || kind == "box") {
-    o.allowOnly({"primitive", "name", "translation", "rotation", "scale", "size", "material"});
+    o.allowOnly(
+        {"primitive", "name", "translation", "rotation", "scale", "size", "material", "animation"});
     glm::vec3 size(1.0f);
     if (o.has("size")) {
       if (o.at("size").is_number())
@@ -175,7 +259,7 @@ Scene makePrimitive(const JsonObject& o, const std::string& file) {
     mesh = kind == "plane" ? detail::makePlane(size.x, size.z) : detail::makeBox(size);
   } else if (kind == "sphere") {
     o.allowOnly({"primitive", "name", "translation", "rotation", "scale", "radius", "segments",
-                 "rings", "material"});
+                 "rings", "material", "animation"});
     const float radius = o.number("radius").value_or(0.5f);
     const int segments = o.integer("segments").value_or(32);
     const int rings = o.integer("rings").value_or(16);
@@ -247,14 +331,229 @@ class SceneJsonLoader {
         model = makePrimitive(m, path_);
         name = m.string("name").value_or(*m.string("primitive"));
       } else {
-        m.allowOnly({"file", "name", "translation", "rotation", "scale"});
+        m.allowOnly({"file", "name", "translation", "rotation", "scale", "clip", "animation"});
         const std::string file = m.requireString("file");
         const fs::path resolved = expandModelPath(file, sceneDir, m, path_);
         model = loadModel(resolved.string(), m);
         name = m.string("name").value_or(resolved.stem().string());
+        if (m.has("clip")) selectClip(m, model, resolved.filename().string());
       }
-      detail::mergeScene(scene_, std::move(model), name, readTransform(m));
+      const int node = detail::mergeScene(scene_, std::move(model), name, readTransform(m));
+      if (m.has("animation")) readAnimation(m, node, readTRS(m), Target::Model);
     }
+  }
+
+  // "clip": keeps only the named (or numbered) animation clip of a model file.
+  void selectClip(const JsonObject& m, Scene& model, const std::string& file) const {
+    const json& c = m.at("clip");
+    std::string names;
+    for (const AnimationClip& a : model.animations)
+      names += (names.empty() ? "" : ", ") + ("'" + a.name + "'");
+    const std::string available =
+        names.empty() ? " (it has no animation clips)" : " (clips: " + names + ")";
+    size_t keep = model.animations.size();
+    if (c.is_string()) {
+      const std::string want = c.get<std::string>();
+      for (size_t i = 0; i < model.animations.size() && keep == model.animations.size(); ++i)
+        if (model.animations[i].name == want) keep = i;
+      if (keep == model.animations.size())
+        m.invalid("clip", "no clip named '" + want + "' in " + file + available);
+    } else if (c.is_number_integer()) {
+      const int index = *m.integer("clip");
+      if (index < 0 || size_t(index) >= model.animations.size())
+        m.invalid("clip", "no clip " + std::to_string(index) + " in " + file + available);
+      keep = size_t(index);
+    } else {
+      m.schemaError("clip", "expected a clip name or index");
+    }
+    std::vector<AnimationClip> kept{std::move(model.animations[keep])};
+    model.animations = std::move(kept);
+  }
+
+  // ---- "animation" of a model, light or camera entry ------------------------------------
+
+  enum class Target { Model, Camera, Light, DirectedLight };
+  enum class Track { Translation, Rotation, Scale, Direction };
+
+  // Keys of one track: "times" (seconds, >= 0, strictly increasing), "values" (one per key, or
+  // in-tangent, value, out-tangent per key for cubicspline) and "interpolation".
+  AnimationSampler readTrack(const JsonObject& t, Track track) const {
+    t.allowOnly({"times", "values", "interpolation"});
+    AnimationSampler s;
+    const std::string interp = t.string("interpolation").value_or("linear");
+    if (interp == "linear")
+      s.interpolation = Interpolation::Linear;
+    else if (interp == "step")
+      s.interpolation = Interpolation::Step;
+    else if (interp == "cubicspline")
+      s.interpolation = Interpolation::CubicSpline;
+    else
+      t.schemaError("interpolation",
+                    "unknown interpolation '" + interp + "' (linear, step or cubicspline)");
+    const bool cubic = s.interpolation == Interpolation::CubicSpline;
+    if (cubic && track == Track::Direction)
+      t.schemaError("interpolation", "direction keys take linear or step interpolation");
+
+    if (!t.has("times")) t.schemaError("times", "missing required key");
+    s.times = detail::numberList(t.at("times"), t.pathOf("times"), path_);
+    if (s.times.empty()) t.invalid("times", "needs at least one key time");
+    for (size_t k = 0; k < s.times.size(); ++k) {
+      const std::string key = "times[" + std::to_string(k) + "]";
+      if (s.times[k] < 0.0f) t.invalid(key, "key times must not be negative");
+      if (k > 0 && !(s.times[k] > s.times[k - 1]))
+        t.invalid(key, "key times must be strictly increasing (" + std::to_string(s.times[k]) +
+                           " after " + std::to_string(s.times[k - 1]) + ")");
+    }
+
+    if (!t.has("values")) t.schemaError("values", "missing required key");
+    const json& values = t.at("values");
+    if (!values.is_array()) t.schemaError("values", "expected an array");
+    const size_t perKey = cubic ? 3 : 1;
+    if (values.size() != s.times.size() * perKey)
+      t.invalid("values", std::to_string(values.size()) + " values for " +
+                              std::to_string(s.times.size()) + " key times" +
+                              (cubic ? " (cubicspline: in-tangent, value, out-tangent per key)"
+                                     : std::string()) +
+                              "; need " + std::to_string(s.times.size() * perKey));
+    s.components = track == Track::Translation || track == Track::Scale ? 3 : 4;
+    glm::vec3 previousDirection(0.0f);
+    glm::quat previousRotation(1.0f, 0.0f, 0.0f, 0.0f);
+    for (size_t i = 0; i < values.size(); ++i) {
+      const std::string where = t.pathOf("values[" + std::to_string(i) + "]");
+      const bool tangent = cubic && i % 3 != 1;
+      std::vector<float> v;
+      switch (track) {
+        case Track::Translation:
+          v = detail::numberList(values[i], where, path_, {3});
+          break;
+        case Track::Scale:
+          v = values[i].is_number()
+                  ? std::vector<float>(3, detail::numberValue(values[i], where, path_))
+                  : detail::numberList(values[i], where, path_, {3});
+          if (!tangent && (v[0] == 0.0f || v[1] == 0.0f || v[2] == 0.0f))
+            throw Error(ErrorKind::InvalidData, path_, where + ": scale must not be zero");
+          break;
+        case Track::Rotation: {
+          v = detail::numberList(
+              values[i], where, path_,
+              cubic ? std::initializer_list<size_t>{4} : std::initializer_list<size_t>{3, 4});
+          if (tangent) break;  // tangents are raw quaternion derivatives
+          const glm::quat q = rotationOf(v, where, path_);
+          v = {q.x, q.y, q.z, q.w};
+          break;
+        }
+        case Track::Direction: {
+          const std::vector<float> d = detail::numberList(values[i], where, path_, {3});
+          const glm::vec3 dir(d[0], d[1], d[2]);
+          if (glm::length(dir) < 1e-6f)
+            throw Error(ErrorKind::InvalidData, path_, where + ": direction must not be zero");
+          // Each key turns the previous one by the shortest arc between their directions, so
+          // that slerping between keys sweeps the direction along a great circle.
+          const glm::vec3 now = glm::normalize(dir);
+          const glm::quat q =
+              i == 0 ? rotationTowards(now)
+                     : glm::normalize(shortestArc(previousDirection, now) * previousRotation);
+          previousDirection = now;
+          previousRotation = q;
+          v = {q.x, q.y, q.z, q.w};
+          break;
+        }
+      }
+      s.values.insert(s.values.end(), v.begin(), v.end());
+    }
+    return s;
+  }
+
+  // "orbit": the entry's whole transform turns about the line through `center` along `axis`
+  // (right-handed), once per `period` seconds. As keys: 32 per turn, positions cubic with the
+  // circle's tangents, rotations slerped (exact for a fixed axis); the first and last keys are
+  // the entry's own transform.
+  void addOrbit(const JsonObject& o, AnimationClip& clip, const TRS& rest,
+                std::optional<glm::vec3> defaultCenter) const {
+    o.allowOnly({"center", "axis", "period"});
+    if (!o.has("center") && !defaultCenter) o.schemaError("center", "missing required key");
+    const glm::vec3 center = o.has("center") ? *o.vec3("center") : *defaultCenter;
+    glm::vec3 axis = o.vec3("axis").value_or(glm::vec3(0, 1, 0));
+    if (glm::length(axis) < 1e-6f) o.invalid("axis", "must not be zero");
+    axis = glm::normalize(axis);
+    if (!o.has("period")) o.schemaError("period", "missing required key");
+    const float period = *o.number("period");
+    if (period <= 0.0f) o.invalid("period", "must be positive");
+
+    constexpr int kKeys = 32;
+    AnimationSampler position, rotation;
+    position.interpolation = Interpolation::CubicSpline;
+    position.components = 3;
+    rotation.components = 4;
+    const double omega = 2.0 * glm::pi<double>() / period;
+    const glm::vec3 arm = rest.translation - center;
+    for (int k = 0; k <= kKeys; ++k) {
+      const float time = float(double(period) * k / kKeys);
+      const float angle = float(2.0 * glm::pi<double>() * k / kKeys);
+      const glm::quat turn = glm::angleAxis(angle, axis);
+      const bool ends = k == 0 || k == kKeys;
+      const glm::vec3 offset = turn * arm;
+      const glm::vec3 p = ends ? rest.translation : center + offset;
+      const glm::vec3 tangent = float(omega) * glm::cross(axis, offset);
+      const glm::quat q = ends ? rest.rotation : glm::normalize(turn * rest.rotation);
+      position.times.push_back(time);
+      rotation.times.push_back(time);
+      for (const glm::vec3& v : {tangent, p, tangent})
+        position.values.insert(position.values.end(), {v.x, v.y, v.z});
+      rotation.values.insert(rotation.values.end(), {q.x, q.y, q.z, q.w});
+    }
+    clip.samplers.push_back(std::move(position));
+    clip.samplers.push_back(std::move(rotation));
+  }
+
+  // The entry's "animation" as a clip of its own whose channels drive `node`. Each track
+  // replaces that part of the node's transform (translation keys are absolute positions);
+  // parts without a track keep the entry's own value (`rest`).
+  void readAnimation(const JsonObject& entry, int node, const TRS& rest, Target target,
+                     std::optional<glm::vec3> orbitCenter = std::nullopt) {
+    const JsonObject a(entry.at("animation"), entry.pathOf("animation"), path_);
+    const bool directed = target == Target::DirectedLight;
+    if (directed)
+      a.allowOnly({"translation", "rotation", "scale", "direction", "orbit"});
+    else
+      a.allowOnly({"translation", "rotation", "scale", "orbit"});
+    if (a.has("rotation") && a.has("direction"))
+      a.schemaError("direction", "give either rotation or direction keys, not both");
+    if (a.has("orbit"))
+      for (const char* k : {"translation", "rotation", "direction"})
+        if (a.has(k)) a.schemaError(k, "cannot be combined with \"orbit\"");
+
+    AnimationClip clip;
+    clip.name = scene_.nodes[node].name + " (" + a.path() + ")";
+    auto track = [&](const char* key, Track kind, AnimationPath path) {
+      if (!a.has(key)) return;
+      clip.samplers.push_back(readTrack(JsonObject(a.at(key), a.pathOf(key), path_), kind));
+      clip.channels.push_back({int(clip.samplers.size()) - 1, node, path});
+    };
+    track("translation", Track::Translation, AnimationPath::Translation);
+    track("rotation", Track::Rotation, AnimationPath::Rotation);
+    track("direction", Track::Direction, AnimationPath::Rotation);
+    track("scale", Track::Scale, AnimationPath::Scale);
+    if (a.has("orbit")) {
+      addOrbit(JsonObject(a.at("orbit"), a.pathOf("orbit"), path_), clip, rest, orbitCenter);
+      const int first = int(clip.samplers.size()) - 2;
+      clip.channels.push_back({first, node, AnimationPath::Translation});
+      clip.channels.push_back({first + 1, node, AnimationPath::Rotation});
+    }
+    if (clip.channels.empty())
+      throw Error(ErrorKind::Schema, path_,
+                  a.path() + ": expected at least one of translation, rotation, scale" +
+                      (directed ? ", direction" : "") + " or orbit");
+    for (const AnimationSampler& s : clip.samplers)
+      clip.duration = std::max(clip.duration, s.times.back());
+
+    Node& n = scene_.nodes[node];
+    n.hasTRS = true;
+    n.translation = rest.translation;
+    n.rotation = rest.rotation;
+    n.scale = rest.scale;
+    n.local = rest.matrix();
+    scene_.animations.push_back(std::move(clip));
   }
 
   Scene loadModel(const std::string& file, const JsonObject& m) {
@@ -278,7 +577,7 @@ class SceneJsonLoader {
   }
 
   void readCamera(const JsonObject& c) {
-    c.allowOnly({"name", "position", "target", "up", "yfov_deg", "near", "far"});
+    c.allowOnly({"name", "position", "target", "up", "yfov_deg", "near", "far", "animation"});
     const glm::vec3 position = c.requireVec3("position");
     const glm::vec3 target = c.requireVec3("target");
     const glm::vec3 up = c.vec3("up").value_or(glm::vec3(0, 1, 0));
@@ -299,6 +598,12 @@ class SceneJsonLoader {
     const int node = scene_.addNode(cam.name, glm::inverse(glm::lookAt(position, target, up)));
     scene_.nodes[node].camera = static_cast<int>(scene_.cameras.size()) - 1;
     scene_.activeCameraNode = node;
+    // An orbit about the target keeps the camera looking at it.
+    if (c.has("animation")) {
+      TRS rest = rigidTRS(scene_.nodes[node].local);
+      rest.translation = position;  // exactly, not as the inverse look-at rounds it
+      readAnimation(c, node, rest, Target::Camera, target);
+    }
   }
 
   void readLights(const JsonObject& top) {
@@ -306,7 +611,7 @@ class SceneJsonLoader {
     for (size_t i = 0; i < lights.size(); ++i) {
       JsonObject o(lights[i], indexed("lights", i), path_);
       o.allowOnly({"type", "name", "position", "direction", "color", "intensity", "range",
-                   "inner_cone_deg", "outer_cone_deg", "casts_shadows"});
+                   "inner_cone_deg", "outer_cone_deg", "casts_shadows", "animation"});
       const std::string type = o.requireString("type");
       Light l;
       if (type == "point")
@@ -345,6 +650,12 @@ class SceneJsonLoader {
       const int node =
           scene_.addNode(l.name, glm::inverse(glm::lookAt(position, position + d, up)));
       scene_.nodes[node].light = static_cast<int>(scene_.lights.size()) - 1;
+      if (o.has("animation")) {
+        TRS rest = rigidTRS(scene_.nodes[node].local);
+        rest.translation = position;
+        readAnimation(o, node, rest,
+                      l.type == LightType::Point ? Target::Light : Target::DirectedLight);
+      }
     }
   }
 
