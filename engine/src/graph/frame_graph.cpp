@@ -511,8 +511,8 @@ void FrameGraph::allocateTransients() {
   }
 }
 
-void FrameGraph::execute(VkCommandBuffer cmd, vk::DescriptorArena& descriptors,
-                         vk::GpuTimer* timer, const PassBoundary& afterPass) {
+void FrameGraph::execute(VkCommandBuffer cmd, vk::DescriptorArena& descriptors, vk::GpuTimer* timer,
+                         const PassBoundary& afterPass) {
   if (!compiled_) throw Error(ErrorKind::Usage, "", "frame graph: execute() before compile()");
   // Transient contents never survive a frame: they start undefined.
   for (auto& r : resources_)
