@@ -26,7 +26,22 @@ struct Row {
   unsigned referenceSpp = 0;
   double referenceStdError = 0.0;  // mean per-pixel standard error of the reference
   double nrmse = 0.0, ssim = 1.0;
-  size_t pixels = 0;  // compared (unmasked) pixels
+  size_t pixels = 0;              // compared (unmasked) pixels
+  double referenceSeconds = 0.0;  // wall time the reference took (when it was computed)
+  // With --ao-split (AO effects): the effect's error e = S - F (S the effect's AO, F = AO_full)
+  // over the compared pixels, split as e = E + O + H: O and H the occluded fractions whose
+  // occluders are off-screen and hidden (F + O + H = AO_visible), E = S - AO_visible the
+  // estimator's own part. Shares of the mean squared error: mean(e X) / mean(e^2) for X = O, H,
+  // E (they sum to 1; a negative share means that part cancels some of the others).
+  struct AoSplit {
+    bool present = false;
+    double limitNrmse = 0.0;      // RMS(O + H) / mean(F): NRMSE(AO_visible vs AO_full)
+    double offscreenNrmse = 0.0;  // RMS(O) / mean(F)
+    double hiddenNrmse = 0.0;     // RMS(H) / mean(F)
+    double estimatorNrmse = 0.0;  // RMS(E) / mean(F): the effect against AO_visible
+    double visibleFraction = 0.0, offscreenFraction = 0.0, hiddenFraction = 0.0;  // means
+    double shareOffscreen = 0.0, shareHidden = 0.0, shareEstimator = 0.0;
+  } split;
 };
 
 struct RunInfo {

@@ -54,6 +54,9 @@ const char* kUsage =
     "  --width W --height H  resolution (default 320x240)\n"
     "  --ref-spp N           reference samples per pixel (default 256)\n"
     "  --ref-seed N          reference seed (default 1)\n"
+    "  --ao-split            AO effects: split the reference's occlusion into what the depth\n"
+    "                        buffer holds, off-screen and hidden occluders (gi-reference\n"
+    "                        --quantity ao-split) and report where the effect cannot converge\n"
     "  --cache DIR           reference cache (default <bin>/../bench-cache)\n"
     "  --budget-ms B         --calibrate: frame budget (GPU ms, all passes)\n"
     "  --headroom F          --calibrate: keep the measured time under (1 - F) * budget (0.1)\n"
@@ -72,7 +75,7 @@ struct Options {
   uint32_t width = 320, height = 240, refSpp = 256;
   uint64_t refSeed = 1;
   int frames = 5;
-  bool quick = false, calibrate = false, progress = true, validation = false;
+  bool quick = false, calibrate = false, progress = true, validation = false, aoSplit = false;
   double budgetMs = 0.0, headroom = 0.1;
   bool sizeGiven = false, framesGiven = false, sppGiven = false;
   std::string commandLine;
@@ -145,6 +148,8 @@ Options parseArgs(int argc, char** argv) {
       o.headroom = parseNumber(a, value(), 0, 0.9);
     else if (a == "--quick")
       o.quick = true;
+    else if (a == "--ao-split")
+      o.aoSplit = true;
     else if (a == "--calibrate")
       o.calibrate = true;
     else if (a == "--no-progress")
@@ -193,12 +198,17 @@ bool isIndirectEffect(const std::string& n) {
   return n == "ssdo" || n == "radiosity" || n == "instant_radiosity" || n == "ambient_transfer";
 }
 
-Comparison comparisonFor(const std::vector<gi::EffectConfig>& effects) {
+bool isAo(ref::Quantity q) {
+  return q == ref::Quantity::AO || q == ref::Quantity::AOSplit;
+}
+
+// `aoSplit`: AO effects are compared with the ao-split reference (its value is AO_full).
+Comparison comparisonFor(const std::vector<gi::EffectConfig>& effects, bool aoSplit) {
   Comparison c;
   for (const auto& e : effects)
     if (isAoEffect(e.name)) {
       c.resource = gi::resources::kAO;
-      c.quantity = ref::Quantity::AO;
+      c.quantity = aoSplit ? ref::Quantity::AOSplit : ref::Quantity::AO;
       c.effect = e.name;
       bool hasRadius = false;
       for (const auto& d : e.settings.descs()) hasRadius |= d.name == "radius";
@@ -214,8 +224,9 @@ Comparison comparisonFor(const std::vector<gi::EffectConfig>& effects) {
 }
 
 std::string referenceLabel(const Comparison& c, uint32_t spp) {
-  std::string s = ref::quantityName(c.quantity);
-  if (c.quantity == ref::Quantity::AO) {
+  // The ao-split reference's value is AO itself (the same estimate, see reference.h).
+  std::string s = ref::quantityName(isAo(c.quantity) ? ref::Quantity::AO : c.quantity);
+  if (isAo(c.quantity)) {
     char buf[32];
     std::snprintf(buf, sizeof buf, " r=%g", double(c.radius));
     s += buf;
@@ -232,6 +243,7 @@ uint64_t fnv1a(const std::string& s, uint64_t h = 1469598103934665603ULL) {
 
 struct Reference {
   gi::ImageRGBA32F value, depth;
+  gi::ImageRGBA32F split;  // ao-split only: AO_visible, f_off, f_hid (reference.h)
   uint32_t spp = 0;
   double meanStdError = 0.0, seconds = 0.0;
   bool cached = false;
@@ -281,11 +293,15 @@ Reference computeReference(const Options& o, const LoadedScene& s, const Referen
       const nlohmann::json meta = nlohmann::json::parse(in);
       r.value = gi::readPfm(stem + ".value.pfm");
       r.depth = gi::readPfm(stem + ".depth.pfm");
+      if (k.quantity == ref::Quantity::AOSplit) r.split = gi::readPfm(stem + ".split.pfm");
       r.spp = meta.at("spp");
       r.meanStdError = meta.at("mean_stderr");
       r.seconds = meta.at("seconds");
       r.cached = true;
-      if (r.value.width == int(o.width) && r.value.height == int(o.height)) return r;
+      if (r.value.width == int(o.width) && r.value.height == int(o.height) &&
+          (k.quantity != ref::Quantity::AOSplit ||
+           (r.split.width == r.value.width && r.split.height == r.value.height)))
+        return r;
     } catch (const std::exception& e) {
       std::fprintf(stderr, "gi-bench: warning: %s: unreadable cache entry, recomputing (%s)\n",
                    stem.c_str(), e.what());
@@ -295,16 +311,17 @@ Reference computeReference(const Options& o, const LoadedScene& s, const Referen
   rs.width = o.width;
   rs.height = o.height;
   rs.quantity = k.quantity;
-  rs.radius = k.quantity == ref::Quantity::AO ? k.radius : 0.5f;
+  rs.radius = isAo(k.quantity) ? k.radius : 0.5f;
   rs.spp = o.refSpp;
   rs.minSpp = std::min(rs.minSpp, o.refSpp);
   rs.seed = o.refSeed;
   ref::Result res = ref::render(s.scene, rs);
-  r = Reference{res.value, res.depth, res.spp, res.meanStdError, res.seconds, false};
+  r = Reference{res.value, res.depth, res.split, res.spp, res.meanStdError, res.seconds, false};
   fs::create_directories(o.cache);
   // The metadata is written last: its presence marks a complete entry.
   gi::writePfm(stem + ".value.pfm", r.value);
   gi::writePfm(stem + ".depth.pfm", r.depth);
+  if (k.quantity == ref::Quantity::AOSplit) gi::writePfm(stem + ".split.pfm", r.split);
   nlohmann::json meta = {{"scene", s.name},     {"quantity", ref::quantityName(k.quantity)},
                          {"radius", k.radius},  {"width", o.width},
                          {"height", o.height},  {"spp", r.spp},
@@ -388,7 +405,8 @@ std::string knownEffects(const gi::EffectRegistry& registry) {
 // -----------------------------------------------------------------
 
 bool isEnginePass(const std::string& n) {
-  return n == "gbuffer" || n == "lighting" || n == "tonemap" || n == "floor" || n == "skinning";
+  return n == "gbuffer" || n == "lighting" || n == "tonemap" || n == "floor" || n == "skinning" ||
+         n.starts_with("shadow_");  // the engine's shadow maps, one pass per shadowed light
 }
 
 double median(std::vector<double> v) {
@@ -401,7 +419,58 @@ struct Measurement {
   std::vector<std::pair<std::string, double>> passes;
   double totalMs = 0.0, effectMs = 0.0, floorMs = 0.0, wallMs = 0.0;
   gi::bench::Metrics metrics;
+  Row::AoSplit split;
 };
+
+// The effect's AO error against the ao-split reference, decomposed as in Row::AoSplit, over the
+// pixels `mask` keeps (the ones NRMSE and SSIM use).
+Row::AoSplit splitError(const gi::ImageRGBA32F& out, const Reference& reference,
+                        const std::vector<unsigned char>& mask) {
+  auto sanitize = [](float v) { return std::isfinite(v) ? double(v) : 1e6; };  // as metrics.h
+  double sumF = 0.0, ee = 0.0, eO = 0.0, eH = 0.0, eE = 0.0, OH2 = 0.0, O2 = 0.0, H2 = 0.0,
+         E2 = 0.0, sumV = 0.0, sumO = 0.0, sumH = 0.0;
+  size_t n = 0;
+  for (size_t i = 0; i < mask.size(); ++i) {
+    if (!mask[i]) continue;
+    const double S = sanitize(out.pixels[i * 4]), F = sanitize(reference.value.pixels[i * 4]);
+    const double V = sanitize(reference.split.pixels[i * 4]);
+    const double O = sanitize(reference.split.pixels[i * 4 + 1]);
+    const double H = sanitize(reference.split.pixels[i * 4 + 2]);
+    // e = S - F = E + O + H exactly with E = S - (F + O + H) (= S - AO_visible up to rounding).
+    const double e = S - F, E = S - (F + O + H);
+    sumF += std::abs(F);
+    ee += e * e;
+    eO += e * O;
+    eH += e * H;
+    eE += e * E;
+    OH2 += (O + H) * (O + H);
+    O2 += O * O;
+    H2 += H * H;
+    E2 += E * E;
+    sumV += 1.0 - V;
+    sumO += O;
+    sumH += H;
+    ++n;
+  }
+  Row::AoSplit s;
+  s.present = true;
+  if (n == 0) return s;
+  const double count = double(n), meanF = sumF / count > 1e-8 ? sumF / count : 1.0;
+  auto nrmse = [&](double sumSquares) { return std::sqrt(sumSquares / count) / meanF; };
+  s.limitNrmse = nrmse(OH2);
+  s.offscreenNrmse = nrmse(O2);
+  s.hiddenNrmse = nrmse(H2);
+  s.estimatorNrmse = nrmse(E2);
+  s.visibleFraction = sumV / count;
+  s.offscreenFraction = sumO / count;
+  s.hiddenFraction = sumH / count;
+  if (ee > 0.0) {
+    s.shareOffscreen = eO / ee;
+    s.shareHidden = eH / ee;
+    s.shareEstimator = eE / ee;
+  }
+  return s;
+}
 
 Measurement measure(gi::vk::Context& ctx, const gi::EffectRegistry& registry,
                     const gi::Scene& scene, const std::vector<gi::EffectConfig>& effects,
@@ -443,9 +512,11 @@ Measurement measure(gi::vk::Context& ctx, const gi::EffectRegistry& registry,
   for (size_t i = 0; i < n; ++i)
     mask[i] = reference.depth.pixels[i * 4 + 2] > 0.5f && depth.pixels[i * 4] > 0.0f;
   const int w = int(o.width), h = int(o.height);
-  if (cmp.quantity == ref::Quantity::AO) {
+  if (isAo(cmp.quantity)) {
     m.metrics = gi::bench::compare(gi::bench::channel(w, h, out.pixels, 0),
                                    gi::bench::channel(w, h, reference.value.pixels, 0), mask);
+    if (cmp.quantity == ref::Quantity::AOSplit && reference.split.pixels.size() == n * 4)
+      m.split = splitError(out, reference, mask);
   } else {
     const gi::bench::Plane test = gi::bench::channel(w, h, out.pixels, -1);
     const gi::bench::Plane truth = gi::bench::channel(w, h, reference.value.pixels, -1);
@@ -584,7 +655,7 @@ std::vector<Config> buildConfigs(const Options& o, const Setup& s,
             }
           }
           c.effects = gi::resolveEffects(s.scenes[si].scene, c.presetPtr, ov, s.registry);
-          c.comparison = comparisonFor(c.effects);
+          c.comparison = comparisonFor(c.effects, o.aoSplit);
           configs.push_back(std::move(c));
           size_t k = 0;
           for (; k < idx.size(); ++k) {
@@ -618,7 +689,11 @@ std::map<ReferenceKey, Reference> computeReferences(const Options& o, const Setu
 }
 
 void checkFinite(const Row& r) {
-  for (double v : {r.totalMs, r.effectMs, r.floorMs, r.wallMs, r.nrmse, r.ssim})
+  const Row::AoSplit& s = r.split;
+  for (double v :
+       {r.totalMs, r.effectMs, r.floorMs, r.wallMs, r.nrmse, r.ssim, s.limitNrmse, s.offscreenNrmse,
+        s.hiddenNrmse, s.estimatorNrmse, s.visibleFraction, s.offscreenFraction, s.hiddenFraction,
+        s.shareOffscreen, s.shareHidden, s.shareEstimator})
     if (!std::isfinite(v))
       throw gi::Error(gi::ErrorKind::NonFinite, r.scene,
                       "non-finite measurement for " + r.effect + " " + r.params);
@@ -671,6 +746,8 @@ int runSweep(const Options& o) {
     r.nrmse = m.metrics.nrmse;
     r.ssim = m.metrics.ssim;
     r.pixels = m.metrics.pixels;
+    r.referenceSeconds = reference.seconds;
+    r.split = m.split;
     checkFinite(r);
     rows.push_back(std::move(r));
     bar.step(rows.back().scene + " " + c.effectLabel + " " + c.params);
@@ -753,7 +830,7 @@ int runCalibrate(const Options& o) {
     ov.effects = effects;
     base = gi::resolveEffects(scene, nullptr, ov, s.registry);
   }
-  const Comparison cmp = comparisonFor(base);
+  const Comparison cmp = comparisonFor(base, false);
   const std::map<ReferenceKey, Reference> refs =
       computeReferences(o, s, {ReferenceKey{0, cmp.quantity, cmp.radius}});
   const Reference& reference = refs.begin()->second;

@@ -81,11 +81,22 @@ std::string fileSafe(const std::string& s) {
   return out;
 }
 
+bool anySplit(const std::vector<Row>& rows) {
+  return std::any_of(rows.begin(), rows.end(), [](const Row& r) { return r.split.present; });
+}
+
 std::string csv(const std::vector<Row>& rows) {
   std::ostringstream o;
+  const bool split = anySplit(rows);
   o << "scene,effect,preset,params,width,height,frames,passes_ms,total_ms,effect_ms,floor_ms,"
        "total_over_floor,effect_over_floor,wall_ms,compared,reference,reference_spp,"
-       "reference_stderr,pixels,nrmse,ssim\n";
+       "reference_stderr,pixels,nrmse,ssim";
+  // --ao-split runs only, so that other runs keep their columns.
+  if (split)
+    o << ",reference_seconds,limit_nrmse,offscreen_nrmse,hidden_nrmse,estimator_nrmse,"
+         "visible_fraction,offscreen_fraction,hidden_fraction,share_offscreen,share_hidden,"
+         "share_estimator";
+  o << '\n';
   for (const Row& r : rows) {
     o << csvField(r.scene) << ',' << csvField(r.effect) << ',' << csvField(r.preset) << ','
       << csvField(r.params) << ',' << r.width << ',' << r.height << ',' << r.frames << ','
@@ -94,7 +105,16 @@ std::string csv(const std::vector<Row>& rows) {
       << fmt(r.floorMs > 0 ? r.effectMs / r.floorMs : 0.0, 6) << ',' << fmt(r.wallMs, 6) << ','
       << r.compared << ',' << csvField(r.reference) << ',' << r.referenceSpp << ','
       << fmt(r.referenceStdError, 6) << ',' << r.pixels << ',' << fmt(r.nrmse, 6) << ','
-      << fmt(r.ssim, 6) << '\n';
+      << fmt(r.ssim, 6);
+    if (split) {
+      const Row::AoSplit& s = r.split;
+      o << ',' << fmt(r.referenceSeconds, 6);
+      for (double v : {s.limitNrmse, s.offscreenNrmse, s.hiddenNrmse, s.estimatorNrmse,
+                       s.visibleFraction, s.offscreenFraction, s.hiddenFraction, s.shareOffscreen,
+                       s.shareHidden, s.shareEstimator})
+        o << ',' << (s.present ? fmt(v, 6) : std::string());
+    }
+    o << '\n';
   }
   return o.str();
 }
@@ -129,7 +149,17 @@ std::string json(const std::vector<Row>& rows, const RunInfo& info) {
                             {"reference_stderr", r.referenceStdError},
                             {"pixels", r.pixels},
                             {"nrmse", r.nrmse},
-                            {"ssim", r.ssim}});
+                            {"ssim", r.ssim},
+                            {"reference_seconds", r.referenceSeconds}});
+    if (r.split.present) {
+      const Row::AoSplit& s = r.split;
+      j["results"].back()["ao_split"] = {
+          {"limit_nrmse", s.limitNrmse},           {"offscreen_nrmse", s.offscreenNrmse},
+          {"hidden_nrmse", s.hiddenNrmse},         {"estimator_nrmse", s.estimatorNrmse},
+          {"visible_fraction", s.visibleFraction}, {"offscreen_fraction", s.offscreenFraction},
+          {"hidden_fraction", s.hiddenFraction},   {"share_offscreen", s.shareOffscreen},
+          {"share_hidden", s.shareHidden},         {"share_estimator", s.shareEstimator}};
+    }
   }
   return j.dump(2) + "\n";
 }
@@ -240,6 +270,73 @@ std::string svgPlot(const std::string& title, const std::vector<const Row*>& row
   return o.str();
 }
 
+std::string percent(double v) {
+  return fmt(100.0 * v, 3) + "%";
+}
+
+// "Where screen-space AO cannot converge" (--ao-split): per scene and AO effect, the reference's
+// occlusion split by occluder class and the decomposition of the effect's error at its most
+// expensive grid point, then the decomposition for every configuration.
+std::string splitSection(const std::vector<Row>& rows) {
+  std::ostringstream o;
+  o << "\n## Where screen-space AO cannot converge\n\n"
+    << "The ao-split reference (gi-reference `--quantity ao-split`, same rays as the AO "
+       "reference) classifies every occluded AO direction: *visible* when a surface of the "
+       "depth layer (the primary hits: what the depth buffer holds) lies on it within r, "
+       "otherwise *off-screen* when its first hit is outside the view frustum, otherwise "
+       "*hidden* (inside the frame, behind the visible surface there). The fractions are the "
+       "shares of the cosine-weighted hemisphere each class occludes (so 1 - AO_full = visible "
+       "+ off-screen + hidden), averaged over the compared pixels. AO_visible = 1 - visible "
+       "fraction is the AO of the depth layer alone: the best a single-layer screen-space "
+       "method can converge to. *Limit* is NRMSE(AO_visible vs AO_full) = RMS(O + H) / "
+       "mean(AO_full), with O and H the per-pixel off-screen and hidden fractions; *off-screen "
+       "alone* and *hidden alone* are RMS(O) and RMS(H) over the same mean (the NRMSE of an "
+       "otherwise perfect method missing only that part). The effect's error e = SSAO - "
+       "AO_full is exactly the sum O + H + E with E = SSAO - AO_visible (the estimator's own "
+       "error against what it could reach); its mean squared error is split as mean(e O) + "
+       "mean(e H) + mean(e E), each divided by mean(e^2): the shares sum to 100%, and a "
+       "negative share means that part cancels some of the others (e.g. an estimator darker "
+       "than AO_visible offsetting missing occluders). The reference time is the wall time of "
+       "the split reference on this machine (cached runs repeat the time it took when "
+       "computed).\n\n";
+  std::vector<std::pair<std::string, std::string>> order;
+  std::map<std::pair<std::string, std::string>, const Row*> top;
+  for (const Row& r : rows) {
+    if (!r.split.present) continue;
+    const auto key = std::make_pair(r.scene, r.effect);
+    if (!top.count(key)) order.push_back(key);
+    if (!top.count(key) || r.gridValue >= top[key]->gridValue) top[key] = &r;
+  }
+  o << "| scene | reference | occluded: visible / off-screen / hidden | limit NRMSE "
+       "(AO_visible vs AO_full) | off-screen alone | hidden alone | effect | NRMSE vs AO_full | "
+       "NRMSE vs AO_visible (estimator) | share of MSE: off-screen / hidden / estimator |\n"
+    << "|---|---|---|---:|---:|---:|---|---:|---:|---|\n";
+  for (const auto& key : order) {
+    const Row& r = *top[key];
+    const Row::AoSplit& s = r.split;
+    o << "| " << r.scene << " | " << r.referenceSpp << " spp, " << fmt(r.referenceSeconds, 3)
+      << " s | " << percent(s.visibleFraction) << " / " << percent(s.offscreenFraction) << " / "
+      << percent(s.hiddenFraction) << " | " << fmt(s.limitNrmse, 4) << " | "
+      << fmt(s.offscreenNrmse, 4) << " | " << fmt(s.hiddenNrmse, 4) << " | " << r.effect
+      << (r.params.empty() ? "" : " " + r.params) << " | " << fmt(r.nrmse, 4) << " | "
+      << fmt(s.estimatorNrmse, 4) << " | " << percent(s.shareOffscreen) << " / "
+      << percent(s.shareHidden) << " / " << percent(s.shareEstimator) << " |\n";
+  }
+  o << "\nEvery configuration:\n\n"
+    << "| scene | effect | preset / params | NRMSE vs AO_full | NRMSE vs AO_visible | share of "
+       "MSE: off-screen / hidden / estimator |\n"
+    << "|---|---|---|---:|---:|---|\n";
+  for (const Row& r : rows) {
+    if (!r.split.present) continue;
+    const Row::AoSplit& s = r.split;
+    o << "| " << r.scene << " | " << r.effect << " | " << r.preset
+      << (r.params.empty() ? "" : " " + r.params) << " | " << fmt(r.nrmse, 4) << " | "
+      << fmt(s.estimatorNrmse, 4) << " | " << percent(s.shareOffscreen) << " / "
+      << percent(s.shareHidden) << " / " << percent(s.shareEstimator) << " |\n";
+  }
+  return o.str();
+}
+
 std::string markdown(const std::vector<Row>& rows, const RunInfo& info,
                      const std::vector<std::pair<std::string, std::string>>& plots) {
   std::ostringstream o;
@@ -273,6 +370,7 @@ std::string markdown(const std::vector<Row>& rows, const RunInfo& info,
       << fmt(r.floorMs > 0 ? r.effectMs / r.floorMs : 0.0, 3) << " | " << r.compared << " vs "
       << r.reference << " | " << fmt(r.nrmse, 4) << " | " << fmt(r.ssim, 4) << " |\n";
   }
+  if (anySplit(rows)) o << splitSection(rows);
   if (!plots.empty()) {
     o << "\n## Error against time\n\n";
     for (const auto& [title, file] : plots) o << "![" << title << "](" << file << ")\n\n";

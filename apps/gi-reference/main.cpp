@@ -1,7 +1,8 @@
-// gi-reference: CPU ground-truth renderer (Embree). Estimates ambient occlusion, obscurance, the
-// Alchemy obscurance integral, direct light or direct + one bounce for exactly the scene and
-// camera gi-render uses, and writes the float image, its per-pixel standard error and an 8-bit
-// preview. Prints the time taken, the samples per pixel reached and the mean standard error.
+// gi-reference: CPU ground-truth renderer (Embree). Estimates ambient occlusion (optionally split
+// by what a screen-space method can see), obscurance, the Alchemy obscurance integral, direct
+// light or direct + one bounce for exactly the scene and camera gi-render uses, and writes the
+// float image, its per-pixel standard error and an 8-bit preview. Prints the time taken, the
+// samples per pixel reached and the mean standard error.
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -20,8 +21,8 @@ namespace ref = gi::reference;
 
 const char* kUsage =
     "usage: gi-reference --scene FILE|default --out IMAGE.pfm [options]\n"
-    "  --quantity Q           ao, obscurance, alchemy, direct, direct+indirect, depth, normal\n"
-    "                         (default ao)\n"
+    "  --quantity Q           ao, obscurance, alchemy, direct, direct+indirect, depth, normal,\n"
+    "                         ao-split (default ao)\n"
     "  --radius R             AO / obscurance / Alchemy radius in world units (default 0.5)\n"
     "  --spp N                maximum samples per pixel (default 64)\n"
     "  --noise-target E       stop early once the mean per-pixel standard error is <= E\n"
@@ -43,6 +44,10 @@ const char* kUsage =
     "geometry),\n"
     "                         PREFIX_normal.pfm (view space), PREFIX_position.pfm (world)\n"
     "  --exposure E           preview exposure for the lighting quantities (default 1)\n"
+    "ao-split: --out holds AO_full (= ao); also written: <out>.visible.pfm (AO_visible, the AO\n"
+    "of the depth layer alone), <out>.offscreen.pfm and <out>.hidden.pfm (occluded fractions by\n"
+    "off-screen and hidden occluders), <out>.split.stderr.pfm (their standard errors, rgb) and,\n"
+    "with --png, <png>.visible.png, <png>.offscreen.png, <png>.hidden.png (grey previews)\n"
     "  --quiet                no progress lines\n";
 
 struct Options {
@@ -158,10 +163,34 @@ void checkWritable(const std::string& path) {
     throw gi::Error(gi::ErrorKind::FileNotFound, path, "output path is a folder");
 }
 
+// "dir/x.pfm" + ".visible" -> "dir/x.visible.pfm".
+std::string withSuffix(const std::string& path, const std::string& suffix) {
+  std::filesystem::path p(path);
+  const std::string ext = p.extension().string();
+  return p.replace_extension(suffix + ext).string();
+}
+
+// A single-channel plane of an RGBA image, repeated in rgb (alpha kept).
+gi::ImageRGBA32F grey(const gi::ImageRGBA32F& image, int c) {
+  gi::ImageRGBA32F out = image;
+  for (size_t i = 0; i + 3 < out.pixels.size(); i += 4)
+    out.pixels[i] = out.pixels[i + 1] = out.pixels[i + 2] = image.pixels[i + size_t(c)];
+  return out;
+}
+
 int run(const Options& o) {
   std::vector<std::pair<std::string, const gi::ImageRGBA32F*>> floats;
   std::vector<std::string> outputs = {o.out, o.stderrOut};
   if (!o.png.empty()) outputs.push_back(o.png);
+  const bool split = o.settings.quantity == ref::Quantity::AOSplit;
+  static const char* kSplitNames[3] = {".visible", ".offscreen", ".hidden"};
+  if (split) {
+    for (const char* suffix : kSplitNames) {
+      outputs.push_back(withSuffix(o.out, suffix));
+      if (!o.png.empty()) outputs.push_back(withSuffix(o.png, suffix));
+    }
+    outputs.push_back(withSuffix(o.out, ".split.stderr"));
+  }
   if (!o.gbuffer.empty())
     for (const char* suffix : {"_depth.pfm", "_normal.pfm", "_position.pfm"})
       outputs.push_back(o.gbuffer + suffix);
@@ -182,6 +211,13 @@ int run(const Options& o) {
 
   floats.push_back({o.out, &r.value});
   floats.push_back({o.stderrOut, &r.stdError});
+  std::vector<gi::ImageRGBA32F> splitPlanes;
+  if (split) {
+    for (int c = 0; c < 3; ++c) splitPlanes.push_back(grey(r.split, c));
+    for (int c = 0; c < 3; ++c)
+      floats.push_back({withSuffix(o.out, kSplitNames[c]), &splitPlanes[size_t(c)]});
+    floats.push_back({withSuffix(o.out, ".split.stderr"), &r.splitStdError});
+  }
   if (!o.gbuffer.empty()) {
     floats.push_back({o.gbuffer + "_depth.pfm", &r.depth});
     floats.push_back({o.gbuffer + "_normal.pfm", &r.normal});
@@ -198,6 +234,12 @@ int run(const Options& o) {
     if (!o.png.empty()) {
       gi::writePng(o.png, ref::preview(r.value, settings.quantity, o.exposure));
       written.push_back(o.png);
+      if (split)
+        for (int c = 0; c < 3; ++c) {
+          const std::string path = withSuffix(o.png, kSplitNames[c]);
+          gi::writePng(path, ref::previewChannel(r.split, c));
+          written.push_back(path);
+        }
     }
   } catch (...) {
     std::error_code ec;
@@ -208,13 +250,27 @@ int run(const Options& o) {
   std::printf("scene %s, %ux%u, %zu triangles, quantity %s", o.scene.c_str(), settings.width,
               settings.height, r.triangles, ref::quantityName(settings.quantity));
   if (settings.quantity == ref::Quantity::AO || settings.quantity == ref::Quantity::Alchemy ||
-      settings.quantity == ref::Quantity::Obscurance)
+      settings.quantity == ref::Quantity::Obscurance || split)
     std::printf(", radius %g", double(settings.radius));
   if (settings.quantity == ref::Quantity::Obscurance)
     std::printf(", membership %s", ref::membershipName(settings.membership));
   std::printf("\n");
   std::printf("time %.3f s, %u samples per pixel, mean standard error %.6g (%zu geometry pixels)\n",
               r.seconds, r.spp, r.meanStdError, r.geometryPixels);
+  if (split) {
+    const ref::AoSplitSummary m = ref::summarizeAoSplit(r);
+    std::printf(
+        "ao-split: mean AO_full %.6g, AO_visible %.6g; occluded fraction by visible %.6g, "
+        "off-screen %.6g, hidden %.6g; screen-space limit NRMSE(AO_visible vs AO_full) %.6g\n",
+        m.aoFull, m.aoVisible, m.visible, m.offscreen, m.hidden, m.limitNrmse);
+    const double occluded = double(std::max<uint64_t>(r.splitOccluded, 1));
+    std::printf(
+        "ao-split: of the occluded rays, %.4g%% counted visible through a layer surface behind "
+        "their first hit, %.4g%% counted hidden with the first hit in front of the layer "
+        "(sub-pixel)\n",
+        100.0 * double(r.splitVisibleBehind) / occluded,
+        100.0 * double(r.splitHiddenInFront) / occluded);
+  }
   for (const std::string& path : written) std::printf("wrote %s\n", path.c_str());
   return 0;
 }

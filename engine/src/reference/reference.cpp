@@ -317,9 +317,105 @@ glm::vec3 sampleQuantity(const Settings& s, const Shading& shading, const Primar
     }
     case Quantity::Depth:
     case Quantity::Normal:
+    case Quantity::AOSplit:  // sampleAoSplit
       break;
   }
   return glm::vec3(0.0f);
+}
+
+// The camera and the depth layer (the primary hits) that the AO split classifies occluders
+// against: what a single-layer depth buffer of the rasteriser holds.
+struct DepthLayer {
+  glm::dmat4 view{1.0}, proj{1.0};
+  glm::dvec3 eye{0.0};
+  uint32_t width = 1, height = 1;
+  double znear = 0.0, zfar = 0.0;
+  double relTolerance = 0.01, absTolerance = 0.0;  // |d - D| <= rel d + abs
+  const std::vector<Primary>* primary = nullptr;
+  std::vector<double> viewDepth;  // -view z of each pixel's primary hit (0 on sky)
+};
+
+enum class Occluder { Visible, Offscreen, Hidden, HiddenInFront };
+
+// Where a surface point stands with respect to the camera's depth layer (see reference.h).
+Occluder classifyOccluder(const DepthLayer& layer, const glm::vec3& point) {
+  const glm::dvec3 x(point);
+  const glm::dvec4 viewPos = layer.view * glm::dvec4(x, 1.0);
+  const double d = -viewPos.z;
+  if (!(d >= layer.znear && d <= layer.zfar)) return Occluder::Offscreen;
+  const glm::dvec4 clip = layer.proj * viewPos;
+  if (!(clip.w > 0.0)) return Occluder::Offscreen;
+  const double nx = clip.x / clip.w, ny = clip.y / clip.w;
+  if (!(std::abs(nx) <= 1.0 && std::abs(ny) <= 1.0)) return Occluder::Offscreen;
+  const int W = int(layer.width), H = int(layer.height);
+  const int ix = std::clamp(int(std::floor((nx + 1.0) * 0.5 * W)), 0, W - 1);
+  const int iy = std::clamp(int(std::floor((ny + 1.0) * 0.5 * H)), 0, H - 1);
+  const double tolerance = layer.relTolerance * d + layer.absTolerance;
+  const glm::dvec3 u = x - layer.eye;  // the eye ray through x: view depth t d at eye + t u
+  const double ulen = glm::length(u);
+  // The pixel itself first, then its 8 neighbours.
+  static constexpr int kOffsets[9][2] = {{0, 0}, {-1, -1}, {0, -1}, {1, -1}, {-1, 0},
+                                         {1, 0}, {-1, 1},  {0, 1},  {1, 1}};
+  for (const auto& o : kOffsets) {
+    const int qx = ix + o[0], qy = iy + o[1];
+    if (qx < 0 || qy < 0 || qx >= W || qy >= H) continue;
+    const size_t q = size_t(qy) * layer.width + size_t(qx);
+    const Primary& p = (*layer.primary)[q];
+    if (!p.geometry) continue;
+    if (std::abs(d - layer.viewDepth[q]) <= tolerance) return Occluder::Visible;
+    // The pixel's surface extended by its tangent plane to where the eye ray through x meets it.
+    const glm::dvec3 n(p.hit.geometricNormal);
+    const double denom = glm::dot(u, n);
+    if (std::abs(denom) > 1e-9 * ulen) {
+      const double t = glm::dot(glm::dvec3(p.hit.position) - layer.eye, n) / denom;
+      if (t > 0.0 && std::isfinite(t) && std::abs(d - t * d) <= tolerance) return Occluder::Visible;
+    }
+  }
+  const size_t own = size_t(iy) * layer.width + size_t(ix);
+  const bool behind = (*layer.primary)[own].geometry && d > layer.viewDepth[own];
+  return behind ? Occluder::Hidden : Occluder::HiddenInFront;
+}
+
+struct SplitSample {
+  glm::vec4 value{0.0f};  // open (AO_full), 1 - visible-occluded (AO_visible), f_off, f_hid
+  bool visibleBehind = false, hiddenInFront = false;
+};
+
+// One sample of the AO split: the AO direction, its first hit within r classified; a first hit
+// outside the depth layer lets the ray go on to look for a layer surface behind it within r.
+SplitSample sampleAoSplit(const Settings& s, const Shading& shading, const DepthLayer& layer,
+                          const Primary& p, Rng& rng) {
+  constexpr int kMaxLayers = 64;  // surfaces followed along one ray (ends a pathological loop)
+  const RayScene& rays = shading.rays();
+  const glm::vec3 origin = RayScene::spawnOrigin(p.hit);
+  const glm::vec3 dir = cosineDirection(p.hit.shadingNormal, rng);
+  SplitSample out;
+  SurfaceHit h;
+  if (!rays.intersect(origin, dir, 0.0f, s.radius, h)) {
+    out.value = glm::vec4(1.0f, 1.0f, 0.0f, 0.0f);
+    return out;
+  }
+  const Occluder first = classifyOccluder(layer, h.position);
+  if (first == Occluder::Visible) {
+    out.value = glm::vec4(0.0f, 0.0f, 0.0f, 0.0f);
+    return out;
+  }
+  for (int k = 0; k < kMaxLayers; ++k) {
+    const float tnear = h.t + std::max(RayScene::offsetDistance(h), h.t * 1e-6f);
+    if (!(tnear < s.radius) || !rays.intersect(origin, dir, tnear, s.radius, h)) break;
+    if (classifyOccluder(layer, h.position) == Occluder::Visible) {
+      out.value = glm::vec4(0.0f, 0.0f, 0.0f, 0.0f);
+      out.visibleBehind = true;
+      return out;
+    }
+  }
+  if (first == Occluder::Offscreen) {
+    out.value = glm::vec4(0.0f, 1.0f, 1.0f, 0.0f);
+  } else {
+    out.value = glm::vec4(0.0f, 1.0f, 0.0f, 1.0f);
+    out.hiddenInFront = first == Occluder::HiddenInFront;
+  }
+  return out;
 }
 
 template <class F>
@@ -338,7 +434,7 @@ void validate(const Settings& s) {
   if (s.width < 1 || s.height < 1 || s.width > 16384 || s.height > 16384)
     usage("image size must be 1..16384 pixels per side");
   const bool needsRadius = s.quantity == Quantity::AO || s.quantity == Quantity::Obscurance ||
-                           s.quantity == Quantity::Alchemy;
+                           s.quantity == Quantity::Alchemy || s.quantity == Quantity::AOSplit;
   if (needsRadius && !(s.radius > 0.0f && std::isfinite(s.radius)))
     usage("radius must be a positive finite number");
   if (s.spp < 1) usage("samples per pixel must be at least 1");
@@ -365,11 +461,12 @@ ImageRGBA32F blank(uint32_t w, uint32_t h) {
 }  // namespace
 
 Quantity parseQuantity(const std::string& name) {
-  for (Quantity q : {Quantity::AO, Quantity::Obscurance, Quantity::Alchemy, Quantity::Direct,
-                     Quantity::DirectIndirect, Quantity::Depth, Quantity::Normal})
+  for (Quantity q :
+       {Quantity::AO, Quantity::Obscurance, Quantity::Alchemy, Quantity::Direct,
+        Quantity::DirectIndirect, Quantity::Depth, Quantity::Normal, Quantity::AOSplit})
     if (name == quantityName(q)) return q;
   usage("unknown quantity '" + name +
-        "' (ao, obscurance, alchemy, direct, direct+indirect, depth, normal)");
+        "' (ao, obscurance, alchemy, direct, direct+indirect, depth, normal, ao-split)");
 }
 
 const char* quantityName(Quantity q) {
@@ -388,6 +485,8 @@ const char* quantityName(Quantity q) {
       return "depth";
     case Quantity::Normal:
       return "normal";
+    case Quantity::AOSplit:
+      return "ao-split";
   }
   return "?";
 }
@@ -490,28 +589,71 @@ Result render(const Scene& scene, const Settings& settings) {
     return result;
   }
 
+  // The AO split classifies occluders against the depth layer of the primary hits above.
+  const bool aoSplit = settings.quantity == Quantity::AOSplit;
+  DepthLayer layer;
+  std::vector<uint32_t> visibleBehind, hiddenInFront;  // per pixel, AOSplit diagnostics
+  if (aoSplit) {
+    layer.view = view;
+    layer.proj = proj;
+    layer.eye = eye;
+    layer.width = W;
+    layer.height = H;
+    layer.znear = znear;
+    layer.zfar = zfar;
+    layer.absTolerance = 1e-3 * double(settings.radius);
+    layer.primary = &primary;
+    layer.viewDepth.assign(N, 0.0);
+    for (size_t i = 0; i < N; ++i)
+      if (primary[i].geometry) layer.viewDepth[i] = -double(result.depth.pixels[i * 4 + 1]);
+    result.split = blank(W, H);
+    result.splitStdError = blank(W, H);
+    visibleBehind.assign(N, 0);
+    hiddenInFront.assign(N, 0);
+  }
+
   // Progressive estimation: per-pixel running mean and M2 (Welford) in double, extended in
-  // passes of growing size until the sample budget or the noise target is reached.
-  std::vector<double> mean(N * 3, 0.0), m2(N * 3, 0.0);
+  // passes of growing size until the sample budget or the noise target is reached. Four
+  // channels: the quantity's rgb (AO_full, AO_visible, f_off, f_hid for the AO split).
+  constexpr int C = 4;
+  std::vector<double> mean(N * C, 0.0), m2(N * C, 0.0);
   const bool alchemy = settings.quantity == Quantity::Alchemy;
   const AlchemyParams& ap = settings.alchemy;
   uint32_t done = 0;
+  auto standardError = [&](size_t i, int c) {
+    const double var = done > 1 ? m2[i * C + c] / double(done - 1) : 0.0;
+    return std::sqrt(std::max(var, 0.0) / double(done));
+  };
+  auto finiteFloat = [](double v) { return std::isfinite(v) ? float(v) : 0.0f; };
   auto finishPixel = [&](size_t i) {
     // Value and standard error of the pixel after `done` samples.
     glm::vec3 value, se;
-    for (int c = 0; c < 3; ++c) {
-      const double m = mean[i * 3 + c];
-      const double var = done > 1 ? m2[i * 3 + c] / double(done - 1) : 0.0;
-      double err = std::sqrt(std::max(var, 0.0) / double(done));
-      double v = m;
-      if (alchemy) {
-        const double base = 1.0 - m;
-        v = base > 0.0 ? std::pow(base, double(ap.contrast)) : 0.0;
-        if (ap.contrast != 1.0f)
-          err *= base > 0.0 ? std::min(ap.contrast * std::pow(base, ap.contrast - 1.0), 1e6) : 0.0;
+    if (aoSplit) {
+      value = glm::vec3(finiteFloat(mean[i * C]));
+      se = glm::vec3(finiteFloat(standardError(i, 0)));
+      setPixel(result.split, i,
+               glm::vec3(finiteFloat(mean[i * C + 1]), finiteFloat(mean[i * C + 2]),
+                         finiteFloat(mean[i * C + 3])),
+               1.0f);
+      setPixel(result.splitStdError, i,
+               glm::vec3(finiteFloat(standardError(i, 1)), finiteFloat(standardError(i, 2)),
+                         finiteFloat(standardError(i, 3))),
+               1.0f);
+    } else {
+      for (int c = 0; c < 3; ++c) {
+        const double m = mean[i * C + c];
+        double err = standardError(i, c);
+        double v = m;
+        if (alchemy) {
+          const double base = 1.0 - m;
+          v = base > 0.0 ? std::pow(base, double(ap.contrast)) : 0.0;
+          if (ap.contrast != 1.0f)
+            err *=
+                base > 0.0 ? std::min(ap.contrast * std::pow(base, ap.contrast - 1.0), 1e6) : 0.0;
+        }
+        value[c] = finiteFloat(v);
+        se[c] = finiteFloat(err);
       }
-      value[c] = std::isfinite(v) ? float(v) : 0.0f;
-      se[c] = std::isfinite(err) ? float(err) : 0.0f;
     }
     setPixel(result.value, i, value, 1.0f);
     setPixel(result.stdError, i, se, 1.0f);
@@ -528,13 +670,21 @@ Result render(const Scene& scene, const Settings& settings) {
         if (!p.geometry) continue;
         for (uint32_t s = from; s < to; ++s) {
           Rng rng = Rng::forSample(settings.seed, i, s);
-          glm::vec3 v = sampleQuantity(settings, shading, p, rng);
-          if (!finite(v)) v = glm::vec3(0.0f);  // guard: never let a NaN into the estimate
+          glm::vec4 v(0.0f);
+          if (aoSplit) {
+            const SplitSample split = sampleAoSplit(settings, shading, layer, p, rng);
+            v = split.value;
+            visibleBehind[i] += split.visibleBehind;
+            hiddenInFront[i] += split.hiddenInFront;
+          } else {
+            v = glm::vec4(sampleQuantity(settings, shading, p, rng), 0.0f);
+            if (!finite(glm::vec3(v))) v = glm::vec4(0.0f);  // guard: never let a NaN in
+          }
           const double n = double(s) + 1.0;
-          for (int c = 0; c < 3; ++c) {
-            const double d = double(v[c]) - mean[i * 3 + c];
-            mean[i * 3 + c] += d / n;
-            m2[i * 3 + c] += d * (double(v[c]) - mean[i * 3 + c]);
+          for (int c = 0; c < C; ++c) {
+            const double d = double(v[c]) - mean[i * C + c];
+            mean[i * C + c] += d / n;
+            m2[i * C + c] += d * (double(v[c]) - mean[i * C + c]);
           }
         }
       }
@@ -557,10 +707,60 @@ Result render(const Scene& scene, const Settings& settings) {
     if (primary[i].geometry) continue;
     setPixel(result.value, i, lighting ? finiteOrZero(skyRadiance[i]) : glm::vec3(1.0f), 0.0f);
     setPixel(result.stdError, i, glm::vec3(0.0f), 0.0f);
+    if (aoSplit) {
+      setPixel(result.split, i, glm::vec3(1.0f, 0.0f, 0.0f), 0.0f);
+      setPixel(result.splitStdError, i, glm::vec3(0.0f), 0.0f);
+    }
   }
+  if (aoSplit)
+    for (size_t i = 0; i < N; ++i) {
+      if (!primary[i].geometry) continue;
+      // Occluded samples: 1 - AO_full of `done`, an integer count up to rounding.
+      result.splitOccluded += uint64_t(std::llround((1.0 - mean[i * C]) * double(done)));
+      result.splitVisibleBehind += visibleBehind[i];
+      result.splitHiddenInFront += hiddenInFront[i];
+    }
   result.spp = done;
   result.seconds = elapsed();
   return result;
+}
+
+AoSplitSummary summarizeAoSplit(const Result& r) {
+  AoSplitSummary s;
+  const size_t n = size_t(r.value.width) * size_t(r.value.height);
+  if (r.split.pixels.size() != n * 4 || r.value.pixels.size() != n * 4) return s;
+  double sumFull = 0.0, sumVisible = 0.0, sumOff = 0.0, sumHidden = 0.0, se = 0.0;
+  for (size_t i = 0; i < n; ++i) {
+    if (!(r.split.pixels[i * 4 + 3] > 0.5f)) continue;
+    const double full = r.value.pixels[i * 4], visible = r.split.pixels[i * 4];
+    sumFull += full;
+    sumVisible += visible;
+    sumOff += r.split.pixels[i * 4 + 1];
+    sumHidden += r.split.pixels[i * 4 + 2];
+    se += (visible - full) * (visible - full);
+    ++s.pixels;
+  }
+  if (s.pixels == 0) return s;
+  const double count = double(s.pixels);
+  s.aoFull = sumFull / count;
+  s.aoVisible = sumVisible / count;
+  s.offscreen = sumOff / count;
+  s.hidden = sumHidden / count;
+  s.visible = 1.0 - s.aoVisible;
+  s.limitNrmse = std::sqrt(se / count) / (s.aoFull > 1e-8 ? s.aoFull : 1.0);
+  return s;
+}
+
+ImageRGBA8 previewChannel(const ImageRGBA32F& image, int c) {
+  ImageRGBA8 out{image.width, image.height, std::vector<uint8_t>(image.pixels.size(), 255)};
+  c = std::clamp(c, 0, 3);
+  for (size_t i = 0; i + 3 < image.pixels.size(); i += 4) {
+    float v = image.pixels[i + size_t(c)];
+    if (!std::isfinite(v)) v = 0.0f;
+    const uint8_t g = uint8_t(std::clamp(v, 0.0f, 1.0f) * 255.0f + 0.5f);
+    out.pixels[i] = out.pixels[i + 1] = out.pixels[i + 2] = g;
+  }
+  return out;
 }
 
 ImageRGBA8 preview(const ImageRGBA32F& value, Quantity q, float exposure) {

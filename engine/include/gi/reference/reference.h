@@ -26,6 +26,32 @@
 //    emissive surfaces count as light sources here (only here: Direct ignores them as lights).
 //    Emitters are two-sided, like the rasteriser's surfaces.
 //  - Depth, Normal: the primary hit (deterministic, one sample).
+//  - AOSplit ("ao-split"): AO as above, with its occlusion split by what a single-layer screen-
+//    space method can see. Each occluded direction of the AO estimator (something within r) is
+//    put in exactly one class:
+//      visible:    some surface of the depth layer lies on the ray within r. The depth layer is
+//                  the set of primary hits this renderer traces (the same camera, pixel centres
+//                  and [znear, zfar] as the rasteriser's depth buffer). A ray point x, at view
+//                  depth d, belongs to it when it projects inside the frame and, for its pixel
+//                  or one of the 8 around it, |d - D| <= 0.01 d + 0.001 r, where D is that
+//                  pixel's primary view depth or the depth at which the ray from the eye through
+//                  x meets that pixel's primary tangent plane (point + geometric normal; exact
+//                  for planes seen at grazing angles). The first hit is tested first; when it is
+//                  not in the layer the ray goes on (up to r) through later hits: a depth-buffer
+//                  method does not know about a surface in front of a layer surface it sees.
+//      off-screen: otherwise, if the first hit lies outside the view frustum: outside the
+//                  image, behind the camera, nearer than znear or beyond zfar.
+//      hidden:     otherwise: the first hit projects inside the frame but is not in the depth
+//                  layer, i.e. lies behind the visible surface there (or, rarely, is sub-pixel
+//                  geometry between pixel centres in front of it; Result::splitHiddenInFront
+//                  counts those rays).
+//    Per pixel: AO_full (= AO; the value image), the fractions f_vis, f_off, f_hid of the
+//    cosine-weighted hemisphere occluded by each class, and AO_visible = 1 - f_vis, the AO of
+//    the depth layer alone (non-layer surfaces transparent): what a single-layer screen-space
+//    estimator can at best converge to. Per sample the four indicators sum to 1, so
+//    1 - AO_full = f_vis + f_off + f_hid holds per pixel up to float rounding. The samples are
+//    the AO quantity's (same seed, same directions, closest instead of any hit), so AO_full and
+//    its standard error equal the AO quantity's bit for bit.
 //
 // Estimators: i.i.d. cosine-weighted directions (pdf cos/pi), one per sample; each sample
 // reuses the pixel's deterministic light terms. The light of emissive surfaces in
@@ -71,9 +97,9 @@
 
 namespace gi::reference {
 
-enum class Quantity { AO, Obscurance, Alchemy, Direct, DirectIndirect, Depth, Normal };
+enum class Quantity { AO, Obscurance, Alchemy, Direct, DirectIndirect, Depth, Normal, AOSplit };
 
-// Command-line names: ao, obscurance, alchemy, direct, direct+indirect, depth, normal;
+// Command-line names: ao, obscurance, alchemy, direct, direct+indirect, depth, normal, ao-split;
 // memberships: sqrt, linear, smoothstep, step, exp. Throw gi::Error(Usage) for unknown names.
 Quantity parseQuantity(const std::string& name);
 const char* quantityName(Quantity q);
@@ -89,7 +115,7 @@ struct Progress {
 struct Settings {
   uint32_t width = 320, height = 240;
   Quantity quantity = Quantity::AO;
-  float radius = 0.5f;  // AO radius r, obscurance R, Alchemy r (world units)
+  float radius = 0.5f;  // AO / AO split radius r, obscurance R, Alchemy r (world units)
   Membership membership = Membership::Sqrt;
   AlchemyParams alchemy;
   uint32_t spp = 64;         // maximum samples per pixel
@@ -112,9 +138,21 @@ struct Result {
                           // 0 on sky (the sky mask, kept in 3-channel PFM files), a: same
   ImageRGBA32F normal;    // view-space normal facing the camera (the G-buffer's), a: mask
   ImageRGBA32F position;  // world-space position, a: mask
+  // AOSplit only (empty otherwise): r = AO_visible, g = off-screen occluded fraction f_off,
+  // b = hidden occluded fraction f_hid, a = mask; sky pixels (1, 0, 0, 0). The value image holds
+  // AO_full, so the visible-occluded fraction is f_vis = 1 - AO_visible = 1 - AO_full - f_off -
+  // f_hid. splitStdError: the per-pixel standard errors of r, g and b.
+  ImageRGBA32F split;
+  ImageRGBA32F splitStdError;
+  // AOSplit diagnostics, summed over all samples of all pixels: occluded rays; rays counted
+  // visible although their first hit was not in the depth layer (a layer surface further on
+  // within r); rays counted hidden whose first hit lies in front of the depth layer at its pixel
+  // (or projects onto sky), i.e. sub-pixel geometry rather than a surface behind the layer.
+  uint64_t splitOccluded = 0, splitVisibleBehind = 0, splitHiddenInFront = 0;
   CameraView camera;
   uint32_t spp = 0;           // samples per pixel reached (1 for depth/normal)
-  double meanStdError = 0.0;  // mean over geometry pixels of the per-pixel error (mean of rgb)
+  double meanStdError = 0.0;  // mean over geometry pixels of the per-pixel error (mean of rgb;
+                              // for AOSplit that of AO_full)
   double seconds = 0.0;       // wall time of render() (including the BVH build)
   size_t geometryPixels = 0;
   size_t triangles = 0;
@@ -128,8 +166,20 @@ Result render(const Scene& scene, const Settings& settings);
 // same function as environmentRadiance in engine/shaders/common.glsl.
 glm::vec3 environmentRadiance(const Environment& env, const glm::vec3& dir);
 
+// Per-pixel planes of an AOSplit result over its geometry pixels, and their means.
+struct AoSplitSummary {
+  size_t pixels = 0;                                    // geometry pixels
+  double aoFull = 0.0, aoVisible = 0.0;                 // means
+  double visible = 0.0, offscreen = 0.0, hidden = 0.0;  // mean occluded fractions
+  double limitNrmse = 0.0;  // RMS(AO_visible - AO_full) / mean(AO_full) (0 when no pixel)
+};
+AoSplitSummary summarizeAoSplit(const Result& r);
+
 // 8-bit preview: AO-like quantities as grey, lighting with the renderer's tonemap (exposure,
 // ACES fit, sRGB), depth as grey NDC depth, normals as n * 0.5 + 0.5.
 ImageRGBA8 preview(const ImageRGBA32F& value, Quantity q, float exposure = 1.0f);
+// 8-bit grey preview of channel c (0..2) of an image (values clamped to [0, 1]), e.g. the
+// fractions of Result::split.
+ImageRGBA8 previewChannel(const ImageRGBA32F& image, int c);
 
 }  // namespace gi::reference
