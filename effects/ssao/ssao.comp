@@ -7,7 +7,7 @@
 // the view-space normal; writes AO (1 = open) per pixel.
 //
 // Assumes a perspective projection (clip.w = view distance), as every engine camera has.
-layout(local_size_x = 8, local_size_y = 8) in;
+layout(local_size_x = 32, local_size_y = 16) in;
 
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 // Keep in sync with gi::ssao::Uniforms (ssao_kernel.h).
@@ -27,6 +27,13 @@ const float kMinClipW = 1e-20;
 // this close to the camera (|N.Q| below kSlideMinK x view distance): it would be ill-conditioned.
 const float kSlideMinK = 1e-4;
 
+// Clip coordinates of view-space v (a point or, linear in v, an offset) with x and y already
+// mapped to pixels: (x + w) / 2 * size, and w = -v.z (pixel = xy / w).
+vec3 clipToPixels(vec3 v, float p00, float p11, float p20, float p21, vec2 halfSize) {
+  float w = -v.z;
+  return vec3((vec2(p00 * v.x + p20 * v.z, p11 * v.y + p21 * v.z) + w) * halfSize, w);
+}
+
 void main() {
   ivec2 p = ivec2(gl_GlobalInvocationID.xy);
   ivec2 size = ivec2(frame.viewport.xy);
@@ -40,8 +47,18 @@ void main() {
     return;
   }
 
-  vec2 uv = (vec2(p) + 0.5) * frame.viewport.zw;
-  vec3 P = viewPositionFromDepth(frame.invProj, uv, depth);
+  // The projection's non-zero terms (perspective: clip.w = -z): the full mat4 products cost
+  // llvmpipe 16 multiply-adds each, these 2-3.
+  mat4 proj = frame.proj;
+  // Guards: a degenerate projection must not divide by zero.
+  float p00 = abs(proj[0][0]) > 1e-30 ? proj[0][0] : 1e-30;
+  float p11 = abs(proj[1][1]) > 1e-30 ? proj[1][1] : 1e-30;
+  float p32 = abs(proj[3][2]) > 1e-30 ? proj[3][2] : 1e-30;
+  float p20 = proj[2][0], p21 = proj[2][1], p22 = proj[2][2];
+  // Reverse-Z depth to view distance: 1/z = (d + P22) / P32 (affine in d), then x, y from NDC.
+  vec2 ndc = (vec2(p) + 0.5) * 2.0 * frame.viewport.zw - 1.0;
+  float dist = p32 / max(depth + p22, 1e-30);
+  vec3 P = vec3((ndc.x + p20) * dist / p00, (ndc.y + p21) * dist / p11, -dist);
   // Guard: a zero or NaN normal falls back to facing the camera.
   vec3 N = safeNormalize(normalTexel.xyz, safeNormalize(-P, vec3(0.0, 0.0, 1.0)));
 
@@ -60,17 +77,12 @@ void main() {
   // keeping only x, y and w (the view distance), with x and y already mapped to pixels:
   // pixel = (x + w) / w * size / 2.
   float R = ssao.params.x;
-  mat4 proj = frame.proj;
-  vec4 c0 = proj * vec4(P, 1.0), cT = proj * vec4(R * Tr, 0.0), cB = proj * vec4(R * Br, 0.0),
-       cN = proj * vec4(R * N, 0.0);
   vec2 halfSize = 0.5 * vec2(size);
-  vec3 clipP = vec3((c0.xy + c0.w) * halfSize, c0.w), clipT = vec3((cT.xy + cT.w) * halfSize, cT.w),
-       clipB = vec3((cB.xy + cB.w) * halfSize, cB.w), clipN = vec3((cN.xy + cN.w) * halfSize, cN.w);
-
-  // Reverse-Z depth to inverse view distance: 1/z = (d + P22) / P32 (affine in d). Guard: a
-  // degenerate projection (P32 = 0) must not divide by zero.
-  float p32 = abs(proj[3][2]) > 1e-30 ? proj[3][2] : 1e-30;
-  float invP32 = 1.0 / p32, p22 = proj[2][2];
+  vec3 clipP = clipToPixels(P, p00, p11, p20, p21, halfSize),
+       clipT = clipToPixels(R * Tr, p00, p11, p20, p21, halfSize),
+       clipB = clipToPixels(R * Br, p00, p11, p20, p21, halfSize),
+       clipN = clipToPixels(R * N, p00, p11, p20, p21, halfSize);
+  float invP32 = 1.0 / p32;
 
   // Texel-centre slide: the depth buffer is read at the centre of the texel a tap falls in, so
   // the tap is moved, parallel to the tangent plane, onto that centre's view ray before the
@@ -78,9 +90,7 @@ void main() {
   // offset along a grazing plane is otherwise a large depth error). On the plane N.X = K the
   // inverse distance is affine in NDC: 1/z(ndc') = 1/z(ndc) + (g . (ndc' - ndc)) / K with
   // g = (N.x / P00, N.y / P11); here in pixel units (g scaled by 2 / size).
-  vec2 g = vec2(N.x / (abs(proj[0][0]) > 1e-30 ? proj[0][0] : 1e-30),
-                N.y / (abs(proj[1][1]) > 1e-30 ? proj[1][1] : 1e-30)) *
-           2.0 * frame.viewport.zw;
+  vec2 g = vec2(N.x / p00, N.y / p11) * 2.0 * frame.viewport.zw;
   float NP = dot(N, P);
   float minK = -kSlideMinK * max(-P.z, 1e-20);  // strictly negative: min(K, minK) != 0
 
@@ -94,7 +104,12 @@ void main() {
                   float((code >> 11) & 2047u) * (2.0 / 2047.0) - 1.0,
                   float(code >> 22) * (1.0 / 1023.0));
     vec3 c = clipP + clipT * k.x + clipB * k.y + clipN * k.z;
-    float invW = 1.0 / max(c.z, kMinClipW);
+    // One division for both reciprocals the tap needs, 1 / w and 1 / K (K = N . Q, the rotation
+    // about N leaves it unchanged; clamped to <= minK < 0, so the product never vanishes).
+    float K = NP + R * k.z;
+    float Kc = min(K, minK), w = max(c.z, kMinClipW);
+    float r = 1.0 / (w * Kc);
+    float invW = r * Kc, invK = r * w;
     vec2 pix = c.xy * invW;
     // Guard: taps behind the camera or off screen count as unoccluded.
     bool valid = c.z > kMinClipW && pix.x >= 0.0 && pix.y >= 0.0 && pix.x < sizeF.x &&
@@ -102,8 +117,7 @@ void main() {
     ivec2 t = ivec2(clamp(pix, vec2(0.0), sizeF - 1.0));
     float iS = (texelFetch(gDepth, t, 0).r + p22) * invP32;  // stored surface, 1 / distance
 
-    float K = NP + R * k.z;  // N . Q (the rotation about N leaves it unchanged)
-    float slid = invW + dot(g, vec2(t) + 0.5 - pix) / min(K, minK);
+    float slid = invW + dot(g, vec2(t) + 0.5 - pix) * invK;
     float iQ = (K < minK && slid > 0.0) ? slid : invW;  // tap, 1 / distance
 
     // bias < zQ - zS < R, in inverse distances (both positive): no division needed.

@@ -15,7 +15,7 @@
 // plane comes from the centre's G-buffer normal; 1/z of a plane is affine in screen space, so
 // the prediction is exact along a plane at any angle, and a surface across a depth
 // discontinuity (or across a crease, once it leaves the plane) is rejected.
-layout(local_size_x = 8, local_size_y = 8) in;
+layout(local_size_x = 32, local_size_y = 16) in;
 
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 // Keep in sync with gi::ssao::Uniforms (ssao_kernel.h).
