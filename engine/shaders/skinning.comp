@@ -7,7 +7,7 @@
 #extension GL_GOOGLE_include_directive : require
 #include "common.glsl"
 
-layout(local_size_x = 64) in;
+layout(local_size_x = 256) in;
 
 // Vertex = position (3 floats), normal (3), uv (2): 8 floats, tightly packed.
 layout(set = 0, binding = 0, std430) readonly buffer Rest { float rest[]; };

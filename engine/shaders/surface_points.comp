@@ -5,7 +5,7 @@
 #extension GL_GOOGLE_include_directive : require
 #include "common.glsl"
 
-layout(local_size_x = 64) in;
+layout(local_size_x = 256) in;
 
 // x: instance, y: triangle (global, into Indices / 3), z, w: barycentrics b1, b2 (float bits).
 layout(set = 0, binding = 0, std430) readonly buffer Samples { uvec4 samples[]; };

@@ -535,7 +535,7 @@ struct Renderer::Impl : EffectContext {
             const uint32_t push[5] = {d.srcFirst, d.dstFirst, d.count, d.jointFirst, d.jointCount};
             vkCmdPushConstants(pc.cmd(), skinningPipeline.layout(), VK_SHADER_STAGE_ALL, 0,
                                sizeof(push), push);
-            vkCmdDispatch(pc.cmd(), (d.count + 63) / 64, 1, 1);
+            vkCmdDispatch(pc.cmd(), (d.count + 255) / 256, 1, 1);  // local_size_x 256
             d.dirty = false;
             skinnedThisFrame += d.count;
           }

@@ -20,8 +20,8 @@ void bindCompute(PassContext& pc, const vk::Pipeline& p, vk::DescriptorWriter& w
                           nullptr);
 }
 
-uint32_t groups64(uint64_t n) {
-  return uint32_t((n + 63) / 64);
+uint32_t groupsOf256(uint64_t n) {
+  return uint32_t((n + 255) / 256);
 }
 
 }  // namespace
@@ -85,7 +85,7 @@ void SurfacePointsPass::addPasses(FrameGraph& graph, BufferHandle vertices, cons
           float areaPerPoint;
         } push{count(), count() ? float(set_.totalArea / count()) : 0.0f};
         vkCmdPushConstants(pc.cmd(), update_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof push, &push);
-        if (count() > 0) vkCmdDispatch(pc.cmd(), groups64(count()), 1, 1);
+        if (count() > 0) vkCmdDispatch(pc.cmd(), groupsOf256(count()), 1, 1);
       });
   bb.put(resources::kSurfacePoints, *out);
 
@@ -112,7 +112,7 @@ void SurfacePointsPass::addPasses(FrameGraph& graph, BufferHandle vertices, cons
         const VkExtent2D e = pc.extent(view->image);
         const uint32_t clear[2] = {0u, 1u};
         vkCmdPushConstants(pc.cmd(), view_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof clear, clear);
-        vkCmdDispatch(pc.cmd(), groups64(uint64_t(e.width) * e.height), 1, 1);
+        vkCmdDispatch(pc.cmd(), groupsOf256(uint64_t(e.width) * e.height), 1, 1);
         // The splats overwrite cleared texels: order the two dispatches.
         VkMemoryBarrier2 barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER_2};
         barrier.srcStageMask = barrier.dstStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
@@ -123,7 +123,7 @@ void SurfacePointsPass::addPasses(FrameGraph& graph, BufferHandle vertices, cons
         vkCmdPipelineBarrier2(pc.cmd(), &dep);
         const uint32_t splat[2] = {count(), 0u};
         vkCmdPushConstants(pc.cmd(), view_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof splat, splat);
-        if (count() > 0) vkCmdDispatch(pc.cmd(), groups64(count()), 1, 1);
+        if (count() > 0) vkCmdDispatch(pc.cmd(), groupsOf256(count()), 1, 1);
       });
   bb.put(resources::kPointsView, view->image);
 }
