@@ -113,9 +113,10 @@ std::vector<SurfacePointSample> evaluateSurfacePoints(const Scene& scene,
     }
     const Mesh& mesh = scene.meshes[p.mesh];
     const glm::mat4& world = scene.nodes[p.node].world;
-    const Vertex& v0 = verts[mesh.indices[3 * p.triangle]];
-    const Vertex& v1 = verts[mesh.indices[3 * p.triangle + 1]];
-    const Vertex& v2 = verts[mesh.indices[3 * p.triangle + 2]];
+    const size_t base = size_t(p.triangle) * 3;
+    const Vertex& v0 = verts[mesh.indices[base]];
+    const Vertex& v1 = verts[mesh.indices[base + 1]];
+    const Vertex& v2 = verts[mesh.indices[base + 2]];
     const float b1 = p.barycentric.x, b2 = p.barycentric.y, b0 = 1.0f - b1 - b2;
     const glm::vec3 local = b0 * v0.position + b1 * v1.position + b2 * v2.position;
     glm::vec3 n = b0 * v0.normal + b1 * v1.normal + b2 * v2.normal;
