@@ -12,6 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "bench_support.h"
 #include "process.h"
 #include "test_support.h"
 
@@ -21,29 +22,11 @@ namespace {
 namespace fs = std::filesystem;
 
 std::string bench(const std::string& args) {
-  return test::binPath("gi-bench") + " --validation --no-progress " + args;
+  return test::benchCommand(args);
 }
 
-std::string readAll(const std::string& path) {
-  std::ifstream in(path);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-std::vector<std::string> split(const std::string& line, char sep) {
-  std::vector<std::string> out(1);
-  bool quoted = false;
-  for (char c : line) {
-    if (c == '"')
-      quoted = !quoted;
-    else if (c == sep && !quoted)
-      out.emplace_back();
-    else
-      out.back() += c;
-  }
-  return out;
-}
+using test::readAll;
+using test::splitCsvLine;
 
 TEST(BenchAoSplit, ReportsWhereScreenSpaceAoCannotConverge) {
   if (!fs::exists(test::binPath("plugins/gi_effect_ssao.so")))
@@ -61,7 +44,7 @@ TEST(BenchAoSplit, ReportsWhereScreenSpaceAoCannotConverge) {
   std::istringstream csv(readAll(out + "/results.csv"));
   std::string line;
   std::getline(csv, line);
-  const std::vector<std::string> header = split(line, ',');
+  const std::vector<std::string> header = splitCsvLine(line);
   std::map<std::string, size_t> col;
   for (size_t i = 0; i < header.size(); ++i) col[header[i]] = i;
   for (const char* k : {"reference_seconds", "limit_nrmse", "offscreen_nrmse", "hidden_nrmse",
@@ -70,7 +53,7 @@ TEST(BenchAoSplit, ReportsWhereScreenSpaceAoCannotConverge) {
     ASSERT_TRUE(col.count(k)) << k << " missing from " << line;
   size_t rows = 0;
   while (std::getline(csv, line)) {
-    const std::vector<std::string> cells = split(line, ',');
+    const std::vector<std::string> cells = splitCsvLine(line);
     ASSERT_EQ(cells.size(), header.size()) << line;
     auto num = [&](const char* k) { return std::stod(cells[col[k]]); };
     for (const char* k : {"limit_nrmse", "offscreen_nrmse", "hidden_nrmse", "estimator_nrmse"}) {

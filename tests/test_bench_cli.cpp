@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "bench_support.h"
 #include "process.h"
 #include "test_support.h"
 
@@ -19,32 +20,14 @@ namespace {
 namespace fs = std::filesystem;
 
 std::string bench(const std::string& args) {
-  return test::binPath("gi-bench") + " --validation --no-progress " + args;
+  return test::benchCommand(args);
 }
 
-std::string readAll(const std::string& path) {
-  std::ifstream in(path);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using test::readAll;
+using test::splitCsvLine;
 
 bool hasSsao() {
   return fs::exists(test::binPath("plugins/gi_effect_ssao.so"));
-}
-
-std::vector<std::string> splitCsvLine(const std::string& line) {
-  std::vector<std::string> out(1);
-  bool quoted = false;
-  for (char c : line) {
-    if (c == '"')
-      quoted = !quoted;
-    else if (c == ',' && !quoted)
-      out.emplace_back();
-    else
-      out.back() += c;
-  }
-  return out;
 }
 
 TEST(BenchCli, QuickSweepWritesFiniteResults) {

@@ -19,26 +19,9 @@ namespace fs = std::filesystem;
 namespace {
 
 // A fresh folder per test for files written on the fly.
-class TempDir {
+class TempDir : public gi::test::TempDir {
  public:
-  TempDir() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() /
-           ("gi_test_scene_io_" + std::to_string(::getpid()) + "_" + info->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  ~TempDir() { fs::remove_all(dir_); }
-  std::string write(const std::string& name, const std::string& text) const {
-    fs::path p = dir_ / name;
-    fs::create_directories(p.parent_path());
-    std::ofstream(p, std::ios::binary) << text;
-    return p.string();
-  }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-
- private:
-  fs::path dir_;
+  TempDir() : gi::test::TempDir("test_scene_io") {}
 };
 
 // Runs `load` and checks that it throws gi::Error of `kind` whose message names `file` (and

@@ -23,26 +23,10 @@ namespace fs = std::filesystem;
 namespace gi {
 namespace {
 
-// A fresh folder per test for scene files written on the fly.
-class TempDir {
+// A fresh folder per test for files written on the fly.
+class TempDir : public gi::test::TempDir {
  public:
-  TempDir() {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir_ = fs::temp_directory_path() /
-           ("gi_test_json_anim_" + std::to_string(::getpid()) + "_" + info->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  ~TempDir() { fs::remove_all(dir_); }
-  std::string write(const std::string& name, const std::string& text) const {
-    const fs::path p = dir_ / name;
-    fs::create_directories(p.parent_path());
-    std::ofstream(p, std::ios::binary) << text;
-    return p.string();
-  }
-
- private:
-  fs::path dir_;
+  TempDir() : gi::test::TempDir("test_json_anim") {}
 };
 
 void expectError(const std::function<void()>& load, ErrorKind kind, const std::string& file,

@@ -1,6 +1,9 @@
 #include "test_support.h"
 
+#include <unistd.h>
+
 #include <filesystem>
+#include <fstream>
 
 namespace gi::test {
 
@@ -16,6 +19,32 @@ std::string assimpModel(const std::string& relative) {
 
 std::string binPath(const std::string& name) {
   return (std::filesystem::path(GI_BIN_DIR) / name).string();
+}
+
+TempDir::TempDir(const std::string& prefix) {
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  const std::string test = info ? info->name() : "no_test";
+  dir_ = (std::filesystem::temp_directory_path() /
+          ("gi_" + prefix + "_" + std::to_string(::getpid()) + "_" + test))
+             .string();
+  std::filesystem::remove_all(dir_);
+  std::filesystem::create_directories(dir_);
+}
+
+TempDir::~TempDir() {
+  std::error_code ec;
+  std::filesystem::remove_all(dir_, ec);
+}
+
+std::string TempDir::write(const std::string& name, const std::string& text) const {
+  const std::filesystem::path p = std::filesystem::path(dir_) / name;
+  std::filesystem::create_directories(p.parent_path());
+  std::ofstream(p, std::ios::binary) << text;
+  return p.string();
+}
+
+std::string TempDir::path(const std::string& name) const {
+  return (std::filesystem::path(dir_) / name).string();
 }
 
 }  // namespace gi::test

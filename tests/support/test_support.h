@@ -14,6 +14,22 @@ std::string assimpModel(const std::string& relative);
 // Path to a built executable in build/bin.
 std::string binPath(const std::string& name);
 
+// A fresh folder per test (named after the test and the process) for files written on the
+// fly; removed with everything in it when the object goes away.
+class TempDir {
+ public:
+  explicit TempDir(const std::string& prefix);
+  ~TempDir();
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  // Writes `text` to `name` (sub-folders created) and returns the file's path.
+  std::string write(const std::string& name, const std::string& text) const;
+  std::string path(const std::string& name) const;
+
+ private:
+  std::string dir_;
+};
+
 }  // namespace gi::test
 
 // Skips the current test with a printed reason when ../shared/assets is missing.
