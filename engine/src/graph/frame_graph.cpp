@@ -163,7 +163,11 @@ struct FrameGraph::Resource {
   VkBuffer buffer = VK_NULL_HANDLE;
   VkExtent2D extent{};
   VkImageLayout finalLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-  SyncState state;  // during execute; persists across frames for imported resources
+  // During execute; persist across frames for imported resources. `state`: the layout, every
+  // stage that used the resource since its last write (what a new write waits for) and that
+  // write's access. `lastWrite`: the last write's stage and access. `visible`: the stages and
+  // accesses a barrier already made that write visible to (a later read elsewhere needs one).
+  SyncState state, lastWrite, visible;
   int transient = -1;
   int firstUse = -1, lastUse = -1;  // kept-pass indices
 };
@@ -189,6 +193,9 @@ struct FrameGraph::Slot {
   VkDeviceSize size = 0, alignment = 1;
   uint32_t typeBits = 0;
   std::vector<std::pair<int, int>> lifetimes;  // first/last kept-pass index of each occupant
+  // During execute: every stage that touched the memory this frame. A transient's first use
+  // waits for them, since an earlier occupant's reads and writes share its memory.
+  VkPipelineStageFlags2 usedStages = VK_PIPELINE_STAGE_2_NONE;
 };
 
 FrameGraph::FrameGraph(vk::Context& ctx, VkExtent2D outputExtent)
@@ -516,7 +523,31 @@ void FrameGraph::execute(VkCommandBuffer cmd, vk::DescriptorArena& descriptors, 
   if (!compiled_) throw Error(ErrorKind::Usage, "", "frame graph: execute() before compile()");
   // Transient contents never survive a frame: they start undefined.
   for (auto& r : resources_)
-    if (!r->imported) r->state = {};
+    if (!r->imported) r->state = r->lastWrite = r->visible = {};
+  for (Slot& slot : slots_) slot.usedStages = VK_PIPELINE_STAGE_2_NONE;
+  // The memory slot under a transient (nullptr for imported resources).
+  auto slotOf = [this](const Resource& r) -> Slot* {
+    if (r.imported || r.transient < 0) return nullptr;
+    const int slot = pool_[size_t(r.transient)]->slot;
+    return slot >= 0 ? &slots_[size_t(slot)] : nullptr;
+  };
+
+  // A read needs no barrier when nothing wrote the resource yet, or a barrier already made the
+  // last write visible to this stage and access.
+  auto alreadyVisible = [](const Resource& r, const SyncState& need) {
+    return r.lastWrite.access == VK_ACCESS_2_NONE ||
+           ((need.stage & ~r.visible.stage) == 0 && (need.access & ~r.visible.access) == 0);
+  };
+  // Bookkeeping after a barrier for a write or a layout change to `need`.
+  auto afterBarrier = [](Resource& r, const SyncState& need, bool write) {
+    r.state = need;
+    if (write) {
+      r.lastWrite = {need.layout, need.stage, need.access & kWriteAccess};
+      r.visible = {};  // nothing has seen this write yet
+    } else {
+      r.visible = need;
+    }
+  };
 
   PassContext pc;
   pc.graph_ = this;
@@ -537,22 +568,28 @@ void FrameGraph::execute(VkCommandBuffer cmd, vk::DescriptorArena& descriptors, 
       Resource& r = *resources_[a.resource];
       if (r.texture) {
         SyncState need = required(a.textureUsage, vk::isDepthFormat(r.textureDesc.format));
-        const bool hazard =
-            r.state.layout != need.layout || (r.state.access & kWriteAccess) || a.write;
-        if (!hazard) {  // read after read in the same layout: only widen the stages to wait on
-          r.state.stage |= need.stage;
+        const bool sameLayoutRead = !a.write && r.state.layout == need.layout;
+        if (sameLayoutRead && alreadyVisible(r, need)) {
+          r.state.stage |= need.stage;  // a later write waits for this reader too
+          if (Slot* slot = slotOf(r)) slot->usedStages |= need.stage;
           continue;
         }
         VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
-        b.srcStageMask = r.state.stage;
-        b.srcAccessMask = r.state.access & kWriteAccess;
+        // A read in the same layout waits for the last write only; a write or a layout change
+        // waits for every use since (write-after-read needs the readers done).
+        b.srcStageMask = sameLayoutRead ? r.lastWrite.stage : r.state.stage;
+        b.srcAccessMask = r.lastWrite.access;
         b.dstStageMask = need.stage;
         b.dstAccessMask = need.access;
         const bool discard = a.write && !readsResource(a.resource) && !r.imported;
         b.oldLayout = discard ? VK_IMAGE_LAYOUT_UNDEFINED : r.state.layout;
         b.newLayout = need.layout;
+        Slot* slot = slotOf(r);
+        if (b.srcStageMask == VK_PIPELINE_STAGE_2_NONE && slot)  // first use of aliased memory
+          b.srcStageMask = slot->usedStages;
         if (b.srcStageMask == VK_PIPELINE_STAGE_2_NONE)
           b.srcStageMask = VK_PIPELINE_STAGE_2_TOP_OF_PIPE_BIT;
+        if (slot) slot->usedStages |= need.stage;
         b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
         b.image = r.image;
         const VkImageAspectFlags aspect = vk::isDepthFormat(r.textureDesc.format)
@@ -567,23 +604,35 @@ void FrameGraph::execute(VkCommandBuffer cmd, vk::DescriptorArena& descriptors, 
               throw Error(ErrorKind::Usage, "",
                           "frame graph: pass '" + p->name + "' uses '" + r.name +
                               "' in two conflicting layouts");
+            e.srcStageMask |= b.srcStageMask;
+            e.srcAccessMask |= b.srcAccessMask;
             e.dstStageMask |= b.dstStageMask;
             e.dstAccessMask |= b.dstAccessMask;
             merged = true;
           }
         if (!merged) imageBarriers.push_back(b);
-        r.state = need;
+        if (sameLayoutRead) {
+          r.state.stage |= need.stage;
+          r.visible.stage |= need.stage;
+          r.visible.access |= need.access;
+        } else {
+          afterBarrier(r, need, a.write);
+        }
       } else {
         SyncState need = required(a.bufferUsage);
-        const bool hazard = (r.state.access & kWriteAccess) || a.write;
-        if (!hazard) {
+        if (!a.write && alreadyVisible(r, need)) {
           r.state.stage |= need.stage;
+          if (Slot* slot = slotOf(r)) slot->usedStages |= need.stage;
           continue;
         }
-        if (r.state.stage != VK_PIPELINE_STAGE_2_NONE) {
+        Slot* slot = slotOf(r);
+        VkPipelineStageFlags2 src = a.write ? r.state.stage : r.lastWrite.stage;
+        if (src == VK_PIPELINE_STAGE_2_NONE && slot) src = slot->usedStages;  // aliased memory
+        if (slot) slot->usedStages |= need.stage;
+        if (src != VK_PIPELINE_STAGE_2_NONE) {
           VkBufferMemoryBarrier2 b{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2};
-          b.srcStageMask = r.state.stage;
-          b.srcAccessMask = r.state.access & kWriteAccess;
+          b.srcStageMask = src;
+          b.srcAccessMask = r.lastWrite.access;
           b.dstStageMask = need.stage;
           b.dstAccessMask = need.access;
           b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
@@ -591,7 +640,13 @@ void FrameGraph::execute(VkCommandBuffer cmd, vk::DescriptorArena& descriptors, 
           b.size = VK_WHOLE_SIZE;
           bufferBarriers.push_back(b);
         }
-        r.state = need;
+        if (a.write) {
+          afterBarrier(r, need, true);
+        } else {
+          r.state.stage |= need.stage;
+          r.visible.stage |= need.stage;
+          r.visible.access |= need.access;
+        }
       }
     }
     if (!imageBarriers.empty() || !bufferBarriers.empty()) {

@@ -157,7 +157,15 @@ void Context::createInstance(const ContextOptions& options) {
   info.ppEnabledLayerNames = layers.data();
   info.enabledExtensionCount = static_cast<uint32_t>(extensions.size());
   info.ppEnabledExtensionNames = extensions.data();
-  if (validation_) info.pNext = &dbg;  // also catches messages from instance creation
+  // Synchronization validation too: missing or wrong barriers (the frame graph derives them)
+  // are errors like any other. Provided by the validation layer itself.
+  const VkValidationFeatureEnableEXT enables[] = {
+      VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT};
+  VkValidationFeaturesEXT features{VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT};
+  features.enabledValidationFeatureCount = 1;
+  features.pEnabledValidationFeatures = enables;
+  features.pNext = &dbg;
+  if (validation_) info.pNext = &features;  // dbg also catches messages from instance creation
   check(vkCreateInstance(&info, nullptr, &instance_), "vkCreateInstance");
 
   if (validation_) {
