@@ -102,6 +102,7 @@ TEST(BenchCli, BadInputFailsBeforeRendering) {
       {"--effects none --grid nodot=1", "nodot"},
       {"--effects none --grid ssao.samples=4", "ssao"},
       {"--frames 0", "--frames"},
+      {"--metric ssim", "--metric"},  // only with --calibrate
   };
   for (const auto& [args, needle] : cases) {
     auto r = test::runCommand(

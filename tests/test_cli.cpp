@@ -132,6 +132,29 @@ TEST(Cli, InfinitePositionsNeverRenderNaN) {
   for (float v : img.pixels) ASSERT_TRUE(std::isfinite(v));
 }
 
+// The points view with --surface-points, timed per isolated pass: the pass table lists the
+// point passes, the image shows points, and without a reader the pass is reported culled.
+TEST(Cli, SurfacePointsViewAndIsolatedTimings) {
+  const std::string dir = test::makeTempDir("cli-points");
+  auto r =
+      test::runCommand(render("default", dir + "/points.png",
+                              "--surface-points 80000 --view points --isolate-passes --timings"));
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  for (const char* line : {"surface_points", "points_view", "surface points: 80000\n"})
+    EXPECT_NE(r.output.find(line), std::string::npos) << line << "\n" << r.output;
+  const ImageRGBA8 img = readPng(dir + "/points.png");
+  size_t lit = 0;
+  for (size_t i = 0; i < img.pixels.size(); i += 4)
+    lit += img.pixels[i] + img.pixels[i + 1] + img.pixels[i + 2] > 0;
+  EXPECT_GT(lit, img.pixels.size() / 4 / 4) << "few points visible";
+  r = test::runCommand(render("default", dir + "/plain.png", "--surface-points 20000 --timings"));
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_NE(r.output.find("pass culled"), std::string::npos) << r.output;
+  r = test::runCommand(render("default", dir + "/bad.png", "--surface-points -1"));
+  EXPECT_EQ(r.exitCode, 2) << r.output;
+  EXPECT_FALSE(fs::exists(dir + "/bad.png"));
+}
+
 TEST(Cli, UsageErrors) {
   auto r = test::runCommand(test::binPath("gi-render") + " --scene default");
   EXPECT_EQ(r.exitCode, 2) << r.output;

@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <glm/gtc/matrix_transform.hpp>
+
 #include "gi/animation.h"
 #include "gi/renderer.h"
 #include "gi/scene_io.h"
@@ -45,6 +47,7 @@ void expectGpuPointsMatchCpu(vk::Context& ctx, const Scene& scene, uint32_t coun
   rs.view = "points";
   Renderer r(ctx, scene, rs);
   ASSERT_TRUE(contains(r.passNames(), "surface_points"));
+  EXPECT_TRUE(r.readSurfacePoints().empty()) << "no frame has evaluated the points yet";
   const SurfacePointSet& set = r.surfacePoints();
   ASSERT_EQ(set.points.size(), count);
   const double size = sceneSize(scene);
@@ -89,6 +92,69 @@ TEST_F(SurfacePointsGpuTest, FollowMorphTargets) {
 
 TEST_F(SurfacePointsGpuTest, RigidSceneMatchesCpu) {
   expectGpuPointsMatchCpu(ctx(), makeDefaultScene(), 30000, {0.0, 0.7});
+}
+
+// One quad (two triangles, 4 vertices) in the xz plane with material `material`; `strayIndex`
+// appends a 7th index (a scene built in code may have one: triangle lists ignore it).
+Mesh quad(float size, uint32_t material, bool strayIndex = false) {
+  Mesh m;
+  const float h = 0.5f * size;
+  for (glm::vec2 c : {glm::vec2(-h, -h), glm::vec2(h, -h), glm::vec2(h, h), glm::vec2(-h, h)})
+    m.vertices.push_back({{c.x, 0.0f, c.y}, {0, 1, 0}, {0, 0}});
+  m.indices = {0, 2, 1, 0, 3, 2};
+  if (strayIndex) m.indices.push_back(0);
+  m.material = material;
+  m.boundsMin = {-h, 0, -h};
+  m.boundsMax = {h, 0, h};
+  return m;
+}
+
+// Rigid and skinned instances together: a mesh drawn by two nodes (one mirrored: its normals
+// must flip consistently), a material index past the end (clamped on both sides), a mesh
+// whose index count is not a multiple of 3 before another one (its first index is not a
+// multiple of 3 either), and a skinned character, through several animation steps.
+TEST_F(SurfacePointsGpuTest, MixedRigidInstancedMirroredAndSkinned) {
+  Scene scene = loadGltf(test::assimpModel("glTF2/simple_skin/simple_skin.gltf"));
+  scene.meshes.push_back(quad(1.0f, 0, true));
+  scene.meshes.push_back(quad(3.0f, 7));
+  const int stray = int(scene.meshes.size()) - 2, mesh = stray + 1;
+  const int a = scene.addNode("quad", glm::translate(glm::mat4(1.0f), glm::vec3(0, -1, 0)));
+  const int b = scene.addNode(
+      "mirrored quad",
+      glm::scale(glm::translate(glm::mat4(1.0f), {0, 2, 0}), glm::vec3(-1.0f, 1.0f, 1.0f)));
+  const int c = scene.addNode("small quad", glm::translate(glm::mat4(1.0f), glm::vec3(2, 0, 0)));
+  scene.nodes[a].meshes.push_back(mesh);
+  scene.nodes[b].meshes.push_back(mesh);
+  scene.nodes[c].meshes.push_back(stray);
+  scene.updateWorldTransforms();
+  expectGpuPointsMatchCpu(ctx(), scene, 30000, {0.0, 0.8, 2.2});
+}
+
+// Points asked for on a scene without area: none exist, the view still renders (cleared)
+// without validation errors and the read-back is empty.
+TEST_F(SurfacePointsGpuTest, NoAreaGivesNoPointsAndAnEmptyView) {
+  Scene scene;
+  Mesh m;
+  m.vertices = {{{0, 0, 0}, {0, 1, 0}, {0, 0}},
+                {{1, 1, 1}, {0, 1, 0}, {0, 0}},
+                {{2, 2, 2}, {0, 1, 0}, {0, 0}}};
+  m.indices = {0, 1, 2};
+  scene.meshes.push_back(m);
+  scene.materials.emplace_back();
+  scene.nodes[scene.addNode("line", glm::mat4(1.0f))].meshes.push_back(0);
+  scene.updateWorldTransforms();
+  RenderSettings rs;
+  rs.width = 32;
+  rs.height = 24;
+  rs.surfacePoints = 1000;
+  rs.view = "points";
+  Renderer r(ctx(), scene, rs);
+  r.renderFrame();
+  EXPECT_TRUE(r.surfacePoints().points.empty());
+  EXPECT_TRUE(r.readSurfacePoints().empty());
+  const ImageRGBA32F img = r.readTarget("points");
+  for (size_t i = 0; i < img.pixels.size(); i += 4)
+    ASSERT_EQ(img.pixels[i] + img.pixels[i + 1] + img.pixels[i + 2], 0.0f);
 }
 
 TEST_F(SurfacePointsGpuTest, PassOnlyWhenAskedForAndRead) {

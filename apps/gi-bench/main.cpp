@@ -81,6 +81,7 @@ struct Options {
   bool quick = false, calibrate = false, progress = true, validation = false, aoSplit = false;
   double budgetMs = 0.0, headroom = 0.1;
   std::string metric = "ssim";  // --calibrate: what "most accurate" means
+  bool metricGiven = false;
   bool sizeGiven = false, framesGiven = false, sppGiven = false;
   std::string commandLine;
 };
@@ -158,6 +159,7 @@ Options parseArgs(int argc, char** argv) {
       o.calibrate = true;
     else if (a == "--metric") {
       o.metric = value();
+      o.metricGiven = true;
       if (o.metric != "ssim" && o.metric != "nrmse")
         usageError(a, "expects ssim or nrmse, got '" + o.metric + "'");
     } else if (a == "--no-progress")
@@ -172,6 +174,7 @@ Options parseArgs(int argc, char** argv) {
   if (o.out.empty()) usageError("", "--out is required");
   if (o.scenes.empty()) usageError("--scenes", "no scene given");
   if (o.presets.empty()) usageError("--presets", "no preset given");
+  if (!o.calibrate && o.metricGiven) usageError("--metric", "only applies to --calibrate");
   if (o.calibrate) {
     if (!(o.budgetMs > 0)) usageError("--calibrate", "needs --budget-ms");
     if (fs::path(o.out).extension() != ".json")

@@ -263,8 +263,12 @@ int run(const Options& o) {
     if (renderer.lastSkinnedVertexCount() > 0)
       std::printf("skinning: %u vertices deformed in the last frame\n",
                   renderer.lastSkinnedVertexCount());
+    const std::vector<std::string> passes = renderer.passNames();
     if (!renderer.surfacePoints().points.empty())
-      std::printf("surface points: %zu\n", renderer.surfacePoints().points.size());
+      std::printf("surface points: %zu%s\n", renderer.surfacePoints().points.size(),
+                  std::find(passes.begin(), passes.end(), "surface_points") == passes.end()
+                      ? " (pass culled: nothing reads them; --view points shows them)"
+                      : "");
     std::printf("frame graph compile %.3f ms (CPU), plugin loading %.3f ms (%zu effect(s))\n",
                 renderer.lastCompileMs(), pluginLoadMs, registry.names().size());
     rusage usage{};

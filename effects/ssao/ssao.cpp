@@ -65,6 +65,7 @@ class SsaoEffect : public gi::Effect {
 
   void prepare(gi::EffectContext& ctx, const gi::SettingValues&) override {
     gi::vk::Context& vk = ctx.vulkan();
+    vk.requireWorkgroup(kGroupX, kGroupY, "ssao");
     const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
                tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
                img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;

@@ -18,7 +18,8 @@ layout(push_constant) uniform Push {
 } pc;
 
 void main() {
-  uint i = gl_GlobalInvocationID.x;
+  // The grid is 2-D when one row of workgroups would exceed 65535 (dispatch256).
+  uint i = gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * 256u;
   ivec2 size = imageSize(outImage);
   if (pc.clear != 0u) {
     if (i < uint(size.x * size.y)) imageStore(outImage, ivec2(i % uint(size.x), i / uint(size.x)), vec4(0.0, 0.0, 0.0, 1.0));

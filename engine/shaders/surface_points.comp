@@ -7,7 +7,7 @@
 
 layout(local_size_x = 256) in;
 
-// x: instance, y: triangle (global, into Indices / 3), z, w: barycentrics b1, b2 (float bits).
+// x: instance, y: the triangle's first index in Indices, z, w: barycentrics b1, b2 (float bits).
 layout(set = 0, binding = 0, std430) readonly buffer Samples { uvec4 samples[]; };
 layout(set = 0, binding = 1, std430) readonly buffer Instances { Instance instances[]; };
 layout(set = 0, binding = 2, std430) readonly buffer Indices { uint indices[]; };
@@ -27,14 +27,14 @@ vec3 normal(uint v) {
 }
 
 void main() {
-  uint i = gl_GlobalInvocationID.x;
+  // The grid is 2-D when one row of workgroups would exceed 65535 (dispatch256).
+  uint i = gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * 256u;
   if (i >= pc.count) return;
   uvec4 s = samples[i];
   // Member by member: copying the whole Instance (prevModel included) costs llvmpipe loads.
   uvec4 material = instances[s.x].material;
   uint base = material.y;
-  uint i0 = indices[s.y * 3u] + base, i1 = indices[s.y * 3u + 1u] + base,
-       i2 = indices[s.y * 3u + 2u] + base;
+  uint i0 = indices[s.y] + base, i1 = indices[s.y + 1u] + base, i2 = indices[s.y + 2u] + base;
   float b1 = uintBitsToFloat(s.z), b2 = uintBitsToFloat(s.w), b0 = 1.0 - b1 - b2;
   vec3 p0 = position(i0), p1 = position(i1), p2 = position(i2);
   vec3 local = b0 * p0 + b1 * p1 + b2 * p2;

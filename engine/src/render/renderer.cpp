@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <map>
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -95,7 +96,9 @@ struct Renderer::Impl : EffectContext {
   Sampler linearRepeat, linearClamp, nearestClamp;
   uint32_t lightCount = 0;
   LightSetup lightSetup;
+  std::map<int, std::vector<std::pair<glm::vec3, glm::vec3>>> morphBounds;  // morphDeltaBounds
   glm::mat4 prevViewProj{1.0f};  // the camera of the previous frame (motion vectors)
+  uint64_t framesRendered = 0;
   // Shadows: one map per shadowed light (slot), rendered as one or six views.
   std::vector<ShadowMap> shadowMaps;
   Buffer shadowViewBuffer;
@@ -262,7 +265,7 @@ struct Renderer::Impl : EffectContext {
         const uint32_t materialIndex =
             std::min<uint32_t>(mesh.material, uint32_t(sceneMaterials.size() - 1));
         inst.material = glm::uvec4(materialIndex, uint32_t(vertexOffset), 0, 0);
-        instanceRefs.push_back({int(n), m, uint32_t(instances.size()), ranges[m].firstIndex / 3});
+        instanceRefs.push_back({int(n), m, uint32_t(instances.size()), ranges[m].firstIndex});
         draws.push_back({ranges[m].firstIndex, ranges[m].indexCount, vertexOffset,
                          uint32_t(instances.size()), materialIndex});
         instances.push_back(inst);
@@ -366,17 +369,33 @@ struct Renderer::Impl : EffectContext {
     shadowPipeline = Pipeline::graphics(ctx, sd);
   }
 
-  // World bounds of the posed geometry: each instance's mesh box under its node's transform;
-  // a skinned instance's box under every joint's skinning transform instead (a skinned vertex
-  // is a weighted mean of those transforms of itself, so it stays inside their union).
-  void posedBounds(glm::vec3& lo, glm::vec3& hi) const {
+  // Per-axis min and max of a morph target's position deltas (cached: targets never change).
+  const std::pair<glm::vec3, glm::vec3>& morphDeltaBounds(int mesh, size_t target) {
+    auto& cached = morphBounds[mesh];
+    if (cached.empty())
+      for (const MorphTarget& t : scene.meshes[mesh].morphTargets) {
+        glm::vec3 lo(0.0f), hi(0.0f);
+        for (const glm::vec3& d : t.positionDeltas)
+          if (std::isfinite(d.x) && std::isfinite(d.y) && std::isfinite(d.z)) {
+            lo = glm::min(lo, d);
+            hi = glm::max(hi, d);
+          }
+        cached.emplace_back(lo, hi);
+      }
+    return cached[target];
+  }
+
+  // World bounds of the posed geometry: each instance's mesh box (widened by its morph
+  // targets at the current weights) under its node's transform, and for a skinned instance
+  // also under every joint's skinning transform (a skinned vertex is a weighted mean of those
+  // transforms of itself, or stays in its bind pose when its weights vanish).
+  void posedBounds(glm::vec3& lo, glm::vec3& hi) {
     lo = glm::vec3(std::numeric_limits<float>::max());
     hi = -lo;
-    auto addBox = [&](const Mesh& mesh, const glm::mat4& m) {
+    auto addBox = [&](const glm::vec3& bmin, const glm::vec3& bmax, const glm::mat4& m) {
       for (int i = 0; i < 8; ++i) {
-        const glm::vec3 c(i & 1 ? mesh.boundsMax.x : mesh.boundsMin.x,
-                          i & 2 ? mesh.boundsMax.y : mesh.boundsMin.y,
-                          i & 4 ? mesh.boundsMax.z : mesh.boundsMin.z);
+        const glm::vec3 c(i & 1 ? bmax.x : bmin.x, i & 2 ? bmax.y : bmin.y,
+                          i & 4 ? bmax.z : bmin.z);
         const glm::vec3 w = glm::vec3(m * glm::vec4(c, 1.0f));
         if (!std::isfinite(w.x) || !std::isfinite(w.y) || !std::isfinite(w.z)) continue;
         lo = glm::min(lo, w);
@@ -386,11 +405,19 @@ struct Renderer::Impl : EffectContext {
     for (size_t n = 0; n < pose.nodes.size(); ++n)
       for (int m : pose.nodes[n].meshes) {
         const Mesh& mesh = scene.meshes[m];
+        glm::vec3 bmin = mesh.boundsMin, bmax = mesh.boundsMax;
+        const std::vector<float>& weights = pose.nodes[n].morphWeights;
+        for (size_t t = 0; t < mesh.morphTargets.size() && t < weights.size(); ++t) {
+          // Per-axis worst case of w * delta over the target's vertices, added target by target.
+          const float w = std::isfinite(weights[t]) ? weights[t] : 0.0f;
+          const auto& [dmin, dmax] = morphDeltaBounds(m, t);
+          bmin += glm::min(glm::vec3(0.0f), glm::min(w * dmin, w * dmax));
+          bmax += glm::max(glm::vec3(0.0f), glm::max(w * dmin, w * dmax));
+        }
         const glm::mat4& world = pose.nodes[n].world;
-        const std::vector<glm::mat4> joints =
-            mesh.skinned() ? jointMatrices(pose, int(n)) : std::vector<glm::mat4>{};
-        if (joints.empty()) addBox(mesh, world);
-        for (const glm::mat4& j : joints) addBox(mesh, world * j);
+        addBox(bmin, bmax, world);
+        if (mesh.skinned())
+          for (const glm::mat4& j : jointMatrices(pose, int(n))) addBox(bmin, bmax, world * j);
       }
     if (lo.x > hi.x) {  // no geometry: a unit box keeps the shadow fit finite
       lo = glm::vec3(-1.0f);
@@ -423,6 +450,7 @@ struct Renderer::Impl : EffectContext {
   }
 
   void createPipelines() {
+    ctx.requireWorkgroup(256, 1, "skinning / surface points");  // local_size_x 256
     const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
                tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
                img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
@@ -487,6 +515,11 @@ struct Renderer::Impl : EffectContext {
     prevViewProj = cameraView.proj * cameraView.view;
     if (scene.activeCameraNode >= 0)
       cameraView = activeCamera(pose, float(settings.width) / float(settings.height));
+    if (framesRendered == 0) {
+      // No frame was seen before this pose: nothing moved (no motion from the load pose).
+      prevViewProj = cameraView.proj * cameraView.view;
+      for (gpu::Instance& inst : instances) inst.prevModel = inst.model;
+    }
     updateLights();
   }
 
@@ -914,6 +947,7 @@ struct Renderer::Impl : EffectContext {
     submitAndWait(cmd);
     timings.clear();
     for (auto& [name, ms] : timer.collect()) timings.push_back({name, ms});
+    ++framesRendered;
   }
 
   void setEffectSettings(const std::string& name, const SettingValues& values) {

@@ -1,5 +1,6 @@
 #include "render/surface_points_pass.h"
 
+#include <algorithm>
 #include <cstring>
 #include <map>
 #include <memory>
@@ -20,8 +21,13 @@ void bindCompute(PassContext& pc, const vk::Pipeline& p, vk::DescriptorWriter& w
                           nullptr);
 }
 
-uint32_t groupsOf256(uint64_t n) {
-  return uint32_t((n + 255) / 256);
+// Dispatches n invocations of a 256-wide workgroup as a 2-D grid: one row holds at most 65535
+// groups (the guaranteed maxComputeWorkGroupCount); the shaders flatten the grid again.
+void dispatch256(VkCommandBuffer cmd, uint64_t n) {
+  const uint64_t groups = (n + 255) / 256;
+  if (groups == 0) return;
+  const uint64_t x = std::min<uint64_t>(groups, 65535);
+  vkCmdDispatch(cmd, uint32_t(x), uint32_t((groups + x - 1) / x), 1);
 }
 
 }  // namespace
@@ -38,7 +44,7 @@ SurfacePointsPass::SurfacePointsPass(vk::Context& ctx, const Scene& scene, uint3
     if (it == byNodeMesh.end())
       throw Error(ErrorKind::InvalidData, scene.sourcePath,
                   "surface point on a mesh instance the renderer does not draw");
-    glm::uvec4 s(it->second->instance, it->second->firstTriangle + p.triangle, 0u, 0u);
+    glm::uvec4 s(it->second->instance, it->second->firstIndex + 3 * p.triangle, 0u, 0u);
     std::memcpy(&s.z, &p.barycentric.x, 4);
     std::memcpy(&s.w, &p.barycentric.y, 4);
     packed.push_back(s);
@@ -47,9 +53,11 @@ SurfacePointsPass::SurfacePointsPass(vk::Context& ctx, const Scene& scene, uint3
   if (packed.empty()) packed.emplace_back(0u);
   samples_ = vk::createDeviceBuffer(ctx, packed.data(), packed.size() * sizeof(glm::uvec4),
                                     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  // Zeros until the pass first runs: a read-back never sees uninitialised memory.
+  const std::vector<glm::vec4> zeros(packed.size() * 2, glm::vec4(0.0f));
   points_ =
-      vk::Buffer(ctx, packed.size() * kPointBytes,
-                 VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT, false);
+      vk::createDeviceBuffer(ctx, zeros.data(), zeros.size() * sizeof(glm::vec4),
+                             VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
   const auto ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
   update_ = vk::Pipeline::compute(ctx, vk::loadSpirv("surface_points.comp"),
                                   {{0, ssbo}, {1, ssbo}, {2, ssbo}, {3, ssbo}, {4, ssbo}}, 8);
@@ -85,7 +93,8 @@ void SurfacePointsPass::addPasses(FrameGraph& graph, BufferHandle vertices, cons
           float areaPerPoint;
         } push{count(), count() ? float(set_.totalArea / count()) : 0.0f};
         vkCmdPushConstants(pc.cmd(), update_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof push, &push);
-        if (count() > 0) vkCmdDispatch(pc.cmd(), groupsOf256(count()), 1, 1);
+        dispatch256(pc.cmd(), count());
+        evaluated_ = true;
       });
   bb.put(resources::kSurfacePoints, *out);
 
@@ -112,7 +121,7 @@ void SurfacePointsPass::addPasses(FrameGraph& graph, BufferHandle vertices, cons
         const VkExtent2D e = pc.extent(view->image);
         const uint32_t clear[2] = {0u, 1u};
         vkCmdPushConstants(pc.cmd(), view_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof clear, clear);
-        vkCmdDispatch(pc.cmd(), groupsOf256(uint64_t(e.width) * e.height), 1, 1);
+        dispatch256(pc.cmd(), uint64_t(e.width) * e.height);
         // The splats overwrite cleared texels: order the two dispatches.
         VkMemoryBarrier2 barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER_2};
         barrier.srcStageMask = barrier.dstStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
@@ -123,12 +132,13 @@ void SurfacePointsPass::addPasses(FrameGraph& graph, BufferHandle vertices, cons
         vkCmdPipelineBarrier2(pc.cmd(), &dep);
         const uint32_t splat[2] = {count(), 0u};
         vkCmdPushConstants(pc.cmd(), view_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof splat, splat);
-        if (count() > 0) vkCmdDispatch(pc.cmd(), groupsOf256(count()), 1, 1);
+        dispatch256(pc.cmd(), count());
       });
   bb.put(resources::kPointsView, view->image);
 }
 
 std::vector<SurfacePointSample> SurfacePointsPass::read(vk::Context& ctx) const {
+  if (!evaluated_) return {};
   std::vector<SurfacePointSample> out(count());
   if (out.empty()) return out;
   vk::Buffer staging(ctx, points_.size(), VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);

@@ -19,8 +19,8 @@ class SurfacePointsPass {
   // Where each mesh instance lives in the renderer's buffers.
   struct InstanceRef {
     int node = 0, mesh = 0;
-    uint32_t instance = 0;       // index into the instance buffer
-    uint32_t firstTriangle = 0;  // first triangle of the mesh in the index buffer
+    uint32_t instance = 0;    // index into the instance buffer
+    uint32_t firstIndex = 0;  // the mesh's first index in the index buffer
   };
   struct Buffers {
     VkBuffer vertices, indices, instances, frameUniforms;
@@ -37,13 +37,16 @@ class SurfacePointsPass {
 
   const SurfacePointSet& set() const { return set_; }
   uint32_t count() const { return uint32_t(set_.points.size()); }
-  // The points as the last executed frame left them (waits for the device).
+  // The points as the last executed frame left them (waits for the device); empty until a
+  // frame ran the "surface_points" pass (it is culled when nothing reads the points).
   std::vector<SurfacePointSample> read(vk::Context& ctx) const;
+  bool evaluated() const { return evaluated_; }
 
  private:
   SurfacePointSet set_;
   vk::Buffer samples_, points_;
   vk::Pipeline update_, view_;
+  bool evaluated_ = false;
 };
 
 }  // namespace gi

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 
 #include "gi/animation.h"
 
@@ -101,16 +102,18 @@ std::vector<SurfacePointSample> evaluateSurfacePoints(const Scene& scene,
   std::vector<SurfacePointSample> out(set.points.size());
   if (set.points.empty()) return out;
   const float area = float(set.totalArea / double(set.points.size()));
-  // Posed vertices once per instance (points are grouped by instance in sampling order).
-  std::vector<Vertex> verts;
-  int cachedNode = -1, cachedMesh = -1;
+  // Posed vertices once per instance (points of all instances are interleaved).
+  std::map<std::pair<uint32_t, uint32_t>, std::vector<Vertex>> posed;
+  const uint32_t lastMaterial = uint32_t(std::max<size_t>(scene.materials.size(), 1) - 1);
   for (size_t i = 0; i < set.points.size(); ++i) {
     const SurfacePoint& p = set.points[i];
-    if (int(p.node) != cachedNode || int(p.mesh) != cachedMesh) {
-      verts = posedVertices(scene, int(p.node), int(p.mesh));
-      cachedNode = int(p.node);
-      cachedMesh = int(p.mesh);
-    }
+    auto it = posed.find({p.node, p.mesh});
+    if (it == posed.end())
+      it = posed
+               .emplace(std::make_pair(p.node, p.mesh),
+                        posedVertices(scene, int(p.node), int(p.mesh)))
+               .first;
+    const std::vector<Vertex>& verts = it->second;
     const Mesh& mesh = scene.meshes[p.mesh];
     const glm::mat4& world = scene.nodes[p.node].world;
     const size_t base = size_t(p.triangle) * 3;
@@ -129,7 +132,7 @@ std::vector<SurfacePointSample> evaluateSurfacePoints(const Scene& scene,
     s.position = glm::vec3(world * glm::vec4(local, 1.0f));
     s.normal = len2 > 1e-30f && std::isfinite(len2) ? n / std::sqrt(len2) : glm::vec3(0, 1, 0);
     s.area = area;
-    s.material = float(mesh.material);
+    s.material = float(std::min(mesh.material, lastMaterial));  // as the renderer clamps it
   }
   return out;
 }

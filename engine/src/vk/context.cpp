@@ -372,4 +372,17 @@ void Context::savePipelineCache() const {
   std::filesystem::rename(tmp, path, ec);
 }
 
+void Context::requireWorkgroup(uint32_t x, uint32_t y, const std::string& who) const {
+  const VkPhysicalDeviceLimits& l = properties_.limits;
+  if (x * y <= l.maxComputeWorkGroupInvocations && x <= l.maxComputeWorkGroupSize[0] &&
+      y <= l.maxComputeWorkGroupSize[1])
+    return;
+  throw Error(ErrorKind::Unsupported, "",
+              who + " needs compute workgroups of " + std::to_string(x) + "x" + std::to_string(y) +
+                  " invocations; " + deviceName() + " allows " +
+                  std::to_string(l.maxComputeWorkGroupInvocations) + " (" +
+                  std::to_string(l.maxComputeWorkGroupSize[0]) + "x" +
+                  std::to_string(l.maxComputeWorkGroupSize[1]) + ")");
+}
+
 }  // namespace gi::vk

@@ -44,6 +44,9 @@ class Context {
   VkQueue queue() const { return queue_; }
   uint32_t queueFamily() const { return queueFamily_; }
   const VkPhysicalDeviceProperties& properties() const { return properties_; }
+  // Throws a clear Unsupported error when the device cannot run compute workgroups of x * y
+  // invocations (Vulkan only guarantees 128); `who` names the shader in the message.
+  void requireWorkgroup(uint32_t x, uint32_t y, const std::string& who) const;
   std::string deviceName() const { return properties_.deviceName; }
   MemoryAllocator& allocator() { return *allocator_; }
   VkPipelineCache pipelineCache() const { return pipelineCache_; }
