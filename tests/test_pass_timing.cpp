@@ -77,7 +77,8 @@ TEST_F(PassTimingTest, PassTimesAccountForTheFrameOnACpuDevice) {
   rs.height = 48;
   rs.surfacePoints = 400000;
   rs.view = "points";
-  Renderer r(ctx(), makeDefaultScene(), rs);
+  const Scene scene = makeDefaultScene();  // the renderer keeps a reference
+  Renderer r(ctx(), scene, rs);
   std::vector<double> ratios;
   for (int i = 0; i < 6; ++i) {
     const auto start = std::chrono::steady_clock::now();
