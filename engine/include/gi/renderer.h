@@ -50,7 +50,8 @@ struct PassTiming {
 
 class Renderer {
  public:
-  // `registry` must outlive the renderer when effects are requested.
+  // `scene` must outlive the renderer (it is read, not copied: pass a named Scene, never a
+  // temporary); so must `registry` when effects are requested.
   Renderer(vk::Context& ctx, const Scene& scene, const RenderSettings& settings,
            const EffectRegistry* registry = nullptr);
   ~Renderer();
