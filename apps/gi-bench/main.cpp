@@ -66,10 +66,11 @@ const char* kUsage =
     "  --no-progress         no progress lines on stderr\n"
     "  --validation          Vulkan validation layers (also GI_VALIDATION=1)\n"
     "  --device NAME         Vulkan device by name or index (also GI_DEVICE)\n"
-    "Comparison table (by effect name): ssao, hbao, sao, alchemy -> its 'ao' resource vs\n"
-    "reference AO of the effect's 'radius'; ssdo, radiosity, instant_radiosity, ambient_transfer\n"
-    "-> the lit image vs reference direct+indirect; anything else (and none) -> the lit image vs\n"
-    "reference direct. Sky pixels (reference sky mask or G-buffer depth 0) are excluded.\n";
+    "Ground truth: what each effect declares it estimates (EffectInfo::estimates, shown by\n"
+    "gi-render --list-effects): ambient occlusion -> its 'ao' resource vs reference AO of the\n"
+    "effect's 'radius'; indirect light -> the lit image vs reference direct+indirect; direct\n"
+    "light (and none) -> the lit image vs reference direct. Sky pixels (reference sky mask or\n"
+    "G-buffer depth 0) are excluded.\n";
 
 struct Options {
   std::string out, cache, device;
@@ -202,22 +203,22 @@ struct Comparison {
   std::string effect;   // the effect that decided it ("" for the engine)
 };
 
-bool isAoEffect(const std::string& n) {
-  return n == "ssao" || n == "hbao" || n == "sao" || n == "alchemy";
-}
-bool isIndirectEffect(const std::string& n) {
-  return n == "ssdo" || n == "radiosity" || n == "instant_radiosity" || n == "ambient_transfer";
-}
-
 bool isAo(ref::Quantity q) {
   return q == ref::Quantity::AO || q == ref::Quantity::AOSplit;
 }
 
 // `aoSplit`: AO effects are compared with the ao-split reference (its value is AO_full).
-Comparison comparisonFor(const std::vector<gi::EffectConfig>& effects, bool aoSplit) {
+// What the effects estimate (EffectInfo::estimates) decides the ground truth: AO first, then
+// indirect light, else direct light.
+gi::GroundTruth estimates(const gi::EffectRegistry& registry, const std::string& effect) {
+  return registry.has(effect) ? registry.info(effect).estimates : gi::GroundTruth::DirectLight;
+}
+
+Comparison comparisonFor(const std::vector<gi::EffectConfig>& effects,
+                         const gi::EffectRegistry& registry, bool aoSplit) {
   Comparison c;
   for (const auto& e : effects)
-    if (isAoEffect(e.name)) {
+    if (estimates(registry, e.name) == gi::GroundTruth::AmbientOcclusion) {
       c.resource = gi::resources::kAO;
       c.quantity = aoSplit ? ref::Quantity::AOSplit : ref::Quantity::AO;
       c.effect = e.name;
@@ -227,7 +228,7 @@ Comparison comparisonFor(const std::vector<gi::EffectConfig>& effects, bool aoSp
       return c;
     }
   for (const auto& e : effects)
-    if (isIndirectEffect(e.name)) {
+    if (estimates(registry, e.name) == gi::GroundTruth::IndirectLight) {
       c.quantity = ref::Quantity::DirectIndirect;
       c.effect = e.name;
     }
@@ -666,7 +667,7 @@ std::vector<Config> buildConfigs(const Options& o, const Setup& s,
             }
           }
           c.effects = gi::resolveEffects(s.scenes[si].scene, c.presetPtr, ov, s.registry);
-          c.comparison = comparisonFor(c.effects, o.aoSplit);
+          c.comparison = comparisonFor(c.effects, s.registry, o.aoSplit);
           configs.push_back(std::move(c));
           size_t k = 0;
           for (; k < idx.size(); ++k) {
@@ -841,7 +842,7 @@ int runCalibrate(const Options& o) {
     ov.effects = effects;
     base = gi::resolveEffects(scene, nullptr, ov, s.registry);
   }
-  const Comparison cmp = comparisonFor(base, false);
+  const Comparison cmp = comparisonFor(base, s.registry, false);
   const std::map<ReferenceKey, Reference> refs =
       computeReferences(o, s, {ReferenceKey{0, cmp.quantity, cmp.radius}});
   const Reference& reference = refs.begin()->second;

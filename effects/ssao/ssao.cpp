@@ -42,6 +42,7 @@ class SsaoEffect : public gi::Effect {
     i.reads = {res::kDepth, res::kNormal};
     i.writes = {res::kAO};
     i.debugView = res::kAO;
+    i.estimates = gi::GroundTruth::AmbientOcclusion;
     return i;
   }
 

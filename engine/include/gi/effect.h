@@ -48,6 +48,13 @@ inline constexpr const char* kPointsView = "points";  // RGBA16F debug view of t
 // AO) or after it (it can read the lit colour, e.g. an indirect bounce).
 enum class EffectStage { BeforeLighting, AfterLighting };
 
+// What an effect's output approximates: gi-bench compares it with that ground truth.
+enum class GroundTruth {
+  DirectLight,       // the lit image against ray-traced direct light (the default)
+  AmbientOcclusion,  // its "ao" resource against ray-traced AO of its `radius` setting
+  IndirectLight,     // the lit image against direct light + one diffuse bounce
+};
+
 struct EffectInfo {
   std::string name;         // unique, lower case, used in scenes, presets, --effects and --view
   std::string version;      // the effect's own version
@@ -56,6 +63,7 @@ struct EffectInfo {
   std::vector<std::string> reads;   // well-known resources it reads
   std::vector<std::string> writes;  // resources it publishes on the blackboard
   std::string debugView;            // resource shown by `gi-render --view <name>`
+  GroundTruth estimates = GroundTruth::DirectLight;
 };
 
 // Services the engine offers effects while they build and record their passes.

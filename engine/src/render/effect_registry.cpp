@@ -182,6 +182,10 @@ std::string EffectRegistry::describe() const {
     for (auto& w : e.info.writes) writes += " " + w;
     s << ", reads:" << (reads.empty() ? " -" : reads)
       << ", writes:" << (writes.empty() ? " -" : writes) << ", debug view: " << e.info.debugView
+      << ", estimates: "
+      << (e.info.estimates == GroundTruth::AmbientOcclusion ? "ambient occlusion"
+          : e.info.estimates == GroundTruth::IndirectLight  ? "indirect light"
+                                                            : "direct light")
       << "\n";
     for (const SettingDesc& d : e.settings) {
       s << "  " << name << "." << d.name << " (" << settingTypeName(d.type) << ", default ";
