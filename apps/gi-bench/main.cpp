@@ -24,6 +24,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bench.h"
+#include "cli.h"
 #include "gi/effect_config.h"
 #include "gi/errors.h"
 #include "gi/image_io.h"
@@ -92,12 +93,8 @@ struct Options {
 }
 
 double parseNumber(const std::string& flag, const char* text, double lo, double hi) {
-  char* end = nullptr;
-  const double v = std::strtod(text, &end);
-  if (end == text || *end != '\0' || !(v >= lo && v <= hi))
-    usageError(flag, "expects a number in [" + std::to_string(lo) + ", " + std::to_string(hi) +
-                         "], got '" + text + "'");
-  return v;
+  if (const auto v = gi::cli::numberIn(text, lo, hi)) return *v;
+  usageError(flag, gi::cli::rangeMessage(text, lo, hi));
 }
 
 std::vector<std::string> splitList(const std::string& text) {
@@ -921,14 +918,8 @@ int runCalibrate(const Options& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
+  return gi::cli::runMain("gi-bench", [&] {
     const Options o = parseArgs(argc, argv);
     return o.calibrate ? runCalibrate(o) : runSweep(o);
-  } catch (const gi::Error& e) {
-    std::fprintf(stderr, "gi-bench: error (%s): %s\n", gi::errorKindName(e.kind()), e.what());
-    return e.kind() == gi::ErrorKind::Usage ? 2 : 1;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "gi-bench: error: %s\n", e.what());
-    return 1;
-  }
+  });
 }

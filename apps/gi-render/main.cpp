@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "cli.h"
 #include "gi/effect_config.h"
 #include "gi/errors.h"
 #include "gi/image_io.h"
@@ -68,12 +69,8 @@ struct Options {
 }
 
 double parseNumber(const std::string& flag, const char* text, double lo, double hi) {
-  char* end = nullptr;
-  double v = std::strtod(text, &end);
-  if (end == text || *end != '\0' || !(v >= lo && v <= hi))
-    usageError(flag + " expects a number in [" + std::to_string(lo) + ", " + std::to_string(hi) +
-               "], got '" + text + "'");
-  return v;
+  if (const auto v = gi::cli::numberIn(text, lo, hi)) return *v;
+  usageError(flag + " " + gi::cli::rangeMessage(text, lo, hi));
 }
 
 Options parseArgs(int argc, char** argv) {
@@ -287,13 +284,5 @@ int run(const Options& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
-    return run(parseArgs(argc, argv));
-  } catch (const gi::Error& e) {
-    std::fprintf(stderr, "gi-render: error (%s): %s\n", gi::errorKindName(e.kind()), e.what());
-    return e.kind() == gi::ErrorKind::Usage ? 2 : 1;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "gi-render: error: %s\n", e.what());
-    return 1;
-  }
+  return gi::cli::runMain("gi-render", [&] { return run(parseArgs(argc, argv)); });
 }
