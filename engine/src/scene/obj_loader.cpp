@@ -102,6 +102,18 @@ std::string lower(std::string s) {
   return s;
 }
 
+// Calls fn(line, 1-based line number) for every line of `text` (without the '\n').
+template <class Fn>
+void forEachLine(const std::string& text, Fn&& fn) {
+  size_t lineNo = 0, pos = 0;
+  while (pos <= text.size()) {
+    size_t end = text.find('\n', pos);
+    if (end == std::string::npos) end = text.size();
+    fn(std::string_view(text.data() + pos, end - pos), ++lineNo);
+    pos = end + 1;
+  }
+}
+
 struct MtlEntry {
   Material material;
   glm::vec3 ka{0.0f};
@@ -116,24 +128,18 @@ std::unordered_map<std::string, MtlEntry> readMtl(const std::string& path) {
   std::unordered_map<std::string, MtlEntry> out;
   std::string text = readTextFile(path);
   MtlEntry* current = nullptr;
-  size_t lineNo = 0, pos = 0;
-  while (pos <= text.size()) {
-    size_t end = text.find('\n', pos);
-    if (end == std::string::npos) end = text.size();
-    std::string_view line(text.data() + pos, end - pos);
-    pos = end + 1;
-    ++lineNo;
+  forEachLine(text, [&](std::string_view line, size_t lineNo) {
     if (size_t hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
     auto tok = tokens(line);
-    if (tok.empty()) continue;
+    if (tok.empty()) return;
     LineError err(path, lineNo);
     if (tok[0] == "newmtl") {
       std::string name = restOfLine(line, "newmtl");
       current = &out[name];
       current->material.name = name;
-      continue;
+      return;
     }
-    if (!current) continue;  // statements before the first newmtl have nothing to apply to
+    if (!current) return;  // statements before the first newmtl have nothing to apply to
     if (tok[0] == "Kd") {
       glm::vec3 kd = readVec<3>(tok, err, 1);
       if (tok.size() == 2) kd = glm::vec3(kd.x);  // "Kd r" means grey
@@ -153,7 +159,7 @@ std::unordered_map<std::string, MtlEntry> readMtl(const std::string& path) {
     } else if (tok[0] == "map_Kd" && tok.size() >= 2) {
       current->mapKd = std::string(tok.back());  // options (-s, -o ...) come before the file
     }
-  }
+  });
   return out;
 }
 
@@ -203,15 +209,9 @@ class ObjReader {
 
   MeshFileData read() {
     std::string text = readTextFile(path_);
-    size_t lineNo = 0, pos = 0;
-    while (pos <= text.size()) {
-      size_t end = text.find('\n', pos);
-      if (end == std::string::npos) end = text.size();
-      std::string_view line(text.data() + pos, end - pos);
-      pos = end + 1;
-      ++lineNo;
+    forEachLine(text, [&](std::string_view line, size_t lineNo) {
       parseLine(line, LineError(path_, lineNo));
-    }
+    });
     for (Group& g : groups_)
       if (!g.mesh.indices.empty()) data_.meshes.push_back(std::move(g.mesh));
     if (data_.meshes.empty())
