@@ -142,6 +142,7 @@ struct Renderer::Impl : EffectContext {
     cameraView = activeCamera(scene, float(settings.width) / float(settings.height));
     uploadScene();
     updateDeformations();  // joint matrices of the scene as loaded
+    updateLights();        // after the joints: the shadow fit bounds skinned meshes by them
     createPipelines();
     for (const EffectConfig& e : settings.effects) {
       if (!registry)
@@ -332,7 +333,6 @@ struct Renderer::Impl : EffectContext {
     pose.cameras = scene.cameras;
     pose.activeCameraNode = scene.activeCameraNode;
     prevViewProj = cameraView.proj * cameraView.view;
-    updateLights();
     const Environment& env = scene.environment;
     irradiance = irradianceSH(env);
     if (env.kind == Environment::Kind::Map && env.mapWidth > 0 && env.mapHeight > 0 &&
@@ -385,10 +385,10 @@ struct Renderer::Impl : EffectContext {
     return cached[target];
   }
 
-  // World bounds of the posed geometry: each instance's mesh box (widened by its morph
-  // targets at the current weights) under its node's transform, and for a skinned instance
-  // also under every joint's skinning transform (a skinned vertex is a weighted mean of those
-  // transforms of itself, or stays in its bind pose when its weights vanish).
+  // World bounds of the posed geometry (after updateDeformations): each instance's mesh box
+  // (widened by its morph targets at the current weights) under its node's transform, and for
+  // a skinned instance also under every joint's skinning transform (a skinned vertex is a weighted
+  // mean of those transforms of itself, or stays in its bind pose when its weights vanish).
   void posedBounds(glm::vec3& lo, glm::vec3& hi) {
     lo = glm::vec3(std::numeric_limits<float>::max());
     hi = -lo;
@@ -416,8 +416,12 @@ struct Renderer::Impl : EffectContext {
         }
         const glm::mat4& world = pose.nodes[n].world;
         addBox(bmin, bmax, world);
-        if (mesh.skinned())
-          for (const glm::mat4& j : jointMatrices(pose, int(n))) addBox(bmin, bmax, world * j);
+        // The joint matrices updateDeformations() just computed for this instance.
+        const auto d = std::find_if(deformed.begin(), deformed.end(), [&](const Deformed& e) {
+          return e.node == int(n) && e.mesh == m;
+        });
+        if (d != deformed.end())
+          for (const glm::mat4& j : d->lastJoints) addBox(bmin, bmax, world * j);
       }
     if (lo.x > hi.x) {  // no geometry: a unit box keeps the shadow fit finite
       lo = glm::vec3(-1.0f);
