@@ -164,11 +164,7 @@ class SsaoEffect : public gi::Effect {
 
   static void dispatch(gi::PassContext& pc, const gi::vk::Pipeline& p, gi::vk::DescriptorWriter& w,
                        uint32_t x, uint32_t y, const void* push = nullptr, uint32_t pushBytes = 0) {
-    VkDescriptorSet set = pc.descriptors().allocate(p.setLayout());
-    w.update(pc.context().device(), set);
-    vkCmdBindPipeline(pc.cmd(), VK_PIPELINE_BIND_POINT_COMPUTE, p.handle());
-    vkCmdBindDescriptorSets(pc.cmd(), VK_PIPELINE_BIND_POINT_COMPUTE, p.layout(), 0, 1, &set, 0,
-                            nullptr);
+    pc.descriptors().bind(pc.cmd(), p, w);
     if (pushBytes > 0)
       vkCmdPushConstants(pc.cmd(), p.layout(), VK_SHADER_STAGE_ALL, 0, pushBytes, push);
     vkCmdDispatch(pc.cmd(), x, y, 1);

@@ -58,17 +58,13 @@ class VignetteEffect : public gi::Effect {
         // uniform-only changes apply without a graph rebuild.
         [this, io, values = &settings, frame = ctx.frameUniforms(),
          sampler = ctx.nearestSampler()](gi::PassContext& pc) {
-          VkDescriptorSet set = pc.descriptors().allocate(pipeline_.setLayout());
-          gi::vk::DescriptorWriter()
-              .buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame)
+          gi::vk::DescriptorWriter writer;
+          writer.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame)
               .sampled(1, pc.view(io->in), sampler)
-              .storageImage(2, pc.view(io->out))
-              .update(pc.context().device(), set);
+              .storageImage(2, pc.view(io->out));
+          pc.descriptors().bind(pc.cmd(), pipeline_, writer);
           const Params params{float(values->number("strength")), float(values->number("radius"))};
           const VkExtent2D size = pc.extent(io->out);
-          vkCmdBindPipeline(pc.cmd(), VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_.handle());
-          vkCmdBindDescriptorSets(pc.cmd(), VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_.layout(), 0,
-                                  1, &set, 0, nullptr);
           vkCmdPushConstants(pc.cmd(), pipeline_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof params,
                              &params);
           vkCmdDispatch(pc.cmd(), (size.width + 7) / 8, (size.height + 7) / 8, 1);

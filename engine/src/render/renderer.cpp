@@ -628,10 +628,7 @@ struct Renderer::Impl : EffectContext {
   }
 
   void bind(VkCommandBuffer c, const Pipeline& p, DescriptorWriter& writer) {
-    VkDescriptorSet set = descriptors.allocate(p.setLayout());
-    writer.update(ctx.device(), set);
-    vkCmdBindPipeline(c, p.bindPoint(), p.handle());
-    vkCmdBindDescriptorSets(c, p.bindPoint(), p.layout(), 0, 1, &set, 0, nullptr);
+    descriptors.bind(c, p, writer);
   }
 
   void addGBufferPass(Blackboard& bb) {

@@ -13,14 +13,6 @@ namespace {
 
 constexpr VkDeviceSize kPointBytes = 2 * sizeof(glm::vec4);
 
-void bindCompute(PassContext& pc, const vk::Pipeline& p, vk::DescriptorWriter& w) {
-  VkDescriptorSet set = pc.descriptors().allocate(p.setLayout());
-  w.update(pc.context().device(), set);
-  vkCmdBindPipeline(pc.cmd(), VK_PIPELINE_BIND_POINT_COMPUTE, p.handle());
-  vkCmdBindDescriptorSets(pc.cmd(), VK_PIPELINE_BIND_POINT_COMPUTE, p.layout(), 0, 1, &set, 0,
-                          nullptr);
-}
-
 // Dispatches n invocations of a 256-wide workgroup as a 2-D grid: one row holds at most 65535
 // groups (the guaranteed maxComputeWorkGroupCount); the shaders flatten the grid again.
 void dispatch256(VkCommandBuffer cmd, uint64_t n) {
@@ -87,7 +79,7 @@ void SurfacePointsPass::addPasses(FrameGraph& graph, BufferHandle vertices, cons
             .buffer(2, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, in.indices)
             .buffer(3, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, in.vertices)
             .buffer(4, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, points_.handle());
-        bindCompute(pc, update_, w);
+        pc.descriptors().bind(pc.cmd(), update_, w);
         struct {
           uint32_t count;
           float areaPerPoint;
@@ -117,7 +109,7 @@ void SurfacePointsPass::addPasses(FrameGraph& graph, BufferHandle vertices, cons
             .buffer(1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, pc.buffer(view->points))
             .sampled(2, pc.view(view->depth), in.nearest)
             .storageImage(3, pc.view(view->image));
-        bindCompute(pc, view_, w);
+        pc.descriptors().bind(pc.cmd(), view_, w);
         const VkExtent2D e = pc.extent(view->image);
         const uint32_t clear[2] = {0u, 1u};
         vkCmdPushConstants(pc.cmd(), view_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof clear, clear);

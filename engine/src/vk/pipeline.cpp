@@ -178,6 +178,13 @@ VkDescriptorPool DescriptorArena::newPool() {
   return pool;
 }
 
+void DescriptorArena::bind(VkCommandBuffer cmd, const Pipeline& p, DescriptorWriter& writer) {
+  VkDescriptorSet set = allocate(p.setLayout());
+  writer.update(ctx_->device(), set);
+  vkCmdBindPipeline(cmd, p.bindPoint(), p.handle());
+  vkCmdBindDescriptorSets(cmd, p.bindPoint(), p.layout(), 0, 1, &set, 0, nullptr);
+}
+
 VkDescriptorSet DescriptorArena::allocate(VkDescriptorSetLayout layout) {
   for (;;) {
     if (current_ == pools_.size()) newPool();

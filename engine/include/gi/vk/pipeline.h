@@ -77,6 +77,8 @@ class Pipeline {
 
 // Descriptor sets that live for one frame: allocate freely, reset() when the frame is done.
 // Grows by adding pools, so callers never size it.
+class DescriptorWriter;
+
 class DescriptorArena {
  public:
   explicit DescriptorArena(Context& ctx) : ctx_(&ctx) {}
@@ -84,6 +86,8 @@ class DescriptorArena {
   DescriptorArena(const DescriptorArena&) = delete;
   DescriptorArena& operator=(const DescriptorArena&) = delete;
   VkDescriptorSet allocate(VkDescriptorSetLayout layout);
+  // Allocates a set for `p`, applies `writer` to it and binds the pipeline and the set.
+  void bind(VkCommandBuffer cmd, const Pipeline& p, DescriptorWriter& writer);
   void reset();
 
  private:
