@@ -30,14 +30,9 @@ namespace res = gi::resources;
 
 namespace {
 
-// Cofactor of the upper 3x3 (columns b x c, c x a, a x b), signed by the determinant: transforms
-// normals like the inverse transpose but stays finite when the matrix is singular.
+// Normal matrix: the cofactor of the model's 3x3 (gi::cofactor3), finite for singular ones.
 glm::mat4 normalMatrixOf(const glm::mat4& m) {
-  glm::vec3 a(m[0]), b(m[1]), c(m[2]);
-  glm::mat3 cof(glm::cross(b, c), glm::cross(c, a), glm::cross(a, b));
-  float det = glm::dot(a, glm::cross(b, c));
-  if (det < 0.0f) cof = -cof;
-  return glm::mat4(cof);
+  return glm::mat4(cofactor3(m));
 }
 
 // The shared vertex buffer as the graph sees it once deformed meshes are written into it.
