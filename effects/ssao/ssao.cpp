@@ -3,7 +3,9 @@
 // and a depth-aware blur that removes the interleave pattern. Publishes "ao", which the
 // lighting pass applies to the environment term. Estimator and kernel: ssao_kernel.h.
 #include <algorithm>
+#include <array>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "gi/effect.h"
@@ -155,11 +157,19 @@ class SsaoEffect : public gi::Effect {
  private:
   // Host-visible and written while recording: the renderer waits for each frame before it
   // records the next, so the GPU is not reading it. (Frames in flight would need one per frame.)
+  // The kernel and rotations are rebuilt only when a setting changed since the last upload.
   void upload(const gi::SettingValues& s) {
-    const gi::ssao::Uniforms u = gi::ssao::makeUniforms(
-        s.number("radius"), s.number("bias"), s.number("intensity"), s.integer("samples"),
-        s.integer("blur_radius"), s.flag("interleave"));
+    const std::array<double, 6> key = {s.number("radius"),
+                                       s.number("bias"),
+                                       s.number("intensity"),
+                                       double(s.integer("samples")),
+                                       double(s.integer("blur_radius")),
+                                       s.flag("interleave") ? 1.0 : 0.0};
+    if (key == uploaded_) return;
+    const gi::ssao::Uniforms u =
+        gi::ssao::makeUniforms(key[0], key[1], key[2], int(key[3]), int(key[4]), key[5] != 0.0);
     uniforms_.write(&u, sizeof u);
+    uploaded_ = key;
   }
 
   static void dispatch(gi::PassContext& pc, const gi::vk::Pipeline& p, gi::vk::DescriptorWriter& w,
@@ -188,6 +198,7 @@ class SsaoEffect : public gi::Effect {
 
   gi::vk::Pipeline ssao_, blur_;
   gi::vk::Buffer uniforms_;
+  std::optional<std::array<double, 6>> uploaded_;  // the settings uniforms_ holds
 };
 
 }  // namespace
