@@ -34,6 +34,10 @@ glm::vec3 environmentLookup(const Environment& env, const glm::vec3& dir);
 // convolved in), so E(n) = sum c_i Y_i(n).
 using SH9 = std::array<glm::vec3, 9>;
 std::array<float, 9> shBasis(const glm::vec3& n);
+// Sky and Constant environments as an equirect map: radiance at each texel centre, intensity
+// NOT applied (like mapRGB). irradianceSH projects this map at kTabulatedWidth x Height.
+constexpr int kTabulatedWidth = 128, kTabulatedHeight = 64;
+std::vector<float> tabulateEnvironment(const Environment& env, int width, int height);
 // Projects the environment (Sky and Constant are tabulated into a 128x64 map first).
 SH9 irradianceSH(const Environment& env);
 SH9 irradianceSHFromMap(int width, int height, const std::vector<float>& rgb, float intensity);
@@ -52,6 +56,13 @@ class EnvironmentSampler {
   };
   Sample sample(float u1, float u2) const;  // u1, u2 uniform in [0, 1)
   float pdf(const glm::vec3& dir) const;    // per unit solid angle
+  // Per unit solid angle, constant over texel (x, y); what sample() and pdf() return.
+  float texelPdf(int x, int y) const;
+  // cos(theta) of the top edge of row y (y = height: the bottom edge); sample() interpolates it.
+  float rowCosTheta(int y) const;
+  // The tables sample() searches, for uploading them to the GPU (gi::EnvironmentGpu).
+  const std::vector<float>& marginalCdf() const { return marginal_; }
+  const std::vector<float>& conditionalCdf() const { return conditional_; }
   int width() const { return width_; }
   int height() const { return height_; }
 

@@ -23,14 +23,26 @@ glm::vec3 texel(const Environment& env, int x, int y) {
   return {p[0], p[1], p[2]};
 }
 
-// Solid angle of one texel of row y (exact: the row's band of the sphere split in W).
+// Solid angle of one texel of row y (exact: the row's band of the sphere split in W). The
+// product form of cos(t0) - cos(t1) keeps pole rows of tall maps > 0 where the difference of
+// two cosines near 1 would round to 0 (and the pdf to inf).
 float texelSolidAngle(int y, int width, int height) {
   const float t0 = kPi * float(y) / float(height), t1 = kPi * float(y + 1) / float(height);
-  return 2.0f * kPi / float(width) * (std::cos(t0) - std::cos(t1));
+  return 2.0f * kPi / float(width) *
+         (2.0f * std::sin(0.5f * (t0 + t1)) * std::sin(0.5f * (t1 - t0)));
 }
 
-// Tabulates a non-map environment into a small map (for SH projection).
-std::vector<float> tabulate(const Environment& env, int w, int h) {
+// First index i with cdf[i + 1] > u (cdf ascending, cdf[0] = 0, cdf.back() = 1).
+int searchCdf(const float* cdf, int n, float u) {
+  const float* it = std::upper_bound(cdf + 1, cdf + n + 1, u);
+  return std::clamp(int(it - cdf) - 1, 0, n - 1);
+}
+
+}  // namespace
+
+std::vector<float> tabulateEnvironment(const Environment& env, int w, int h) {
+  w = std::max(w, 1);
+  h = std::max(h, 1);
   std::vector<float> rgb(size_t(w) * h * 3);
   Environment unit = env;
   unit.intensity = 1.0f;
@@ -42,14 +54,6 @@ std::vector<float> tabulate(const Environment& env, int w, int h) {
     }
   return rgb;
 }
-
-// First index i with cdf[i + 1] > u (cdf ascending, cdf[0] = 0, cdf.back() = 1).
-int searchCdf(const float* cdf, int n, float u) {
-  const float* it = std::upper_bound(cdf + 1, cdf + n + 1, u);
-  return std::clamp(int(it - cdf) - 1, 0, n - 1);
-}
-
-}  // namespace
 
 void loadEnvironmentMap(Environment& env, const std::string& file) {
   std::error_code ec;
@@ -145,8 +149,9 @@ SH9 irradianceSHFromMap(int width, int height, const std::vector<float>& rgb, fl
 SH9 irradianceSH(const Environment& env) {
   if (env.kind == Environment::Kind::Map)
     return irradianceSHFromMap(env.mapWidth, env.mapHeight, env.mapRGB, env.intensity);
-  constexpr int w = 128, h = 64;
-  return irradianceSHFromMap(w, h, tabulate(env, w, h), env.intensity);
+  return irradianceSHFromMap(kTabulatedWidth, kTabulatedHeight,
+                             tabulateEnvironment(env, kTabulatedWidth, kTabulatedHeight),
+                             env.intensity);
 }
 
 glm::vec3 evalIrradiance(const SH9& sh, const glm::vec3& n) {
@@ -215,23 +220,34 @@ EnvironmentSampler::Sample EnvironmentSampler::sample(float u1, float u2) const 
   const float fx =
       cdf[x + 1] > cdf[x] ? std::clamp((u2 - cdf[x]) / (cdf[x + 1] - cdf[x]), 0.0f, 1.0f) : 0.5f;
   // Uniform in phi and cos(theta) inside the texel: the pdf is constant over it.
-  const float c0 = std::cos(kPi * float(y) / float(height_));
-  const float c1 = std::cos(kPi * float(y + 1) / float(height_));
+  const float c0 = rowCosTheta(y), c1 = rowCosTheta(y + 1);
   const float cosTheta = std::clamp(c0 + (c1 - c0) * fy, -1.0f, 1.0f);
   const float sinTheta = std::sqrt(std::max(0.0f, 1.0f - cosTheta * cosTheta));
   const float phi = 2.0f * kPi * (float(x) + fx) / float(width_);
   Sample s;
   s.direction = {sinTheta * std::cos(phi), cosTheta, sinTheta * std::sin(phi)};
   s.pixel = y * width_ + x;
-  s.pdf = pixelProb_[size_t(s.pixel)] / texelSolidAngle(y, width_, height_);
+  s.pdf = texelPdf(x, y);
   return s;
+}
+
+float EnvironmentSampler::texelPdf(int x, int y) const {
+  x = std::clamp(x, 0, width_ - 1);
+  y = std::clamp(y, 0, height_ - 1);
+  const float dw = texelSolidAngle(y, width_, height_);
+  const float p = pixelProb_[size_t(y) * width_ + x];
+  return dw > 0.0f && p > 0.0f ? p / dw : 0.0f;  // guard: finite even if dw underflows
+}
+
+float EnvironmentSampler::rowCosTheta(int y) const {
+  return std::cos(kPi * float(std::clamp(y, 0, height_)) / float(height_));
 }
 
 float EnvironmentSampler::pdf(const glm::vec3& dir) const {
   const glm::vec2 uv = equirectUV(dir);
   const int x = std::clamp(int(uv.x * width_), 0, width_ - 1);
   const int y = std::clamp(int(uv.y * height_), 0, height_ - 1);
-  return pixelProb_[size_t(y) * width_ + x] / texelSolidAngle(y, width_, height_);
+  return texelPdf(x, y);
 }
 
 }  // namespace gi
