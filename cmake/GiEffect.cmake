@@ -4,7 +4,8 @@
 # run time. Each shader is compiled (and validated) by glslangValidator at build time into a
 # header `<file>.h` (e.g. `ssao.comp.h`) holding `const uint32_t <file_with_underscores>[]`
 # (e.g. `ssao_comp`), so a module is one self-contained file. Shaders may
-# `#include "common.glsl"` (the engine's FrameUniforms and helpers).
+# `#include "common.glsl"` (the engine's FrameUniforms and helpers) and "environment.glsl"
+# (environment importance sampling).
 #
 # Works in the engine's own tree and against an installed package (find_package(gi), which
 # includes this file and sets GI_SHADER_INCLUDE_DIR). GI_PLUGIN_OUTPUT_DIR sets where modules
@@ -35,6 +36,7 @@ function(gi_add_effect name)
   set_property(GLOBAL APPEND PROPERTY GI_EFFECT_TARGETS ${target})
 
   set(generated ${CMAKE_CURRENT_BINARY_DIR}/${target}_shaders)
+  file(GLOB includes ${GI_SHADER_INCLUDE_DIR}/*.glsl)  # a changed include rebuilds the shaders
   set(headers)
   foreach(shader ${EFFECT_SHADERS})
     get_filename_component(file ${shader} NAME)
@@ -45,7 +47,7 @@ function(gi_add_effect name)
       COMMAND ${CMAKE_COMMAND} -E make_directory ${generated}
       COMMAND ${GI_GLSLANG_VALIDATOR} --quiet --target-env vulkan1.3 -I${GI_SHADER_INCLUDE_DIR}
               --vn ${variable} -o ${header} ${source}
-      DEPENDS ${source} ${GI_SHADER_INCLUDE_DIR}/common.glsl
+      DEPENDS ${source} ${includes}
       COMMENT "GLSL ${name}/${file}" VERBATIM)
     list(APPEND headers ${header})
   endforeach()
