@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <sstream>
 
+#include "gi/engine_settings.h"
 #include "gi/errors.h"
 
 namespace gi {
@@ -42,7 +43,7 @@ void EffectRegistry::add(const Factory& factory, const std::string& origin) {
                 "duplicate effect '" + e.info.name + "' (already registered by " +
                     origin_or(e.info.name) + ")");
   // Presets, scenes and --set use this name for the engine's own settings.
-  if (e.info.name == "engine")
+  if (e.info.name == kEngineSettingsOwner)
     throw Error(ErrorKind::InvalidData, from,
                 "effect name 'engine' is reserved for the engine's own settings");
   try {
