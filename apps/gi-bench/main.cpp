@@ -26,6 +26,7 @@
 #include "bench.h"
 #include "cli.h"
 #include "gi/effect_config.h"
+#include "gi/engine_settings.h"
 #include "gi/errors.h"
 #include "gi/image_io.h"
 #include "gi/reference/reference.h"
@@ -391,6 +392,7 @@ struct Config {
   double gridValue = 0.0;
   const gi::Preset* presetPtr = nullptr;
   std::vector<gi::EffectConfig> effects;
+  gi::SettingValues engine;  // the engine's settings (preset and scene "engine" entries)
   Comparison comparison;
 };
 
@@ -483,9 +485,10 @@ Row::AoSplit splitError(const gi::ImageRGBA32F& out, const Reference& reference,
 
 Measurement measure(gi::vk::Context& ctx, const gi::EffectRegistry& registry,
                     const gi::Scene& scene, const std::vector<gi::EffectConfig>& effects,
-                    const Options& o, bool floorPass, const Comparison& cmp,
-                    const Reference& reference) {
+                    const gi::SettingValues& engine, const Options& o, bool floorPass,
+                    const Comparison& cmp, const Reference& reference) {
   gi::RenderSettings settings;
+  gi::applyEngineSettings(engine, settings);
   settings.width = o.width;
   settings.height = o.height;
   settings.floorPass = floorPass;
@@ -664,6 +667,7 @@ std::vector<Config> buildConfigs(const Options& o, const Setup& s,
             }
           }
           c.effects = gi::resolveEffects(s.scenes[si].scene, c.presetPtr, ov, s.registry);
+          c.engine = gi::resolveEngineSettings(s.scenes[si].scene, c.presetPtr, ov, {});
           c.comparison = comparisonFor(c.effects, s.registry, o.aoSplit);
           configs.push_back(std::move(c));
           size_t k = 0;
@@ -730,8 +734,8 @@ int runSweep(const Options& o) {
   for (const Config& c : configs) {
     const Reference& reference =
         refs.at(ReferenceKey{c.scene, c.comparison.quantity, c.comparison.radius});
-    const Measurement m = measure(ctx, s.registry, s.scenes[c.scene].scene, c.effects, o, true,
-                                  c.comparison, reference);
+    const Measurement m = measure(ctx, s.registry, s.scenes[c.scene].scene, c.effects, c.engine, o,
+                                  true, c.comparison, reference);
     Row r;
     r.scene = s.scenes[c.scene].name;
     r.effect = c.effectLabel;
@@ -840,6 +844,7 @@ int runCalibrate(const Options& o) {
     base = gi::resolveEffects(scene, nullptr, ov, s.registry);
   }
   const Comparison cmp = comparisonFor(base, s.registry, false);
+  const gi::SettingValues engine = gi::resolveEngineSettings(scene, nullptr, {}, {});
   const std::map<ReferenceKey, Reference> refs =
       computeReferences(o, s, {ReferenceKey{0, cmp.quantity, cmp.radius}});
   const Reference& reference = refs.begin()->second;
@@ -869,7 +874,7 @@ int runCalibrate(const Options& o) {
       label += (label.empty() ? "" : " ") + ov.sets.back();
     }
     const auto cfg = gi::resolveEffects(scene, nullptr, ov, s.registry);
-    const Measurement m = measure(ctx, s.registry, scene, cfg, o, false, cmp, reference);
+    const Measurement m = measure(ctx, s.registry, scene, cfg, engine, o, false, cmp, reference);
     const bool fits = m.totalMs <= limit;
     cheapest = std::min(cheapest, m.totalMs);
     std::printf("%-40s %12.3f %10.5f %8.5f %8s\n", label.c_str(), m.totalMs, m.metrics.nrmse,

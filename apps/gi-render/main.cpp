@@ -17,6 +17,7 @@
 
 #include "cli.h"
 #include "gi/effect_config.h"
+#include "gi/engine_settings.h"
 #include "gi/errors.h"
 #include "gi/image_io.h"
 #include "gi/renderer.h"
@@ -44,12 +45,15 @@ const char* kUsage =
     "                         effect's name for its debug view (e.g. ssao)\n"
     "  --effects A,B          effects to run, replacing the scene's list ('' for none)\n"
     "  --preset NAME|FILE     quality preset (assets/presets): settings for the effects\n"
-    "  --set EFFECT.KEY=V     override one setting (after preset and scene; repeatable)\n"
-    "  --list-effects         list the effect plugins found, with their settings, and exit\n"
+    "  --set EFFECT.KEY=V     override one setting (after preset and scene; repeatable);\n"
+    "                         engine.KEY=V sets the engine's own (see --list-effects)\n"
+    "  --list-effects         list the effect plugins found, with their settings, and the\n"
+    "                         engine's settings, and exit\n"
     "  --print-graph          print the compiled frame graph (executed and culled passes)\n"
     "  --graph-dot FILE       write the frame graph as Graphviz dot\n"
-    "  --exposure E           exposure before tonemapping (default 1)\n"
-    "  --surface-points N     keep N area-uniform surface points (view them: --view points)\n"
+    "  --exposure E           exposure before tonemapping (= --set engine.exposure=E)\n"
+    "  --surface-points N     keep N area-uniform surface points (view them: --view points;\n"
+    "                         = --set engine.surface_points=N)\n"
     "  --validation           enable Vulkan validation layers (also GI_VALIDATION=1)\n"
     "  --device NAME          pick the Vulkan device by name or index (also GI_DEVICE)\n";
 
@@ -57,10 +61,9 @@ struct Options {
   std::string scene, out, view = "output", device, preset, graphDot;
   gi::EffectOverrides overrides;
   bool listEffects = false, printGraph = false;
-  uint32_t width = 640, height = 480, surfacePoints = 0;
+  uint32_t width = 640, height = 480;
   int frames = 0;  // 0: not given (one frame, or until the window closes)
   double time = 0.0, timeStep = 0.0;
-  float exposure = 1.0f;
   bool timings = false, validation = false, window = false, isolatePasses = false;
 };
 
@@ -99,11 +102,13 @@ Options parseArgs(int argc, char** argv) {
       o.time = parseNumber(a, value(), -1e9, 1e9);
     else if (a == "--time-step")
       o.timeStep = parseNumber(a, value(), -1e6, 1e6);
-    else if (a == "--exposure")
-      o.exposure = float(parseNumber(a, value(), 0, 1e6));
-    else if (a == "--surface-points")
-      o.surfacePoints = uint32_t(parseNumber(a, value(), 0, 1 << 24));
-    else if (a == "--view")
+    else if (a == "--exposure" || a == "--surface-points") {
+      // Shorthands for --set engine.*: same place in the order, same validation.
+      const char* text = value();
+      parseNumber(a, text, 0, a == "--exposure" ? 1e6 : double(1 << 24));
+      o.overrides.sets.push_back(std::string("engine.") +
+                                 (a == "--exposure" ? "exposure=" : "surface_points=") + text);
+    } else if (a == "--view")
       o.view = value();
     else if (a == "--device")
       o.device = value();
@@ -176,6 +181,9 @@ int listEffects() {
   gi::EffectRegistry registry;
   registry.scanDefaultLocations();
   std::printf("%s", registry.describe().c_str());
+  std::printf("%s - the engine's own settings (presets, scenes and --set, as an effect's)\n%s",
+              gi::kEngineSettingsOwner,
+              gi::describeSettings(gi::kEngineSettingsOwner, gi::engineSettingDescs()).c_str());
   return 0;
 }
 
@@ -199,6 +207,10 @@ int run(const Options& o) {
   if (!o.preset.empty()) preset = gi::loadPreset(o.preset);
   std::vector<gi::EffectConfig> effects =
       gi::resolveEffects(scene, preset ? &*preset : nullptr, o.overrides, registry);
+  gi::RenderSettings settings;
+  gi::applyEngineSettings(
+      gi::resolveEngineSettings(scene, preset ? &*preset : nullptr, o.overrides, settings),
+      settings);
   // An effect's name as a view means its debug view.
   std::string view = o.view;
   if (registry.has(view)) view = registry.info(view).debugView;
@@ -214,13 +226,10 @@ int run(const Options& o) {
   }
   gi::vk::Context ctx(ctxOptions);
 
-  gi::RenderSettings settings;
   settings.width = o.width;
   settings.height = o.height;
-  settings.exposure = o.exposure;
   settings.floorPass = o.timings;
   settings.view = view;
-  settings.surfacePoints = o.surfacePoints;
   settings.isolatePasses = o.isolatePasses;
   settings.effects = effects;
   gi::Renderer renderer(ctx, scene, settings, &registry);

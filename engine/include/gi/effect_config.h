@@ -1,6 +1,9 @@
 // Which effects a frame runs and with which settings: registry defaults < quality preset <
 // the scene's overrides < command line (--set effect.key=value). Every layer is validated
 // against the effects' declared settings; errors name the file (or flag), the key and the range.
+// The engine's own settings (gi/engine_settings.h) travel the same way under the name "engine"
+// (preset: "effects": {"engine": {...}}; scene: "effects": [{"name": "engine", "settings":
+// {...}}]; --set engine.key=value); "engine" is never an effect.
 #pragma once
 
 #include <map>
@@ -22,7 +25,7 @@ struct Preset {
   std::string name, description, platform;
   double targetMs = 0.0;                             // frame budget the preset aims at ...
   uint32_t referenceWidth = 0, referenceHeight = 0;  // ... at this resolution
-  std::map<std::string, nlohmann::json> effects;     // effect -> {setting: value}
+  std::map<std::string, nlohmann::json> effects;     // effect (or "engine") -> {setting: value}
 };
 
 // Folders searched for presets by name: $GI_PRESET_PATH (':'-separated), then
@@ -30,19 +33,27 @@ struct Preset {
 std::vector<std::string> presetLocations();
 // `nameOrPath`: a preset name ("medium") or a .json path. Throws gi::Error naming the file.
 Preset loadPreset(const std::string& nameOrPath);
-// Checks every effect and setting a preset names against the registry.
+// Checks every effect and setting a preset names against the registry ("engine": against the
+// engine's settings).
 void validatePreset(const Preset& preset, const EffectRegistry& registry);
 
 struct EffectOverrides {
   std::optional<std::vector<std::string>> effects;  // --effects (replaces the scene's list)
-  std::vector<std::string> sets;                    // --set effect.key=value, in order
+  std::vector<std::string> sets;  // --set effect.key=value (or engine.key=value), in order
 };
 
 // Parses "a,b,c" ("" -> empty list).
 std::vector<std::string> splitEffectList(const std::string& text);
 
+// The effects to run with their settings. Also validates the "engine" entries of the preset,
+// scene and --set (their values come from resolveEngineSettings).
 std::vector<EffectConfig> resolveEffects(const Scene& scene, const Preset* preset,
                                          const EffectOverrides& cli,
                                          const EffectRegistry& registry);
+
+// The engine's settings: `base`'s values < the preset's "engine" < the scene's "engine"
+// entries < --set engine.key=value (in order). Apply them with applyEngineSettings.
+SettingValues resolveEngineSettings(const Scene& scene, const Preset* preset,
+                                    const EffectOverrides& cli, const RenderSettings& base);
 
 }  // namespace gi

@@ -30,6 +30,8 @@ struct RenderSettings {
   // (a point light renders its 6 faces into one 3x2 atlas). Up to 4 lights cast shadows (the
   // first 4 with castsShadows, in scene node order); one "shadow_<light index>" pass each.
   uint32_t shadowMapSize = 1024;
+  uint32_t pcfRadius = 1;             // PCF kernel (2r+1)^2 texels
+  float environmentIntensity = 1.0f;  // scales the environment (sky/map) radiance
   // Point representation (gi/surface_points.h): at least this many points (effects may ask
   // for more), placed with this seed. 0 and no effect asking: no points, no pass.
   uint32_t surfacePoints = 0;

@@ -7,6 +7,7 @@
 #include <set>
 #include <sstream>
 
+#include "gi/engine_settings.h"
 #include "gi/errors.h"
 
 namespace gi {
@@ -109,8 +110,50 @@ Preset loadPreset(const std::string& nameOrPath) {
   return p;
 }
 
+namespace {
+
+bool isEngine(const std::string& name) {
+  return name == kEngineSettingsOwner;
+}
+
+void applyJson(SettingValues& s, const json& values, const std::string& origin) {
+  for (auto it = values.begin(); it != values.end(); ++it) s.set(it.key(), it.value(), origin);
+}
+
+struct SetArg {
+  std::string owner, key, value;
+};
+
+// "effect.key=value" (or "engine.key=value").
+SetArg parseSet(const std::string& s) {
+  const size_t dot = s.find('.'), eq = s.find('=');
+  if (dot == std::string::npos || eq == std::string::npos || dot > eq)
+    throw Error(ErrorKind::Usage, "--set", "'" + s + "': expected effect.setting=value");
+  return {s.substr(0, dot), s.substr(dot + 1, eq - dot - 1), s.substr(eq + 1)};
+}
+
+// Layers the engine's values: preset < scene < --set, each validated with its origin.
+void layerEngineSettings(SettingValues& v, const Scene& scene, const Preset* preset,
+                         const EffectOverrides& cli) {
+  if (preset && preset->effects.count(kEngineSettingsOwner))
+    applyJson(v, preset->effects.at(kEngineSettingsOwner), preset->path);
+  for (const EffectRequest& r : scene.effects)
+    if (isEngine(r.name)) applyJson(v, r.settings, scene.sourcePath);
+  for (const std::string& s : cli.sets) {
+    const SetArg a = parseSet(s);
+    if (isEngine(a.owner)) v.setFromString(a.key, a.value, "--set");
+  }
+}
+
+}  // namespace
+
 void validatePreset(const Preset& preset, const EffectRegistry& registry) {
   for (const auto& [effect, values] : preset.effects) {
+    if (isEngine(effect)) {
+      SettingValues s(kEngineSettingsOwner, engineSettingDescs());
+      applyJson(s, values, preset.path);
+      continue;
+    }
     if (!registry.has(effect)) {
       try {
         registry.info(effect);
@@ -119,8 +162,7 @@ void validatePreset(const Preset& preset, const EffectRegistry& registry) {
       }
     }
     SettingValues s = registry.defaultSettings(effect);
-    for (auto it = values.begin(); it != values.end(); ++it)
-      s.set(it.key(), it.value(), preset.path);
+    applyJson(s, values, preset.path);
   }
 }
 
@@ -139,8 +181,14 @@ std::vector<EffectConfig> resolveEffects(const Scene& scene, const Preset* prese
   std::vector<std::string> names;
   if (cli.effects) {
     names = *cli.effects;
+    for (const std::string& name : names)
+      if (isEngine(name))
+        throw Error(ErrorKind::Usage, "--effects",
+                    "'engine' names the engine's own settings, not an effect (set them with "
+                    "--set engine.key=value)");
   } else {
-    for (const EffectRequest& r : scene.effects) names.push_back(r.name);
+    for (const EffectRequest& r : scene.effects)
+      if (!isEngine(r.name)) names.push_back(r.name);
   }
   std::vector<EffectConfig> configs;
   for (const std::string& name : names) {
@@ -155,33 +203,36 @@ std::vector<EffectConfig> resolveEffects(const Scene& scene, const Preset* prese
     }
   }
   if (preset) validatePreset(*preset, registry);
+  // The engine's entries, checked here too so a caller that skips resolveEngineSettings
+  // still refuses them.
+  SettingValues engine(kEngineSettingsOwner, engineSettingDescs());
+  layerEngineSettings(engine, scene, preset, cli);
   for (EffectConfig& c : configs) {
-    if (preset && preset->effects.count(c.name)) {
-      const json& values = preset->effects.at(c.name);
-      for (auto it = values.begin(); it != values.end(); ++it)
-        c.settings.set(it.key(), it.value(), preset->path);
-    }
+    if (preset && preset->effects.count(c.name))
+      applyJson(c.settings, preset->effects.at(c.name), preset->path);
     for (const EffectRequest& r : scene.effects)
-      if (r.name == c.name)
-        for (auto it = r.settings.begin(); it != r.settings.end(); ++it)
-          c.settings.set(it.key(), it.value(), scene.sourcePath);
+      if (r.name == c.name) applyJson(c.settings, r.settings, scene.sourcePath);
   }
   for (const std::string& s : cli.sets) {
-    const size_t dot = s.find('.'), eq = s.find('=');
-    if (dot == std::string::npos || eq == std::string::npos || dot > eq)
-      throw Error(ErrorKind::Usage, "--set", "'" + s + "': expected effect.setting=value");
-    const std::string effect = s.substr(0, dot), key = s.substr(dot + 1, eq - dot - 1),
-                      value = s.substr(eq + 1);
+    const SetArg a = parseSet(s);
+    if (isEngine(a.owner)) continue;
     auto it = std::find_if(configs.begin(), configs.end(),
-                           [&](const EffectConfig& c) { return c.name == effect; });
+                           [&](const EffectConfig& c) { return c.name == a.owner; });
     if (it == configs.end()) {
-      registry.info(effect);  // unknown effect: names the known ones
+      registry.info(a.owner);  // unknown effect: names the known ones
       throw Error(ErrorKind::Usage, "--set",
-                  "'" + s + "': effect '" + effect + "' is not enabled (scene or --effects)");
+                  "'" + s + "': effect '" + a.owner + "' is not enabled (scene or --effects)");
     }
-    it->settings.setFromString(key, value, "--set");
+    it->settings.setFromString(a.key, a.value, "--set");
   }
   return configs;
+}
+
+SettingValues resolveEngineSettings(const Scene& scene, const Preset* preset,
+                                    const EffectOverrides& cli, const RenderSettings& base) {
+  SettingValues v = engineSettingsOf(base);
+  layerEngineSettings(v, scene, preset, cli);
+  return v;
 }
 
 }  // namespace gi

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <sstream>
 
+#include "gi/engine_settings.h"
 #include "gi/errors.h"
 
 namespace gi {
@@ -41,13 +42,15 @@ void EffectRegistry::add(const Factory& factory, const std::string& origin) {
     throw Error(ErrorKind::InvalidData, from,
                 "duplicate effect '" + e.info.name + "' (already registered by " +
                     origin_or(e.info.name) + ")");
-  SettingValues check(e.info.name, e.settings);  // rejects duplicate setting names
-  for (const SettingDesc& d : e.settings)
-    if (d.type != SettingType::Bool &&
-        !(d.minValue <= d.defaultValue && d.defaultValue <= d.maxValue))
-      throw Error(
-          ErrorKind::InvalidData, from,
-          "effect '" + e.info.name + "': default of setting '" + d.name + "' is outside its range");
+  // Presets, scenes and --set use this name for the engine's own settings.
+  if (e.info.name == kEngineSettingsOwner)
+    throw Error(ErrorKind::InvalidData, from,
+                "effect name 'engine' is reserved for the engine's own settings");
+  try {
+    validateSettingDescs("effect '" + e.info.name + "'", e.settings);
+  } catch (const Error& err) {
+    throw Error(ErrorKind::InvalidData, from, err.what());
+  }
   entries_.push_back(std::move(e));
 }
 
@@ -187,14 +190,7 @@ std::string EffectRegistry::describe() const {
           : e.info.estimates == GroundTruth::IndirectLight  ? "indirect light"
                                                             : "direct light")
       << "\n";
-    for (const SettingDesc& d : e.settings) {
-      s << "  " << name << "." << d.name << " (" << settingTypeName(d.type) << ", default ";
-      if (d.type == SettingType::Bool)
-        s << (d.defaultValue != 0.0 ? "true" : "false");
-      else
-        s << d.defaultValue << ", range [" << d.minValue << ", " << d.maxValue << "]";
-      s << (d.changesGraph ? ", changes the graph" : ", uniform only") << "): " << d.help << "\n";
-    }
+    s << describeSettings(name, e.settings);
   }
   for (const std::string& p : problems_) s << "refused: " << p << "\n";
   return s.str();

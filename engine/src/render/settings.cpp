@@ -1,11 +1,16 @@
 #include "gi/settings.h"
 
 #include <cmath>
+#include <cstdlib>
+#include <iomanip>
+#include <set>
 #include <sstream>
 
 #include "gi/errors.h"
 
 namespace gi {
+
+using nlohmann::json;
 
 const char* settingTypeName(SettingType type) {
   switch (type) {
@@ -15,8 +20,153 @@ const char* settingTypeName(SettingType type) {
       return "int";
     case SettingType::Float:
       return "float";
+    case SettingType::Enum:
+      return "enum";
+    case SettingType::Vec3:
+      return "vec3";
+    case SettingType::Color:
+      return "color";
   }
   return "?";
+}
+
+SettingDesc SettingDesc::enumeration(std::string name, std::vector<std::string> options,
+                                     int defaultIndex, std::string help, bool changesGraph) {
+  SettingDesc d;
+  d.name = std::move(name);
+  d.type = SettingType::Enum;
+  d.defaultValue = defaultIndex;
+  d.minValue = 0;
+  d.maxValue = options.empty() ? 0 : double(options.size() - 1);
+  d.help = std::move(help);
+  d.changesGraph = changesGraph;
+  d.options = std::move(options);
+  return d;
+}
+
+SettingDesc SettingDesc::vec3(std::string name, std::array<double, 3> def, double min, double max,
+                              std::string help, bool changesGraph) {
+  SettingDesc d;
+  d.name = std::move(name);
+  d.type = SettingType::Vec3;
+  d.minValue = min;
+  d.maxValue = max;
+  d.help = std::move(help);
+  d.changesGraph = changesGraph;
+  d.defaultVector = def;
+  return d;
+}
+
+SettingDesc SettingDesc::color(std::string name, std::array<double, 3> def, std::string help,
+                               double max, bool changesGraph) {
+  SettingDesc d = vec3(std::move(name), def, 0.0, max, std::move(help), changesGraph);
+  d.type = SettingType::Color;
+  return d;
+}
+
+namespace {
+
+bool isVector(SettingType t) {
+  return t == SettingType::Vec3 || t == SettingType::Color;
+}
+
+// 10 significant digits: 16777216 reads as such, not 1.67772e+07.
+std::string num(double v) {
+  std::ostringstream s;
+  s << std::setprecision(10) << v;
+  return s.str();
+}
+
+std::string vecText(const std::array<double, 3>& v) {
+  std::ostringstream s;  // (not "[" + ...: GCC 12 reports a false -Wrestrict there)
+  s << std::setprecision(10) << "[" << v[0] << ", " << v[1] << ", " << v[2] << "]";
+  return s.str();
+}
+
+std::string optionList(const SettingDesc& d) {
+  std::string s;
+  for (const std::string& o : d.options) s += (s.empty() ? "" : ", ") + o;
+  return s;
+}
+
+std::string rangeText(const SettingDesc& d) {
+  switch (d.type) {
+    case SettingType::Bool:
+      return "true or false";
+    case SettingType::Enum:
+      return "one of: " + optionList(d);
+    case SettingType::Vec3:
+    case SettingType::Color:
+      return "[x, y, z] with each component in [" + num(d.minValue) + ", " + num(d.maxValue) + "]";
+    case SettingType::Int:
+      return "an integer in [" + num(d.minValue) + ", " + num(d.maxValue) + "]";
+    case SettingType::Float:
+      break;
+  }
+  return "a number in [" + num(d.minValue) + ", " + num(d.maxValue) + "]";
+}
+
+const char* componentName(SettingType t, size_t i) {
+  static const char* xyz[] = {"x", "y", "z"};
+  static const char* rgb[] = {"r", "g", "b"};
+  return t == SettingType::Color ? rgb[i] : xyz[i];
+}
+
+void checkDesc(const SettingDesc& d) {
+  auto fail = [&](const std::string& problem) {
+    throw Error(ErrorKind::InvalidData, "", "setting '" + d.name + "': " + problem);
+  };
+  if (d.name.empty()) throw Error(ErrorKind::InvalidData, "", "a setting has an empty name");
+  if (!std::isfinite(d.step) || d.step < 0) fail("step must be >= 0");
+  if (d.type != SettingType::Enum && !d.options.empty()) fail("options are only for enum settings");
+  if (d.type == SettingType::Bool) {
+    if (d.defaultValue != 0.0 && d.defaultValue != 1.0) fail("bool default must be 0 or 1");
+    if (d.logScale) fail("logScale needs a numeric setting");
+    return;
+  }
+  if (d.type == SettingType::Enum) {
+    if (d.options.empty()) fail("an enum needs at least one option");
+    std::set<std::string> seen;
+    for (const std::string& o : d.options) {
+      if (o.empty()) fail("empty option name");
+      if (!seen.insert(o).second) fail("option '" + o + "' listed twice");
+    }
+    if (std::trunc(d.defaultValue) != d.defaultValue || d.defaultValue < 0 ||
+        d.defaultValue >= double(d.options.size()))
+      fail("default index " + num(d.defaultValue) + " is not an option index (0.." +
+           std::to_string(d.options.size() - 1) + ")");
+    if (d.logScale) fail("logScale needs a numeric setting");
+    return;
+  }
+  if (!std::isfinite(d.minValue) || !std::isfinite(d.maxValue) || d.minValue > d.maxValue)
+    fail("range [" + num(d.minValue) + ", " + num(d.maxValue) + "] is empty or not finite");
+  if (d.logScale && !(d.minValue > 0)) fail("logScale needs min > 0");
+  auto inRange = [&](double v) { return std::isfinite(v) && d.minValue <= v && v <= d.maxValue; };
+  if (isVector(d.type)) {
+    for (size_t i = 0; i < 3; ++i)
+      if (!inRange(d.defaultVector[i]))
+        fail("default " + vecText(d.defaultVector) + " is outside its range (component " +
+             componentName(d.type, i) + ")");
+    return;
+  }
+  if (!inRange(d.defaultValue)) fail("default is outside its range");
+  if (d.type == SettingType::Int && std::trunc(d.defaultValue) != d.defaultValue)
+    fail("int default must be an integer");
+}
+
+}  // namespace
+
+void validateSettingDescs(const std::string& owner, const std::vector<SettingDesc>& descs) {
+  std::set<std::string> names;
+  for (const SettingDesc& d : descs) {
+    try {
+      checkDesc(d);
+    } catch (const Error& e) {
+      throw Error(ErrorKind::InvalidData, "", owner + ": " + e.what());
+    }
+    if (!names.insert(d.name).second)
+      throw Error(ErrorKind::InvalidData, "", owner + ": setting '" + d.name + "' declared twice");
+  }
 }
 
 SettingValues::SettingValues(std::string owner, std::vector<SettingDesc> descs)
@@ -24,7 +174,8 @@ SettingValues::SettingValues(std::string owner, std::vector<SettingDesc> descs)
   for (const SettingDesc& d : descs_) {
     if (values_.count(d.name))
       throw Error(ErrorKind::Schema, "", owner_ + ": setting '" + d.name + "' declared twice");
-    values_[d.name] = d.defaultValue;
+    values_[d.name] =
+        isVector(d.type) ? d.defaultVector : std::array<double, 3>{d.defaultValue, 0.0, 0.0};
   }
 }
 
@@ -37,18 +188,17 @@ const SettingDesc& SettingValues::desc(const std::string& key) const {
               owner_ + "." + key + ": unknown setting (" + owner_ + " has: " + known + ")");
 }
 
-namespace {
-std::string rangeText(const SettingDesc& d) {
-  std::ostringstream s;
-  if (d.type == SettingType::Bool) return "true or false";
-  s << (d.type == SettingType::Int ? "an integer" : "a number") << " in [" << d.minValue << ", "
-    << d.maxValue << "]";
-  return s.str();
+const SettingDesc& SettingValues::typed(const std::string& key,
+                                        std::initializer_list<SettingType> types,
+                                        const char* what) const {
+  const SettingDesc& d = desc(key);
+  for (SettingType t : types)
+    if (d.type == t) return d;
+  throw Error(ErrorKind::Schema, "",
+              owner_ + "." + key + ": is " + settingTypeName(d.type) + ", not " + what);
 }
-}  // namespace
 
-void SettingValues::set(const std::string& key, const nlohmann::json& value,
-                        const std::string& origin) {
+void SettingValues::set(const std::string& key, const json& value, const std::string& origin) {
   const SettingDesc* d = nullptr;
   try {
     d = &desc(key);
@@ -59,39 +209,108 @@ void SettingValues::set(const std::string& key, const nlohmann::json& value,
   auto fail = [&](ErrorKind kind) {
     throw Error(kind, origin, where + ": expected " + rangeText(*d) + ", got " + value.dump());
   };
-  double v = 0.0;
+  std::array<double, 3> v{};
   switch (d->type) {
     case SettingType::Bool:
       if (!value.is_boolean()) fail(ErrorKind::Schema);
-      v = value.get<bool>() ? 1.0 : 0.0;
+      v[0] = value.get<bool>() ? 1.0 : 0.0;
       break;
     case SettingType::Int:
       if (!value.is_number_integer() &&
           !(value.is_number_float() && std::trunc(value.get<double>()) == value.get<double>()))
         fail(ErrorKind::Schema);
-      v = value.get<double>();
+      v[0] = value.get<double>();
       break;
     case SettingType::Float:
       if (!value.is_number()) fail(ErrorKind::Schema);
-      v = value.get<double>();
+      v[0] = value.get<double>();
       break;
+    case SettingType::Enum: {
+      if (!value.is_string()) fail(ErrorKind::Schema);
+      const std::string name = value.get<std::string>();
+      size_t i = 0;
+      while (i < d->options.size() && d->options[i] != name) ++i;
+      if (i == d->options.size())
+        throw Error(ErrorKind::Schema, origin,
+                    where + ": unknown option '" + name + "' (one of: " + optionList(*d) + ")");
+      values_[key] = {double(i), 0.0, 0.0};
+      return;
+    }
+    case SettingType::Vec3:
+    case SettingType::Color: {
+      if (!value.is_array() || value.size() != 3)
+        throw Error(ErrorKind::Schema, origin,
+                    where + ": expected 3 components " + rangeText(*d) + ", got " + value.dump());
+      for (size_t i = 0; i < 3; ++i) {
+        const std::string comp =
+            where + ": component " + std::to_string(i) + " (" + componentName(d->type, i) + ")";
+        if (!value[i].is_number())
+          throw Error(ErrorKind::Schema, origin,
+                      comp + ": expected a number, got " + value[i].dump());
+        v[i] = value[i].get<double>();
+        if (!std::isfinite(v[i]) || v[i] < d->minValue || v[i] > d->maxValue)
+          throw Error(ErrorKind::InvalidData, origin,
+                      comp + ": expected a finite number in [" + num(d->minValue) + ", " +
+                          num(d->maxValue) + "], got " + num(v[i]));
+      }
+      values_[key] = v;
+      return;
+    }
   }
-  if (!std::isfinite(v)) fail(ErrorKind::InvalidData);
-  if (d->type != SettingType::Bool && (v < d->minValue || v > d->maxValue))
+  if (!std::isfinite(v[0])) fail(ErrorKind::InvalidData);
+  if (d->type != SettingType::Bool && (v[0] < d->minValue || v[0] > d->maxValue))
     fail(ErrorKind::InvalidData);
   values_[key] = v;
 }
 
+namespace {
+std::string trim(const std::string& s) {
+  const size_t a = s.find_first_not_of(" \t"), b = s.find_last_not_of(" \t");
+  return a == std::string::npos ? "" : s.substr(a, b - a + 1);
+}
+
+// "x,y,z" or "[x,y,z]" -> a JSON array of what parses as numbers (strtod: "nan" and "inf" too,
+// so set() reports them as non-finite); other components stay strings, reported as such.
+json vectorFromText(const std::string& text) {
+  std::string body = trim(text);
+  if (body.size() >= 2 && body.front() == '[' && body.back() == ']')
+    body = body.substr(1, body.size() - 2);
+  json out = json::array();
+  std::stringstream ss(body);
+  std::string part;
+  while (std::getline(ss, part, ',')) {
+    part = trim(part);
+    char* end = nullptr;
+    const double v = std::strtod(part.c_str(), &end);
+    if (!part.empty() && *end == '\0')
+      out.push_back(v);
+    else
+      out.push_back(part);
+  }
+  if (!body.empty() && body.back() == ',') out.push_back("");  // "1,2," has 3 parts
+  return out;
+}
+}  // namespace
+
 void SettingValues::setFromString(const std::string& key, const std::string& text,
                                   const std::string& origin) {
-  nlohmann::json value = nlohmann::json::parse(text, nullptr, false);
-  if (value.is_discarded()) value = text;  // reported as a wrong type by set()
+  const SettingDesc* d = nullptr;
+  try {
+    d = &desc(key);
+  } catch (const Error& e) {
+    throw Error(ErrorKind::Schema, origin, e.what());
+  }
+  if (isVector(d->type)) return set(key, vectorFromText(text), origin);
+  json value = json::parse(text, nullptr, false);
+  if (value.is_discarded() || (d->type == SettingType::Enum && !value.is_string()))
+    value = text;  // an option name as is; anything else is reported as a wrong type by set()
   set(key, value, origin);
 }
 
 double SettingValues::number(const std::string& key) const {
-  desc(key);
-  return values_.at(key);
+  typed(key, {SettingType::Bool, SettingType::Int, SettingType::Float, SettingType::Enum},
+        "a number (use vector())");
+  return values_.at(key)[0];
 }
 int SettingValues::integer(const std::string& key) const {
   return int(std::lround(number(key)));
@@ -99,17 +318,37 @@ int SettingValues::integer(const std::string& key) const {
 bool SettingValues::flag(const std::string& key) const {
   return number(key) != 0.0;
 }
+const std::string& SettingValues::option(const std::string& key) const {
+  const SettingDesc& d = typed(key, {SettingType::Enum}, "an enum");
+  return d.options.at(size_t(values_.at(key)[0]));
+}
+std::array<double, 3> SettingValues::vector(const std::string& key) const {
+  typed(key, {SettingType::Vec3, SettingType::Color}, "a vec3 or color");
+  return values_.at(key);
+}
 
-nlohmann::json SettingValues::toJson() const {
-  nlohmann::json j = nlohmann::json::object();
+json SettingValues::toJson() const {
+  json j = json::object();
   for (const SettingDesc& d : descs_) {
-    const double v = values_.at(d.name);
-    if (d.type == SettingType::Bool)
-      j[d.name] = v != 0.0;
-    else if (d.type == SettingType::Int)
-      j[d.name] = std::lround(v);
-    else
-      j[d.name] = v;
+    const std::array<double, 3>& v = values_.at(d.name);
+    switch (d.type) {
+      case SettingType::Bool:
+        j[d.name] = v[0] != 0.0;
+        break;
+      case SettingType::Int:
+        j[d.name] = std::lround(v[0]);
+        break;
+      case SettingType::Float:
+        j[d.name] = v[0];
+        break;
+      case SettingType::Enum:
+        j[d.name] = d.options.at(size_t(v[0]));
+        break;
+      case SettingType::Vec3:
+      case SettingType::Color:
+        j[d.name] = {v[0], v[1], v[2]};
+        break;
+    }
   }
   return j;
 }
@@ -120,6 +359,36 @@ bool SettingValues::graphDiffers(const SettingValues& other) const {
         other.values_.at(d.name) != values_.at(d.name))
       return true;
   return false;
+}
+
+std::string describeSettings(const std::string& owner, const std::vector<SettingDesc>& descs) {
+  std::ostringstream s;
+  s << std::setprecision(10);
+  for (const SettingDesc& d : descs) {
+    s << "  " << owner << "." << d.name << " (" << settingTypeName(d.type) << ", default ";
+    switch (d.type) {
+      case SettingType::Bool:
+        s << (d.defaultValue != 0.0 ? "true" : "false");
+        break;
+      case SettingType::Enum:
+        s << (size_t(d.defaultValue) < d.options.size() ? d.options[size_t(d.defaultValue)] : "?")
+          << ", options " << optionList(d);
+        break;
+      case SettingType::Vec3:
+      case SettingType::Color:
+        s << vecText(d.defaultVector) << ", range [" << d.minValue << ", " << d.maxValue
+          << "] per component";
+        break;
+      case SettingType::Int:
+      case SettingType::Float:
+        s << d.defaultValue << ", range [" << d.minValue << ", " << d.maxValue << "]";
+        break;
+    }
+    if (d.step > 0) s << ", step " << d.step;
+    if (d.logScale) s << ", log scale";
+    s << (d.changesGraph ? ", changes the graph" : ", uniform only") << "): " << d.help << "\n";
+  }
+  return s.str();
 }
 
 }  // namespace gi
