@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <set>
 #include <sstream>
 
@@ -10,6 +11,7 @@
 #include "gi/vk/gpu_timer.h"
 #include "gi/vk/pipeline.h"
 #include "gi/vk/resources.h"
+#include "graph_images.h"
 
 namespace gi {
 
@@ -135,11 +137,31 @@ VkBufferUsageFlags bufferUsageOf(BufferUsage u) {
 
 }  // namespace
 
+using graph_detail::ImageViews;
+using graph_detail::Range;
+using graph_detail::SubBarrier;
+using graph_detail::TextureDims;
+
+namespace {
+
+// Sync state of one subresource (or a whole buffer) during execute. `state`: the layout, every
+// stage that used it since its last write (what a new write waits for) and that write's access.
+// `lastWrite`: the last write's stage and access. `visible`: the stages and accesses a barrier
+// already made that write visible to (a later read elsewhere needs one).
+struct SubState {
+  SyncState state, lastWrite, visible;
+};
+
+}  // namespace
+
 struct FrameGraph::Access {
   uint32_t resource = 0, version = 0;
   bool write = false;
   TextureUsage textureUsage = TextureUsage::Sampled;
   BufferUsage bufferUsage = BufferUsage::StorageRead;
+  Subresource sub;       // as declared
+  Range range;           // resolved by compile()
+  bool partial = false;  // a write that leaves part of the texture as the previous version had it
 };
 
 struct FrameGraph::Pass {
@@ -150,38 +172,77 @@ struct FrameGraph::Pass {
   PassExecute execute;
 };
 
+// An image the graph owns beyond one compile: a persistent (history) or fallback texture.
+struct FrameGraph::Owned {
+  vk::Context* ctx = nullptr;
+  TextureDesc desc;
+  TextureDims dims;
+  VkImage image = VK_NULL_HANDLE;
+  vk::Allocation allocation;
+  VkImageUsageFlags usage = 0;
+  std::unique_ptr<ImageViews> views;
+  std::vector<SubState> subs;  // carried across frames
+  VkClearColorValue clear{};
+  bool needsClear = true;  // recorded at the start of the next execute()
+  bool written = false;    // a frame wrote it since (re)creation: history is valid
+  bool declared = false;   // in the graph being built (persistent)
+  Owned(vk::Context& c, const TextureDims& d) : ctx(&c), dims(d) {
+    usage = graph_detail::supportedUsage(c.physicalDevice(), d.format);
+    image = graph_detail::createImage(c, d, usage);
+    VkMemoryRequirements req;
+    vkGetImageMemoryRequirements(c.device(), image, &req);
+    allocation = c.allocator().allocate(req, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+    vk::check(vkBindImageMemory(c.device(), image, allocation.memory, allocation.offset),
+              "vkBindImageMemory (frame graph)");
+    views = std::make_unique<ImageViews>(c, image, d);
+    subs.resize(d.subresources());
+  }
+  ~Owned() {
+    views.reset();
+    vkDestroyImage(ctx->device(), image, nullptr);
+    ctx->allocator().free(allocation);
+  }
+  Owned(const Owned&) = delete;
+  Owned& operator=(const Owned&) = delete;
+};
+
 struct FrameGraph::Resource {
   std::string name;
   bool texture = true;
-  bool imported = false;
+  bool imported = false, persistent = false, fallback = false;
   TextureDesc textureDesc;
   BufferDesc bufferDesc;
   uint32_t version = 0;  // latest version declared so far
-  // Vulkan objects (imported, or created by allocateTransients).
+  // Vulkan objects (imported, owned, or created by allocateTransients).
   VkImage image = VK_NULL_HANDLE;
   VkImageView view = VK_NULL_HANDLE;
   VkBuffer buffer = VK_NULL_HANDLE;
-  VkExtent2D extent{};
+  TextureDims dims;  // resolved by compile()
+  VkImageLayout importLayout = VK_IMAGE_LAYOUT_UNDEFINED;
   VkImageLayout finalLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-  // During execute; persist across frames for imported resources. `state`: the layout, every
-  // stage that used the resource since its last write (what a new write waits for) and that
-  // write's access. `lastWrite`: the last write's stage and access. `visible`: the stages and
-  // accesses a barrier already made that write visible to (a later read elsewhere needs one).
-  SyncState state, lastWrite, visible;
+  SyncState state, lastWrite, visible;  // buffers
+  // Textures: one per (mip, layer), index mip * layers + layer; an owned texture's live in the
+  // Owned (they carry across graphs), imported ones' across frames of this graph.
+  std::vector<SubState> ownSubs;
+  std::vector<SubState>* subs = &ownSubs;
+  ImageViews* views = nullptr;                // the transient's or owned image's, or ...
+  std::unique_ptr<ImageViews> importedViews;  // ... subresource views of an imported image
+  Owned* owned = nullptr;
   int transient = -1;
-  int firstUse = -1, lastUse = -1;  // kept-pass indices
+  int firstUse = -1, lastUse = -1;                                      // kept-pass indices
+  bool external() const { return imported || persistent || fallback; }  // not transient
 };
 
 // A transient's Vulkan objects, and the memory range they are bound to (shared by aliases).
 struct FrameGraph::Transient {
   vk::Context* ctx = nullptr;
   VkImage image = VK_NULL_HANDLE;
-  VkImageView view = VK_NULL_HANDLE;
+  std::unique_ptr<ImageViews> views;
   VkBuffer buffer = VK_NULL_HANDLE;
   VkMemoryRequirements requirements{};
   int slot = -1;
   ~Transient() {
-    if (view) vkDestroyImageView(ctx->device(), view, nullptr);
+    views.reset();  // before the image
     if (image) vkDestroyImage(ctx->device(), image, nullptr);
     if (buffer) vkDestroyBuffer(ctx->device(), buffer, nullptr);
   }
@@ -206,18 +267,88 @@ FrameGraph::FrameGraph(vk::Context& ctx, VkExtent2D outputExtent)
 
 FrameGraph::~FrameGraph() {
   reset();
+  releasePersistent();
 }
 
 void FrameGraph::reset() {
+  resources_.clear();  // imported images' views first
   pool_.clear();
   for (Slot& s : slots_) ctx_.allocator().free(s.allocation);
   slots_.clear();
-  resources_.clear();
   passes_.clear();
   outputs_.clear();
   blackboard_.clear();
+  fallbackIds_.clear();
+  for (auto& [name, p] : persistent_) p->declared = false;
   stats_ = {};
   compiled_ = false;
+}
+
+void FrameGraph::setOutputExtent(VkExtent2D e) {
+  if (compiled_)
+    throw Error(ErrorKind::Usage, "",
+                "frame graph: setOutputExtent() after compile() (reset() first)");
+  if (e.width == 0 || e.height == 0)
+    throw Error(ErrorKind::Usage, "", "frame graph output size must be at least 1x1");
+  outputExtent_ = e;
+}
+
+void FrameGraph::releasePersistent() {
+  if (compiled_)
+    throw Error(
+        ErrorKind::Usage, "",
+        "frame graph: releasePersistent() while a compiled graph uses them (reset() first)");
+  for (auto& r : resources_)
+    if (r->owned)
+      throw Error(
+          ErrorKind::Usage, "",
+          "frame graph: releasePersistent() while '" + r->name + "' is declared (reset() first)");
+  persistent_.clear();
+  fallbacks_.clear();
+}
+
+void FrameGraph::declareFallback(const std::string& name, VkFormat format,
+                                 VkClearColorValue value) {
+  if (vk::isDepthFormat(format))
+    throw Error(ErrorKind::Usage, "", "frame graph: fallback '" + name + "' needs a color format");
+  auto it = fallbacks_.find(name);
+  if (it != fallbacks_.end() && it->second->dims.format == format &&
+      std::memcmp(&it->second->clear, &value, sizeof value) == 0)
+    return;  // already declared like this
+  if (fallbackIds_.count(name) || compiled_)
+    throw Error(
+        ErrorKind::Usage, "",
+        "frame graph: fallback '" + name + "' changed while a graph uses it (reset() first)");
+  TextureDims dims;
+  dims.format = format;
+  dims.extent = {1, 1};
+  auto owned = std::make_unique<Owned>(ctx_, dims);
+  owned->clear = value;
+  fallbacks_[name] = std::move(owned);
+}
+
+TextureHandle FrameGraph::persistentTexture(const std::string& name, const TextureDesc& desc) {
+  for (auto& r : resources_)
+    if (r->persistent && r->name == name)
+      throw Error(ErrorKind::Usage, "",
+                  "frame graph: persistent texture '" + name + "' declared twice");
+  if (desc.sizeClass == SizeClass::InputRelative && !desc.relativeTo.valid())
+    throw Error(ErrorKind::Usage, "",
+                "frame graph: '" + name + "' is input-relative but names no input");
+  uint32_t id = addResource(name, true);
+  Resource& r = *resources_[id];
+  r.persistent = true;
+  r.textureDesc = desc;
+  return {id, 0};
+}
+
+bool FrameGraph::historyValid(TextureHandle h) const {
+  const Resource& r = resource(h.id);
+  if (!r.persistent)
+    throw Error(ErrorKind::Usage, "",
+                "frame graph: historyValid('" + r.name + "'): not a persistent texture");
+  auto it = persistent_.find(r.name);
+  return it != persistent_.end() && it->second->declared && it->second->written;
 }
 
 const FrameGraph::Resource& FrameGraph::resource(uint32_t id) const {
@@ -273,12 +404,13 @@ BufferHandle PassBuilder::create(const std::string& name, const BufferDesc& desc
   return {id, 0};
 }
 
-TextureHandle PassBuilder::read(TextureHandle h, TextureUsage usage) {
+TextureHandle PassBuilder::read(TextureHandle h, TextureUsage usage, const Subresource& sub) {
   graph_.checkCurrent(h.id, h.version, "a read");
   FrameGraph::Access a;
   a.resource = h.id;
   a.version = h.version;
   a.textureUsage = usage;
+  a.sub = sub;
   graph_.passes_[pass_]->accesses.push_back(a);
   return h;
 }
@@ -293,13 +425,19 @@ BufferHandle PassBuilder::read(BufferHandle h, BufferUsage usage) {
   return h;
 }
 
-TextureHandle PassBuilder::write(TextureHandle h, TextureUsage usage) {
+TextureHandle PassBuilder::write(TextureHandle h, TextureUsage usage, const Subresource& sub) {
   graph_.checkCurrent(h.id, h.version, "a write");
+  FrameGraph::Resource& r = *graph_.resources_[h.id];
+  if (r.fallback)
+    throw Error(ErrorKind::Usage, "",
+                "frame graph: pass '" + graph_.passes_[pass_]->name + "' writes the fallback '" +
+                    r.name + "' (fallbacks are read-only)");
   FrameGraph::Access a;
   a.resource = h.id;
-  a.version = ++graph_.resources_[h.id]->version;
+  a.version = ++r.version;
   a.write = true;
   a.textureUsage = usage;
+  a.sub = sub;
   graph_.passes_[pass_]->accesses.push_back(a);
   return {h.id, a.version};
 }
@@ -315,6 +453,31 @@ BufferHandle PassBuilder::write(BufferHandle h, BufferUsage usage) {
   return {h.id, a.version};
 }
 
+TextureHandle PassBuilder::readOptional(const std::string& name, TextureUsage usage) {
+  if (TextureHandle h = graph_.blackboard_.texture(name); h.valid()) return read(h, usage);
+  auto it = graph_.fallbacks_.find(name);
+  if (it == graph_.fallbacks_.end())
+    throw Error(ErrorKind::Usage, "",
+                "frame graph: pass '" + graph_.passes_[pass_]->name + "' reads optional '" + name +
+                    "', which no pass published and which has no fallback "
+                    "(FrameGraph::declareFallback)");
+  auto [id, isNew] = graph_.fallbackIds_.try_emplace(name, 0u);
+  if (isNew) {
+    id->second = graph_.addResource(name + " (fallback)", true);
+    FrameGraph::Resource& r = *graph_.resources_[id->second];
+    r.fallback = true;
+    r.owned = it->second.get();
+    r.textureDesc.format = r.owned->dims.format;
+    r.textureDesc.sizeClass = SizeClass::Absolute;
+    r.textureDesc.width = r.textureDesc.height = 1;
+  }
+  return read({id->second, 0}, usage);
+}
+
+bool PassBuilder::isFallback(TextureHandle h) const {
+  return h.id < graph_.resources_.size() && graph_.resources_[h.id]->fallback;
+}
+
 void PassBuilder::sideEffect() {
   graph_.passes_[pass_]->sideEffect = true;
 }
@@ -328,8 +491,8 @@ TextureHandle FrameGraph::importTexture(const std::string& name, VkImage image, 
   r.textureDesc = desc;
   r.image = image;
   r.view = view;
+  r.importLayout = currentLayout;
   r.finalLayout = finalLayout;
-  r.state = {currentLayout, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT};
   return {id, 0};
 }
 
@@ -371,12 +534,67 @@ VkExtent2D FrameGraph::resolveExtent(uint32_t id) const {
   return outputExtent_;
 }
 
+void FrameGraph::resolveTextures() {
+  for (uint32_t id = 0; id < resources_.size(); ++id) {
+    Resource& r = *resources_[id];
+    if (!r.texture) continue;
+    r.dims = r.fallback ? r.owned->dims
+                        : graph_detail::resolveDims(r.name, r.textureDesc, resolveExtent(id));
+  }
+  for (auto& p : passes_)
+    for (Access& a : p->accesses) {
+      const Resource& r = *resources_[a.resource];
+      if (!r.texture) continue;
+      a.range = graph_detail::resolveRange(r.name, a.sub, r.dims);
+      a.partial = a.write && !a.range.covers(r.dims);
+    }
+}
+
+// Links this graph's persistent textures to their images, (re)creating those whose shape
+// changed and freeing those no longer declared.
+void FrameGraph::preparePersistent() {
+  for (auto& r : resources_)
+    if (r->persistent) {
+      auto& slot = persistent_[r->name];
+      if (slot && !(slot->dims == r->dims)) slot.reset();  // resized: history is gone
+      if (!slot) slot = std::make_unique<Owned>(ctx_, r->dims);
+      slot->declared = true;
+      r->owned = slot.get();
+    }
+  std::erase_if(persistent_, [](const auto& kv) { return !kv.second->declared; });
+  for (auto& r : resources_)
+    if (r->owned) {
+      r->image = r->owned->image;
+      r->views = r->owned->views.get();
+      r->subs = &r->owned->subs;
+      if (r->dims.type != TextureType::CubeArray) r->view = r->views->natural();
+    } else if (r->imported && r->texture) {
+      r->importedViews = std::make_unique<ImageViews>(ctx_, r->image, r->dims);
+      r->views = r->importedViews.get();
+      // Whatever came before is unknown: a write waits for all of it, a read in the same
+      // layout needs no barrier.
+      r->ownSubs.assign(r->dims.subresources(),
+                        SubState{{r->importLayout, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+                                  VK_ACCESS_2_MEMORY_WRITE_BIT},
+                                 {},
+                                 {}});
+    }
+}
+
 void FrameGraph::compile() {
   if (compiled_)
     throw Error(ErrorKind::Usage, "", "frame graph: compile() called twice (reset() first)");
+  resolveTextures();
+  preparePersistent();
+  // A persistent texture's last version is next frame's history: an implicit output.
+  std::vector<std::pair<uint32_t, uint32_t>> outputs = outputs_;
+  for (uint32_t id = 0; id < resources_.size(); ++id)
+    if (resources_[id]->persistent && resources_[id]->version > 0)
+      outputs.emplace_back(id, resources_[id]->version);
   // Cull: walk passes backwards from the outputs, keeping each pass that writes a needed
-  // version (or has a side effect) and marking what it reads as needed.
-  std::set<std::pair<uint32_t, uint32_t>> needed(outputs_.begin(), outputs_.end());
+  // version (or has a side effect) and marking what it reads as needed. A partial write also
+  // needs the previous version: the subresources it leaves alone carry over.
+  std::set<std::pair<uint32_t, uint32_t>> needed(outputs.begin(), outputs.end());
   for (auto it = passes_.rbegin(); it != passes_.rend(); ++it) {
     Pass& p = **it;
     bool keep = p.sideEffect;
@@ -384,13 +602,15 @@ void FrameGraph::compile() {
       keep = keep || (a.write && needed.count({a.resource, a.version}));
     p.culled = !keep;
     if (!keep) continue;
-    for (const Access& a : p.accesses)
+    for (const Access& a : p.accesses) {
       if (!a.write) needed.insert({a.resource, a.version});
+      if (a.partial) needed.insert({a.resource, a.version - 1});
+    }
   }
-  // Every kept read must have a producer (a kept write of that version, or an import).
+  // Every kept read must have a producer (a kept write of that version, or an external one).
   std::set<std::pair<uint32_t, uint32_t>> produced;
   for (uint32_t id = 0; id < resources_.size(); ++id)
-    if (resources_[id]->imported) produced.insert({id, 0});
+    if (resources_[id]->external()) produced.insert({id, 0});
   int order = 0;
   for (auto& p : passes_) {
     if (p->culled) continue;
@@ -401,6 +621,11 @@ void FrameGraph::compile() {
             ErrorKind::Usage, "",
             "frame graph: pass '" + p->name + "' reads '" + r.name + "' but no pass writes it");
       if (a.write) produced.insert({a.resource, a.version});
+      if (r.owned && r.texture && (imageUsageOf(a.textureUsage, false) & ~r.owned->usage) != 0)
+        throw Error(ErrorKind::Usage, "",
+                    "frame graph: pass '" + p->name + "' uses '" + r.name +
+                        "' in a way its format does not support (format " +
+                        std::to_string(int(r.dims.format)) + ")");
       if (r.firstUse < 0) r.firstUse = order;
       r.lastUse = order;
     }
@@ -419,7 +644,7 @@ void FrameGraph::allocateTransients() {
   std::vector<uint32_t> transientIds;
   for (uint32_t id = 0; id < resources_.size(); ++id) {
     Resource& r = *resources_[id];
-    if (r.imported || r.firstUse < 0) continue;  // imported, or only used by culled passes
+    if (r.external() || r.firstUse < 0) continue;  // not transient, or only used by culled passes
     auto t = std::make_unique<Transient>();
     t->ctx = &ctx_;
     if (r.texture) {
@@ -430,18 +655,9 @@ void FrameGraph::allocateTransients() {
         if (!p->culled)
           for (const Access& a : p->accesses)
             if (a.resource == id) usage |= imageUsageOf(a.textureUsage, depth);
-      r.extent = resolveExtent(id);
-      VkImageCreateInfo info{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
-      info.imageType = VK_IMAGE_TYPE_2D;
-      info.format = r.textureDesc.format;
-      info.extent = {r.extent.width, r.extent.height, 1};
-      info.mipLevels = 1;
-      info.arrayLayers = 1;
-      info.samples = VK_SAMPLE_COUNT_1_BIT;
-      info.tiling = VK_IMAGE_TILING_OPTIMAL;
-      info.usage = usage;
-      vk::check(vkCreateImage(device, &info, nullptr, &t->image), "vkCreateImage (frame graph)");
+      t->image = graph_detail::createImage(ctx_, r.dims, usage);
       vkGetImageMemoryRequirements(device, t->image, &t->requirements);
+      r.ownSubs.resize(r.dims.subresources());
       ++stats_.transientTextures;
     } else {
       VkBufferUsageFlags usage = 0;
@@ -498,17 +714,11 @@ void FrameGraph::allocateTransients() {
     if (t.image) {
       vk::check(vkBindImageMemory(device, t.image, slot.allocation.memory, slot.allocation.offset),
                 "vkBindImageMemory");
-      VkImageViewCreateInfo view{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
-      view.image = t.image;
-      view.viewType = VK_IMAGE_VIEW_TYPE_2D;
-      view.format = r.textureDesc.format;
-      const VkImageAspectFlags aspect = vk::isDepthFormat(r.textureDesc.format)
-                                            ? VK_IMAGE_ASPECT_DEPTH_BIT
-                                            : VK_IMAGE_ASPECT_COLOR_BIT;
-      view.subresourceRange = {aspect, 0, 1, 0, 1};
-      vk::check(vkCreateImageView(device, &view, nullptr, &t.view), "vkCreateImageView");
+      t.views = std::make_unique<ImageViews>(ctx_, t.image, r.dims);
+      r.views = t.views.get();
+      // A cube array's natural view needs the imageCubeArray feature: made only when asked.
+      if (r.dims.type != TextureType::CubeArray) r.view = t.views->natural();
       r.image = t.image;
-      r.view = t.view;
     } else {
       vk::check(
           vkBindBufferMemory(device, t.buffer, slot.allocation.memory, slot.allocation.offset),
@@ -518,35 +728,97 @@ void FrameGraph::allocateTransients() {
   }
 }
 
+namespace {
+
+// A read needs no barrier when nothing wrote the subresource yet, or a barrier already made the
+// last write visible to this stage and access.
+bool alreadyVisible(const SyncState& lastWrite, const SyncState& visible, const SyncState& need) {
+  return lastWrite.access == VK_ACCESS_2_NONE ||
+         ((need.stage & ~visible.stage) == 0 && (need.access & ~visible.access) == 0);
+}
+
+// Bookkeeping after a barrier for a write or a layout change to `need`.
+void afterBarrier(SyncState& state, SyncState& lastWrite, SyncState& visible, const SyncState& need,
+                  bool write) {
+  state = need;
+  if (write) {
+    lastWrite = {need.layout, need.stage, need.access & kWriteAccess};
+    visible = {};  // nothing has seen this write yet
+  } else {
+    visible = need;
+  }
+}
+
+// What one pass needs of one subresource: all its accesses there, combined.
+struct SubNeed {
+  SyncState sync;
+  bool read = false, write = false;
+};
+
+}  // namespace
+
+// Persistent and fallback images start cleared (zero, or the fallback's value): recorded at the
+// start of the frame, then treated as a write.
+void FrameGraph::clearOwned(VkCommandBuffer cmd) {
+  std::vector<Owned*> owned;
+  for (auto& [name, o] : persistent_)
+    if (o->needsClear) owned.push_back(o.get());
+  for (auto& [name, o] : fallbacks_)
+    if (o->needsClear) owned.push_back(o.get());
+  if (owned.empty()) return;
+  std::vector<VkImageMemoryBarrier2> barriers;
+  for (Owned* o : owned) {
+    VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
+    b.srcStageMask = VK_PIPELINE_STAGE_2_NONE;
+    b.dstStageMask = VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT;
+    b.dstAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
+    b.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+    b.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
+    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    b.image = o->image;
+    b.subresourceRange = {graph_detail::aspectOf(o->dims.format), 0, VK_REMAINING_MIP_LEVELS, 0,
+                          VK_REMAINING_ARRAY_LAYERS};
+    barriers.push_back(b);
+  }
+  VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+  dep.imageMemoryBarrierCount = uint32_t(barriers.size());
+  dep.pImageMemoryBarriers = barriers.data();
+  vkCmdPipelineBarrier2(cmd, &dep);
+  const SyncState cleared{VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                          VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT};
+  for (size_t i = 0; i < owned.size(); ++i) {
+    Owned* o = owned[i];
+    const VkImageSubresourceRange& range = barriers[i].subresourceRange;
+    if (vk::isDepthFormat(o->dims.format)) {
+      VkClearDepthStencilValue zero{};
+      vkCmdClearDepthStencilImage(cmd, o->image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &zero, 1,
+                                  &range);
+    } else {
+      vkCmdClearColorImage(cmd, o->image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &o->clear, 1,
+                           &range);
+    }
+    for (SubState& s : o->subs) s = {cleared, cleared, {}};
+    o->needsClear = false;
+    o->written = false;
+  }
+}
+
 void FrameGraph::execute(VkCommandBuffer cmd, vk::DescriptorArena& descriptors, vk::GpuTimer* timer,
                          const PassBoundary& afterPass) {
   if (!compiled_) throw Error(ErrorKind::Usage, "", "frame graph: execute() before compile()");
   // Transient contents never survive a frame: they start undefined.
   for (auto& r : resources_)
-    if (!r->imported) r->state = r->lastWrite = r->visible = {};
+    if (!r->external()) {
+      r->state = r->lastWrite = r->visible = {};
+      for (SubState& s : r->ownSubs) s = {};
+    }
   for (Slot& slot : slots_) slot.usedStages = VK_PIPELINE_STAGE_2_NONE;
-  // The memory slot under a transient (nullptr for imported resources).
+  clearOwned(cmd);
+  // The memory slot under a transient (nullptr for external resources).
   auto slotOf = [this](const Resource& r) -> Slot* {
-    if (r.imported || r.transient < 0) return nullptr;
+    if (r.external() || r.transient < 0) return nullptr;
     const int slot = pool_[size_t(r.transient)]->slot;
     return slot >= 0 ? &slots_[size_t(slot)] : nullptr;
-  };
-
-  // A read needs no barrier when nothing wrote the resource yet, or a barrier already made the
-  // last write visible to this stage and access.
-  auto alreadyVisible = [](const Resource& r, const SyncState& need) {
-    return r.lastWrite.access == VK_ACCESS_2_NONE ||
-           ((need.stage & ~r.visible.stage) == 0 && (need.access & ~r.visible.access) == 0);
-  };
-  // Bookkeeping after a barrier for a write or a layout change to `need`.
-  auto afterBarrier = [](Resource& r, const SyncState& need, bool write) {
-    r.state = need;
-    if (write) {
-      r.lastWrite = {need.layout, need.stage, need.access & kWriteAccess};
-      r.visible = {};  // nothing has seen this write yet
-    } else {
-      r.visible = need;
-    }
   };
 
   PassContext pc;
@@ -558,95 +830,107 @@ void FrameGraph::execute(VkCommandBuffer cmd, vk::DescriptorArena& descriptors, 
     if (p->culled) continue;
     std::vector<VkImageMemoryBarrier2> imageBarriers;
     std::vector<VkBufferMemoryBarrier2> bufferBarriers;
-    // Does this pass read the resource's previous contents? If not, they may be discarded.
-    auto readsResource = [&](uint32_t id) {
-      for (const Access& a : p->accesses)
-        if (a.resource == id && !a.write) return true;
-      return false;
-    };
+    // Textures: combine the pass's accesses per subresource first, so that coinciding ranges
+    // share one barrier and different ranges of one image get their own.
+    std::vector<uint32_t> images;
+    std::unordered_map<uint32_t, std::vector<SubNeed>> needs;
     for (const Access& a : p->accesses) {
       Resource& r = *resources_[a.resource];
-      if (r.texture) {
-        SyncState need = required(a.textureUsage, vk::isDepthFormat(r.textureDesc.format));
-        const bool sameLayoutRead = !a.write && r.state.layout == need.layout;
-        if (sameLayoutRead && alreadyVisible(r, need)) {
-          r.state.stage |= need.stage;  // a later write waits for this reader too
-          if (Slot* slot = slotOf(r)) slot->usedStages |= need.stage;
+      if (!r.texture) continue;
+      std::vector<SubNeed>& subs = needs[a.resource];
+      if (subs.empty()) {
+        subs.resize(r.dims.subresources());
+        images.push_back(a.resource);
+      }
+      const SyncState n = required(a.textureUsage, vk::isDepthFormat(r.dims.format));
+      for (uint32_t m = a.range.mip; m < a.range.mip + a.range.mipCount; ++m)
+        for (uint32_t l = a.range.layer; l < a.range.layer + a.range.layerCount; ++l) {
+          SubNeed& x = subs[m * r.dims.layers + l];
+          if ((x.read || x.write) && x.sync.layout != n.layout)
+            throw Error(ErrorKind::Usage, "",
+                        "frame graph: pass '" + p->name + "' uses '" + r.name +
+                            "' in two conflicting layouts" +
+                            graph_detail::describeSubresource(Subresource::one(m, l)));
+          x.sync.layout = n.layout;
+          x.sync.stage |= n.stage;
+          x.sync.access |= n.access;
+          (a.write ? x.write : x.read) = true;
+        }
+    }
+    for (uint32_t id : images) {
+      Resource& r = *resources_[id];
+      Slot* slot = slotOf(r);
+      const std::vector<SubNeed>& subs = needs[id];
+      std::vector<SubBarrier> barriers(subs.size());
+      VkPipelineStageFlags2 used = VK_PIPELINE_STAGE_2_NONE;
+      for (size_t i = 0; i < subs.size(); ++i) {
+        const SubNeed& x = subs[i];
+        if (!x.read && !x.write) continue;
+        SubState& st = (*r.subs)[i];
+        used |= x.sync.stage;
+        const bool sameLayoutRead = !x.write && st.state.layout == x.sync.layout;
+        if (sameLayoutRead && alreadyVisible(st.lastWrite, st.visible, x.sync)) {
+          st.state.stage |= x.sync.stage;  // a later write waits for this reader too
           continue;
         }
-        VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
+        SubBarrier& b = barriers[i];
+        b.needed = true;
         // A read in the same layout waits for the last write only; a write or a layout change
         // waits for every use since (write-after-read needs the readers done).
-        b.srcStageMask = sameLayoutRead ? r.lastWrite.stage : r.state.stage;
+        // (The last write's own stage joins too: its access must be in a stage of the mask.)
+        b.srcStage = sameLayoutRead ? st.lastWrite.stage : st.state.stage | st.lastWrite.stage;
+        b.srcAccess = st.lastWrite.access;
+        b.dstStage = x.sync.stage;
+        b.dstAccess = x.sync.access;
+        // A transient's previous contents may be discarded where this pass only writes.
+        const bool discard = x.write && !x.read && !r.external();
+        b.oldLayout = discard ? VK_IMAGE_LAYOUT_UNDEFINED : st.state.layout;
+        b.newLayout = x.sync.layout;
+        if (b.srcStage == VK_PIPELINE_STAGE_2_NONE && slot)  // first use of aliased memory
+          b.srcStage = slot->usedStages;
+        if (b.srcStage == VK_PIPELINE_STAGE_2_NONE)
+          b.srcStage = VK_PIPELINE_STAGE_2_TOP_OF_PIPE_BIT;
+        if (sameLayoutRead) {
+          st.state.stage |= x.sync.stage;
+          st.visible.stage |= x.sync.stage;
+          st.visible.access |= x.sync.access;
+        } else {
+          afterBarrier(st.state, st.lastWrite, st.visible, x.sync, x.write);
+        }
+      }
+      if (slot) slot->usedStages |= used;
+      graph_detail::appendBarriers(barriers, r.dims, r.image, imageBarriers);
+    }
+    for (const Access& a : p->accesses) {
+      Resource& r = *resources_[a.resource];
+      if (r.texture) continue;
+      SyncState need = required(a.bufferUsage);
+      if (!a.write && alreadyVisible(r.lastWrite, r.visible, need)) {
+        r.state.stage |= need.stage;
+        if (Slot* slot = slotOf(r)) slot->usedStages |= need.stage;
+        continue;
+      }
+      Slot* slot = slotOf(r);
+      VkPipelineStageFlags2 src = a.write ? r.state.stage | r.lastWrite.stage : r.lastWrite.stage;
+      if (src == VK_PIPELINE_STAGE_2_NONE && slot) src = slot->usedStages;  // aliased memory
+      if (slot) slot->usedStages |= need.stage;
+      if (src != VK_PIPELINE_STAGE_2_NONE) {
+        VkBufferMemoryBarrier2 b{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2};
+        b.srcStageMask = src;
         b.srcAccessMask = r.lastWrite.access;
         b.dstStageMask = need.stage;
         b.dstAccessMask = need.access;
-        const bool discard = a.write && !readsResource(a.resource) && !r.imported;
-        b.oldLayout = discard ? VK_IMAGE_LAYOUT_UNDEFINED : r.state.layout;
-        b.newLayout = need.layout;
-        Slot* slot = slotOf(r);
-        if (b.srcStageMask == VK_PIPELINE_STAGE_2_NONE && slot)  // first use of aliased memory
-          b.srcStageMask = slot->usedStages;
-        if (b.srcStageMask == VK_PIPELINE_STAGE_2_NONE)
-          b.srcStageMask = VK_PIPELINE_STAGE_2_TOP_OF_PIPE_BIT;
-        if (slot) slot->usedStages |= need.stage;
         b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        b.image = r.image;
-        const VkImageAspectFlags aspect = vk::isDepthFormat(r.textureDesc.format)
-                                              ? VK_IMAGE_ASPECT_DEPTH_BIT
-                                              : VK_IMAGE_ASPECT_COLOR_BIT;
-        b.subresourceRange = {aspect, 0, VK_REMAINING_MIP_LEVELS, 0, VK_REMAINING_ARRAY_LAYERS};
-        // Merge with an earlier barrier of this pass on the same image (read + write).
-        bool merged = false;
-        for (auto& e : imageBarriers)
-          if (e.image == b.image) {
-            if (e.newLayout != b.newLayout)
-              throw Error(ErrorKind::Usage, "",
-                          "frame graph: pass '" + p->name + "' uses '" + r.name +
-                              "' in two conflicting layouts");
-            e.srcStageMask |= b.srcStageMask;
-            e.srcAccessMask |= b.srcAccessMask;
-            e.dstStageMask |= b.dstStageMask;
-            e.dstAccessMask |= b.dstAccessMask;
-            merged = true;
-          }
-        if (!merged) imageBarriers.push_back(b);
-        if (sameLayoutRead) {
-          r.state.stage |= need.stage;
-          r.visible.stage |= need.stage;
-          r.visible.access |= need.access;
-        } else {
-          afterBarrier(r, need, a.write);
-        }
+        b.buffer = r.buffer;
+        b.size = VK_WHOLE_SIZE;
+        bufferBarriers.push_back(b);
+      }
+      if (a.write) {
+        afterBarrier(r.state, r.lastWrite, r.visible, need, true);
       } else {
-        SyncState need = required(a.bufferUsage);
-        if (!a.write && alreadyVisible(r, need)) {
-          r.state.stage |= need.stage;
-          if (Slot* slot = slotOf(r)) slot->usedStages |= need.stage;
-          continue;
-        }
-        Slot* slot = slotOf(r);
-        VkPipelineStageFlags2 src = a.write ? r.state.stage : r.lastWrite.stage;
-        if (src == VK_PIPELINE_STAGE_2_NONE && slot) src = slot->usedStages;  // aliased memory
-        if (slot) slot->usedStages |= need.stage;
-        if (src != VK_PIPELINE_STAGE_2_NONE) {
-          VkBufferMemoryBarrier2 b{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2};
-          b.srcStageMask = src;
-          b.srcAccessMask = r.lastWrite.access;
-          b.dstStageMask = need.stage;
-          b.dstAccessMask = need.access;
-          b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-          b.buffer = r.buffer;
-          b.size = VK_WHOLE_SIZE;
-          bufferBarriers.push_back(b);
-        }
-        if (a.write) {
-          afterBarrier(r, need, true);
-        } else {
-          r.state.stage |= need.stage;
-          r.visible.stage |= need.stage;
-          r.visible.access |= need.access;
-        }
+        r.state.stage |= need.stage;
+        r.visible.stage |= need.stage;
+        r.visible.access |= need.access;
       }
     }
     if (!imageBarriers.empty() || !bufferBarriers.empty()) {
@@ -662,20 +946,37 @@ void FrameGraph::execute(VkCommandBuffer cmd, vk::DescriptorArena& descriptors, 
     if (timer) timer->end(cmd);
     if (afterPass) pc.cmd_ = cmd = afterPass(cmd);
   }
-  // Leave imported images in the layout their owner asked for.
+  // Leave imported images in the layout their owner asked for, each subresource from its own.
+  std::vector<VkImageMemoryBarrier2> finals;
   for (auto& r : resources_) {
-    if (!r->imported || !r->texture || r->finalLayout == VK_IMAGE_LAYOUT_UNDEFINED ||
-        r->finalLayout == r->state.layout)
-      continue;
-    const VkImageAspectFlags aspect = vk::isDepthFormat(r->textureDesc.format)
-                                          ? VK_IMAGE_ASPECT_DEPTH_BIT
-                                          : VK_IMAGE_ASPECT_COLOR_BIT;
-    vk::imageBarrier(cmd, r->image, aspect, r->state.layout, r->finalLayout,
-                     r->state.stage ? r->state.stage : VK_PIPELINE_STAGE_2_TOP_OF_PIPE_BIT,
-                     r->state.access & kWriteAccess, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
-                     VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT);
-    r->state = {r->finalLayout, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT};
+    if (!r->imported || !r->texture || r->finalLayout == VK_IMAGE_LAYOUT_UNDEFINED) continue;
+    std::vector<SubBarrier> barriers(r->ownSubs.size());
+    for (size_t i = 0; i < barriers.size(); ++i) {
+      SyncState& s = r->ownSubs[i].state;
+      if (s.layout == r->finalLayout) continue;
+      barriers[i] = {true,
+                     s.stage ? s.stage : VK_PIPELINE_STAGE_2_TOP_OF_PIPE_BIT,
+                     VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+                     s.access & kWriteAccess,
+                     VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT,
+                     s.layout,
+                     r->finalLayout};
+      s = {r->finalLayout, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT};
+    }
+    graph_detail::appendBarriers(barriers, r->dims, r->image, finals);
   }
+  if (!finals.empty()) {
+    VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+    dep.imageMemoryBarrierCount = uint32_t(finals.size());
+    dep.pImageMemoryBarriers = finals.data();
+    vkCmdPipelineBarrier2(cmd, &dep);
+  }
+  // A persistent texture some kept pass wrote now holds history for the next frame.
+  for (auto& p : passes_)
+    if (!p->culled)
+      for (const Access& a : p->accesses)
+        if (a.write && resources_[a.resource]->persistent)
+          resources_[a.resource]->owned->written = true;
 }
 
 FrameGraph::TextureState FrameGraph::textureState(TextureHandle h) const {
@@ -683,8 +984,7 @@ FrameGraph::TextureState FrameGraph::textureState(TextureHandle h) const {
   if (!r.texture || !r.image)
     throw Error(ErrorKind::Usage, "",
                 "frame graph: '" + r.name + "' was not produced (its passes were culled)");
-  return {r.image, r.view, r.textureDesc.format, r.imported ? resolveExtent(h.id) : r.extent,
-          r.state.layout};
+  return {r.image, r.view, r.textureDesc.format, r.dims.extent, (*r.subs)[0].state.layout};
 }
 
 std::vector<std::string> FrameGraph::executedPasses() const {
@@ -708,8 +1008,11 @@ std::string FrameGraph::describe() const {
   for (auto& p : passes_) {
     s << (p->culled ? "  [culled] " : "  [run]    ") << p->name;
     std::string reads, writes;
-    for (const Access& a : p->accesses)
-      (a.write ? writes : reads) += " " + resources_[a.resource]->name;
+    for (const Access& a : p->accesses) {
+      const Resource& r = *resources_[a.resource];
+      (a.write ? writes : reads) += " " + r.name + (r.persistent ? " (persistent)" : "") +
+                                    (r.texture ? graph_detail::describeSubresource(a.sub) : "");
+    }
     s << "\n      reads:" << (reads.empty() ? " -" : reads)
       << "\n      writes:" << (writes.empty() ? " -" : writes) << "\n";
   }
@@ -727,16 +1030,25 @@ std::string FrameGraph::toDot() const {
     s << "  p" << i << " [shape=box, label=\"" << passes_[i]->name << "\""
       << (passes_[i]->culled ? ", style=dashed, color=gray" : ", style=filled, fillcolor=lightblue")
       << "];\n";
-  for (size_t r = 0; r < resources_.size(); ++r)
-    s << "  r" << r << " [shape=ellipse, label=\"" << resources_[r]->name << "\""
-      << (resources_[r]->imported ? ", peripheries=2" : "") << "];\n";
+  for (size_t r = 0; r < resources_.size(); ++r) {
+    const Resource& res = *resources_[r];
+    s << "  r" << r << " [shape=ellipse, label=\"" << res.name
+      << (res.persistent ? "\\n(persistent)\", style=bold, color=darkgreen" : "\"")
+      << (res.imported ? ", peripheries=2" : "") << "];\n";
+  }
   for (size_t i = 0; i < passes_.size(); ++i)
     for (const Access& a : passes_[i]->accesses) {
-      const char* style = passes_[i]->culled ? " [style=dashed, color=gray]" : "";
+      const std::string sub =
+          resources_[a.resource]->texture ? graph_detail::describeSubresource(a.sub) : "";
+      std::string attrs;
+      if (!sub.empty()) attrs += "label=\"" + sub + "\"";
+      if (passes_[i]->culled)
+        attrs += std::string(attrs.empty() ? "" : ", ") + "style=dashed, color=gray";
+      if (!attrs.empty()) attrs = " [" + attrs + "]";
       if (a.write)
-        s << "  p" << i << " -> r" << a.resource << style << ";\n";
+        s << "  p" << i << " -> r" << a.resource << attrs << ";\n";
       else
-        s << "  r" << a.resource << " -> p" << i << style << ";\n";
+        s << "  r" << a.resource << " -> p" << i << attrs << ";\n";
     }
   s << "}\n";
   return s.str();
@@ -746,7 +1058,15 @@ VkImage PassContext::image(TextureHandle h) const {
   return graph_->resource(h.id).image;
 }
 VkImageView PassContext::view(TextureHandle h) const {
-  return graph_->resource(h.id).view;
+  const auto& r = graph_->resource(h.id);
+  if (!r.view && r.views) return r.views->natural();  // a cube array's, made on request
+  return r.view;
+}
+VkImageView PassContext::view(TextureHandle h, const Subresource& sub) const {
+  const auto& r = graph_->resource(h.id);
+  if (!r.views)
+    throw Error(ErrorKind::Usage, "", "frame graph: '" + r.name + "' has no image to view");
+  return r.views->ofRange(graph_detail::resolveRange(r.name, sub, r.dims));
 }
 VkFormat PassContext::format(TextureHandle h) const {
   return graph_->resource(h.id).textureDesc.format;
@@ -760,9 +1080,41 @@ VkDeviceSize PassContext::bufferSize(BufferHandle h) const {
 VkExtent2D PassContext::outputExtent() const {
   return graph_->outputExtent();
 }
-VkExtent2D PassContext::extent(TextureHandle h) const {
+VkExtent2D PassContext::extent(TextureHandle h, uint32_t mip) const {
+  return graph_->resource(h.id).dims.mipExtent(mip);
+}
+uint32_t PassContext::layers(TextureHandle h) const {
+  return graph_->resource(h.id).dims.layers;
+}
+uint32_t PassContext::mips(TextureHandle h) const {
+  return graph_->resource(h.id).dims.mips;
+}
+
+void PassContext::barrier(TextureHandle h, const Subresource& sub) const {
   const auto& r = graph_->resource(h.id);
-  return r.imported ? graph_->resolveExtent(h.id) : r.extent;
+  const graph_detail::Range range = graph_detail::resolveRange(r.name, sub, r.dims);
+  std::vector<SubBarrier> barriers(r.dims.subresources());
+  for (uint32_t m = range.mip; m < range.mip + range.mipCount; ++m)
+    for (uint32_t l = range.layer; l < range.layer + range.layerCount; ++l) {
+      const uint32_t i = m * r.dims.layers + l;
+      SubState& st = (*r.subs)[i];
+      if ((st.state.access & kWriteAccess) == 0) continue;  // this pass does not write it
+      barriers[i] = {true,
+                     st.state.stage,
+                     st.state.stage,
+                     st.state.access & kWriteAccess,
+                     st.state.access,
+                     st.state.layout,
+                     st.state.layout};
+      st.visible = st.state;
+    }
+  std::vector<VkImageMemoryBarrier2> out;
+  graph_detail::appendBarriers(barriers, r.dims, r.image, out);
+  if (out.empty()) return;
+  VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+  dep.imageMemoryBarrierCount = uint32_t(out.size());
+  dep.pImageMemoryBarriers = out.data();
+  vkCmdPipelineBarrier2(cmd_, &dep);
 }
 
 TextureHandle Blackboard::texture(const std::string& name) const {
