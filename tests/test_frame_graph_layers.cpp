@@ -442,6 +442,25 @@ TEST_F(FrameGraphLayersTest, PartialWritesKeepEarlierProducers) {
   EXPECT_EQ(g.executedPasses(), (std::vector<std::string>{"C"}));
   EXPECT_EQ(g.culledPasses(), (std::vector<std::string>{"A", "B"}));
 
+  // One subresource in two layouts in one pass is an error; different subresources are fine.
+  g.reset();
+  g.addPass("conflict",
+            [&](PassBuilder& pb) {
+              TextureHandle t = pb.write(pb.create("t", desc), TextureUsage::StorageWrite,
+                                         Subresource::layerOf(0));
+              pb.read(t, TextureUsage::Sampled, Subresource::layerOf(0));
+              pb.sideEffect();
+            },
+            {});
+  try {
+    g.compile();
+    FAIL() << "expected a layout conflict";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("'t[layer 0]' in two conflicting layouts"),
+              std::string::npos)
+        << e.what();
+  }
+
   // A subresource outside the texture is an error naming it.
   g.reset();
   g.addPass("bad",
@@ -471,9 +490,11 @@ TEST_F(FrameGraphLayersTest, PersistentHistoryAcrossFramesAndResize) {
   bool validInPass = true;
   VkExtent2D extentInPass{};
   TextureHandle history;
+  bool validAtSetup = true;
   auto build = [&] {
     history = g.persistentTexture("history", desc);
-    addReadback(g, history, out);  // last frame's value, before this frame's write
+    validAtSetup = g.historyValid(history);  // effects decide at setup whether to use it
+    addReadback(g, history, out);            // last frame's value, before this frame's write
     g.addPass(
         "update", [&](PassBuilder& pb) { history = pb.write(history, TextureUsage::StorageWrite); },
         [&, h = history](PassContext& pc) {
@@ -489,6 +510,7 @@ TEST_F(FrameGraphLayersTest, PersistentHistoryAcrossFramesAndResize) {
     for (uint32_t i = 0; i < texels; ++i) ASSERT_EQ(floats(out)[i], v) << what << " texel " << i;
   };
   build();
+  EXPECT_FALSE(validAtSetup);
   EXPECT_FALSE(g.historyValid(history));
   for (int n = 0; n < 3; ++n) {
     frameValue = f(n);
@@ -503,6 +525,7 @@ TEST_F(FrameGraphLayersTest, PersistentHistoryAcrossFramesAndResize) {
   // Rebuilt at the same size: the history survives reset() and compile().
   g.reset();
   build();
+  EXPECT_TRUE(validAtSetup);
   EXPECT_TRUE(g.historyValid(history));
   frameValue = f(3);
   run(ctx(), g);
@@ -512,6 +535,7 @@ TEST_F(FrameGraphLayersTest, PersistentHistoryAcrossFramesAndResize) {
   g.reset();
   g.setOutputExtent({8, 8});
   build();
+  EXPECT_FALSE(validAtSetup);
   EXPECT_FALSE(g.historyValid(history));
   EXPECT_EQ(g.textureState(history).extent.width, 8u);
   std::memset(out.mapped(), 0xff, 16 * 16 * 4);

@@ -348,7 +348,10 @@ bool FrameGraph::historyValid(TextureHandle h) const {
     throw Error(ErrorKind::Usage, "",
                 "frame graph: historyValid('" + r.name + "'): not a persistent texture");
   auto it = persistent_.find(r.name);
-  return it != persistent_.end() && it->second->declared && it->second->written;
+  if (it == persistent_.end() || !it->second->written) return false;
+  if (compiled_) return it->second.get() == r.owned;
+  // Before compile(): valid if compile() will keep the image (its resolved shape is the same).
+  return it->second->dims == graph_detail::resolveDims(r.name, r.textureDesc, resolveExtent(h.id));
 }
 
 const FrameGraph::Resource& FrameGraph::resource(uint32_t id) const {
@@ -548,6 +551,26 @@ void FrameGraph::resolveTextures() {
       a.range = graph_detail::resolveRange(r.name, a.sub, r.dims);
       a.partial = a.write && !a.range.covers(r.dims);
     }
+  // One subresource has one layout during a pass.
+  for (auto& p : passes_)
+    for (size_t i = 0; i < p->accesses.size(); ++i)
+      for (size_t j = 0; j < i; ++j) {
+        const Access& a = p->accesses[i];
+        const Access& b = p->accesses[j];
+        const Resource& r = *resources_[a.resource];
+        if (a.resource != b.resource || !r.texture) continue;
+        const bool overlap = a.range.mip < b.range.mip + b.range.mipCount &&
+                             b.range.mip < a.range.mip + a.range.mipCount &&
+                             a.range.layer < b.range.layer + b.range.layerCount &&
+                             b.range.layer < a.range.layer + a.range.layerCount;
+        const bool depth = vk::isDepthFormat(r.dims.format);
+        if (overlap &&
+            required(a.textureUsage, depth).layout != required(b.textureUsage, depth).layout)
+          throw Error(ErrorKind::Usage, "",
+                      "frame graph: pass '" + p->name + "' uses '" + r.name +
+                          graph_detail::describeSubresource(a.sub) +
+                          "' in two conflicting layouts");
+      }
 }
 
 // Links this graph's persistent textures to their images, (re)creating those whose shape
@@ -849,8 +872,8 @@ void FrameGraph::execute(VkCommandBuffer cmd, vk::DescriptorArena& descriptors, 
           if ((x.read || x.write) && x.sync.layout != n.layout)
             throw Error(ErrorKind::Usage, "",
                         "frame graph: pass '" + p->name + "' uses '" + r.name +
-                            "' in two conflicting layouts" +
-                            graph_detail::describeSubresource(Subresource::one(m, l)));
+                            graph_detail::describeSubresource(Subresource::one(m, l)) +
+                            "' in two conflicting layouts");
           x.sync.layout = n.layout;
           x.sync.stage |= n.stage;
           x.sync.access |= n.access;
@@ -984,7 +1007,9 @@ FrameGraph::TextureState FrameGraph::textureState(TextureHandle h) const {
   if (!r.texture || !r.image)
     throw Error(ErrorKind::Usage, "",
                 "frame graph: '" + r.name + "' was not produced (its passes were culled)");
-  return {r.image, r.view, r.textureDesc.format, r.dims.extent, (*r.subs)[0].state.layout};
+  const VkImageLayout layout = r.subs->empty() ? r.importLayout : (*r.subs)[0].state.layout;
+  return {r.image, r.view, r.textureDesc.format, r.imported ? resolveExtent(h.id) : r.dims.extent,
+          layout};
 }
 
 std::vector<std::string> FrameGraph::executedPasses() const {
