@@ -274,6 +274,10 @@ TEST_F(FrameGraphLayersTest, MipChainPassPerMip) {
   run(ctx(), g);
   expectMips(out, kSize);
   EXPECT_NE(g.describe().find("chain[mip 3]"), std::string::npos) << g.describe();
+  EXPECT_NE(g.toDot().find("label=\"[mip 3]\""), std::string::npos) << g.toDot();
+  const FrameGraph::TextureState state = g.textureState(t);  // mip 0, layer 0
+  EXPECT_EQ(state.extent.width, kSize);
+  EXPECT_EQ(state.layout, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
 }
 
 // Test 2b: the whole chain in one pass, with PassContext::barrier between the mips.
@@ -397,6 +401,51 @@ TEST_F(FrameGraphLayersTest, CubeAndVolumeTextures) {
   }
   for (uint32_t i = 0; i < kW * kH * kD; ++i)
     ASSERT_EQ(floats(volumeOut)[i], 0.5f + float(i)) << "texel " << i;
+}
+
+// A 2-layer array and, after its last use, a cube share memory; both still read back exactly.
+TEST_F(FrameGraphLayersTest, ArrayAndCubeAliasMemory) {
+  constexpr uint32_t kSize = 16;
+  FrameGraph g(ctx(), {kSize, kSize});
+  vk::Pipeline fillArray = computePipeline(ctx(), fillSource("image2DArray"), "fill_array.comp",
+                                           {{0, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE}}, 16);
+  vk::Buffer arrayOut(ctx(), kSize * kSize * 2 * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
+  vk::Buffer cubeOut(ctx(), kSize * kSize * 6 * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
+  TextureHandle arr, cube;
+  g.addPass(
+      "write_array",
+      [&](PassBuilder& pb) {
+        arr = pb.write(pb.create("array", r32(kSize, kSize, TextureType::Tex2DArray, 2)),
+                       TextureUsage::StorageWrite);
+      },
+      [&, &h = arr](PassContext& pc) {
+        fill(pc, fillArray, pc.view(h, Subresource::all()), {kSize, kSize, 2}, {1, 1, 0, 1000});
+      });
+  addReadback(g, arr, arrayOut);
+  g.addPass(
+      "write_cube",
+      [&](PassBuilder& pb) {
+        cube = pb.write(pb.create("cube", r32(kSize, kSize, TextureType::Cube)),
+                        TextureUsage::StorageWrite);
+      },
+      [&, &h = cube](PassContext& pc) {
+        fill(pc, fillArray, pc.view(h, Subresource::all()), {kSize, kSize, 6}, {2, 0, 1, 100});
+      });
+  addReadback(g, cube, cubeOut);
+  g.compile();
+  EXPECT_EQ(g.stats().transientTextures, 2u);
+  EXPECT_LT(g.stats().transientBytesAllocated, g.stats().transientBytesRequested) << g.describe();
+  for (int frame = 0; frame < 2; ++frame) {
+    run(ctx(), g);
+    for (uint32_t l = 0; l < 2; ++l)
+      for (uint32_t y = 0; y < kSize; ++y)
+        for (uint32_t x = 0; x < kSize; ++x)
+          ASSERT_EQ(floats(arrayOut)[(l * kSize + y) * kSize + x], 1.0f + x + 1000.0f * l);
+    for (uint32_t f = 0; f < 6; ++f)
+      for (uint32_t y = 0; y < kSize; ++y)
+        for (uint32_t x = 0; x < kSize; ++x)
+          ASSERT_EQ(floats(cubeOut)[(f * kSize + y) * kSize + x], 2.0f + y + 100.0f * f);
+  }
 }
 
 // Test 4: a write to part of a texture keeps the producers of the rest; a whole write does not.

@@ -188,6 +188,11 @@ struct FrameGraph::Owned {
   bool declared = false;   // in the graph being built (persistent)
   Owned(vk::Context& c, const TextureDims& d) : ctx(&c), dims(d) {
     usage = graph_detail::supportedUsage(c.physicalDevice(), d.format);
+    if (!(usage & VK_IMAGE_USAGE_TRANSFER_DST_BIT) || !(usage & VK_IMAGE_USAGE_SAMPLED_BIT))
+      throw Error(
+          ErrorKind::Usage, "",
+          "frame graph: format " + std::to_string(int(d.format)) +
+              " cannot be sampled and cleared on this device (persistent/fallback texture)");
     image = graph_detail::createImage(c, d, usage);
     VkMemoryRequirements req;
     vkGetImageMemoryRequirements(c.device(), image, &req);
@@ -578,11 +583,15 @@ void FrameGraph::resolveTextures() {
 void FrameGraph::preparePersistent() {
   for (auto& r : resources_)
     if (r->persistent) {
-      auto& slot = persistent_[r->name];
-      if (slot && !(slot->dims == r->dims)) slot.reset();  // resized: history is gone
-      if (!slot) slot = std::make_unique<Owned>(ctx_, r->dims);
-      slot->declared = true;
-      r->owned = slot.get();
+      auto it = persistent_.find(r->name);
+      if (it != persistent_.end() && !(it->second->dims == r->dims)) {
+        persistent_.erase(it);  // resized or reshaped: the history is gone
+        it = persistent_.end();
+      }
+      if (it == persistent_.end())
+        it = persistent_.emplace(r->name, std::make_unique<Owned>(ctx_, r->dims)).first;
+      it->second->declared = true;
+      r->owned = it->second.get();
     }
   std::erase_if(persistent_, [](const auto& kv) { return !kv.second->declared; });
   for (auto& r : resources_)
@@ -1131,7 +1140,7 @@ void PassContext::barrier(TextureHandle h, const Subresource& sub) const {
                      st.state.access,
                      st.state.layout,
                      st.state.layout};
-      st.visible = st.state;
+      // `visible` stays as it was: the pass may write the range again after this barrier.
     }
   std::vector<VkImageMemoryBarrier2> out;
   graph_detail::appendBarriers(barriers, r.dims, r.image, out);
