@@ -154,9 +154,10 @@ class FrameGraph {
   // by the time of compile() are freed. Its last version is an implicit output: passes writing
   // it are not culled. The handle's version 0 is last frame's contents.
   TextureHandle persistentTexture(const std::string& name, const TextureDesc& desc);
-  bool historyValid(
-      TextureHandle h) const;  // false until one frame has written it since (re)creation
-  void releasePersistent();    // frees persistent + fallback textures (not compiled)
+  // False until one frame has written it since (re)creation (also answers during setup).
+  bool historyValid(TextureHandle h) const;
+  // Frees persistent and fallback textures (and forgets the fallbacks); not while compiled.
+  void releasePersistent();
 
   void compile();
   // Records every kept pass into `cmd` (after compile()); timer may be null. `afterPass`,
@@ -196,7 +197,6 @@ class FrameGraph {
   struct Transient;
   struct Slot;
   struct Owned;  // a persistent or fallback image
-  struct Views;
 
   uint32_t addResource(const std::string& name, bool texture);
   void checkCurrent(uint32_t id, uint32_t version, const char* what) const;
