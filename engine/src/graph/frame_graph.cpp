@@ -1,202 +1,20 @@
+// Frame graph: declaration (passes, resources, persistent and fallback textures), culling,
+// allocation with aliasing, and the graph's descriptions.
 #include "gi/graph/frame_graph.h"
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <set>
 #include <sstream>
 
-#include "gi/errors.h"
-#include "gi/vk/common.h"
+#include "frame_graph_internal.h"
 #include "gi/vk/gpu_timer.h"
 #include "gi/vk/pipeline.h"
-#include "gi/vk/resources.h"
 
 namespace gi {
 
-namespace {
-
-struct SyncState {
-  VkImageLayout layout = VK_IMAGE_LAYOUT_UNDEFINED;
-  VkPipelineStageFlags2 stage = VK_PIPELINE_STAGE_2_NONE;
-  VkAccessFlags2 access = VK_ACCESS_2_NONE;
-};
-
-constexpr VkAccessFlags2 kWriteAccess =
-    VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT |
-    VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_2_TRANSFER_WRITE_BIT |
-    VK_ACCESS_2_MEMORY_WRITE_BIT;
-constexpr VkPipelineStageFlags2 kShaderStages = VK_PIPELINE_STAGE_2_VERTEX_SHADER_BIT |
-                                                VK_PIPELINE_STAGE_2_FRAGMENT_SHADER_BIT |
-                                                VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
-
-SyncState required(TextureUsage u, bool depthFormat) {
-  switch (u) {
-    case TextureUsage::Sampled:
-      return {VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, kShaderStages,
-              VK_ACCESS_2_SHADER_SAMPLED_READ_BIT};
-    case TextureUsage::StorageRead:
-      return {VK_IMAGE_LAYOUT_GENERAL, kShaderStages, VK_ACCESS_2_SHADER_STORAGE_READ_BIT};
-    case TextureUsage::StorageWrite:
-      return {VK_IMAGE_LAYOUT_GENERAL, kShaderStages,
-              VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT};
-    case TextureUsage::ColorAttachment:
-      return {VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-              VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
-              VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT};
-    case TextureUsage::DepthAttachment:
-      return {VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
-              VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT |
-                  VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-              VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
-                  VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT};
-    case TextureUsage::DepthRead:
-      return {VK_IMAGE_LAYOUT_DEPTH_READ_ONLY_OPTIMAL,
-              VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT |
-                  VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT,
-              VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT};
-    case TextureUsage::TransferSrc:
-      return {VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT,
-              VK_ACCESS_2_TRANSFER_READ_BIT};
-    case TextureUsage::TransferDst:
-      return {VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT,
-              VK_ACCESS_2_TRANSFER_WRITE_BIT};
-  }
-  (void)depthFormat;
-  return {};
-}
-
-SyncState required(BufferUsage u) {
-  switch (u) {
-    case BufferUsage::Uniform:
-      return {{}, kShaderStages, VK_ACCESS_2_UNIFORM_READ_BIT};
-    case BufferUsage::StorageRead:
-      return {{}, kShaderStages, VK_ACCESS_2_SHADER_STORAGE_READ_BIT};
-    case BufferUsage::StorageWrite:
-      return {{},
-              kShaderStages,
-              VK_ACCESS_2_SHADER_STORAGE_READ_BIT | VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT};
-    case BufferUsage::Vertex:
-      return {{},
-              VK_PIPELINE_STAGE_2_VERTEX_ATTRIBUTE_INPUT_BIT,
-              VK_ACCESS_2_VERTEX_ATTRIBUTE_READ_BIT};
-    case BufferUsage::Index:
-      return {{}, VK_PIPELINE_STAGE_2_INDEX_INPUT_BIT, VK_ACCESS_2_INDEX_READ_BIT};
-    case BufferUsage::Indirect:
-      return {{}, VK_PIPELINE_STAGE_2_DRAW_INDIRECT_BIT, VK_ACCESS_2_INDIRECT_COMMAND_READ_BIT};
-    case BufferUsage::TransferSrc:
-      return {{}, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_READ_BIT};
-    case BufferUsage::TransferDst:
-      return {{}, VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT};
-  }
-  return {};
-}
-
-VkImageUsageFlags imageUsageOf(TextureUsage u, bool depth) {
-  switch (u) {
-    case TextureUsage::Sampled:
-      return VK_IMAGE_USAGE_SAMPLED_BIT;
-    case TextureUsage::StorageRead:
-    case TextureUsage::StorageWrite:
-      return VK_IMAGE_USAGE_STORAGE_BIT;
-    case TextureUsage::ColorAttachment:
-      return VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT;
-    case TextureUsage::DepthAttachment:
-    case TextureUsage::DepthRead:
-      return VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT;
-    case TextureUsage::TransferSrc:
-      return VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
-    case TextureUsage::TransferDst:
-      return VK_IMAGE_USAGE_TRANSFER_DST_BIT;
-  }
-  (void)depth;
-  return 0;
-}
-
-VkBufferUsageFlags bufferUsageOf(BufferUsage u) {
-  switch (u) {
-    case BufferUsage::Uniform:
-      return VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT;
-    case BufferUsage::StorageRead:
-    case BufferUsage::StorageWrite:
-      return VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
-    case BufferUsage::Vertex:
-      return VK_BUFFER_USAGE_VERTEX_BUFFER_BIT;
-    case BufferUsage::Index:
-      return VK_BUFFER_USAGE_INDEX_BUFFER_BIT;
-    case BufferUsage::Indirect:
-      return VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT;
-    case BufferUsage::TransferSrc:
-      return VK_BUFFER_USAGE_TRANSFER_SRC_BIT;
-    case BufferUsage::TransferDst:
-      return VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-  }
-  return 0;
-}
-
-}  // namespace
-
-struct FrameGraph::Access {
-  uint32_t resource = 0, version = 0;
-  bool write = false;
-  TextureUsage textureUsage = TextureUsage::Sampled;
-  BufferUsage bufferUsage = BufferUsage::StorageRead;
-};
-
-struct FrameGraph::Pass {
-  std::string name;
-  std::vector<Access> accesses;
-  bool sideEffect = false;
-  bool culled = false;
-  PassExecute execute;
-};
-
-struct FrameGraph::Resource {
-  std::string name;
-  bool texture = true;
-  bool imported = false;
-  TextureDesc textureDesc;
-  BufferDesc bufferDesc;
-  uint32_t version = 0;  // latest version declared so far
-  // Vulkan objects (imported, or created by allocateTransients).
-  VkImage image = VK_NULL_HANDLE;
-  VkImageView view = VK_NULL_HANDLE;
-  VkBuffer buffer = VK_NULL_HANDLE;
-  VkExtent2D extent{};
-  VkImageLayout finalLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-  // During execute; persist across frames for imported resources. `state`: the layout, every
-  // stage that used the resource since its last write (what a new write waits for) and that
-  // write's access. `lastWrite`: the last write's stage and access. `visible`: the stages and
-  // accesses a barrier already made that write visible to (a later read elsewhere needs one).
-  SyncState state, lastWrite, visible;
-  int transient = -1;
-  int firstUse = -1, lastUse = -1;  // kept-pass indices
-};
-
-// A transient's Vulkan objects, and the memory range they are bound to (shared by aliases).
-struct FrameGraph::Transient {
-  vk::Context* ctx = nullptr;
-  VkImage image = VK_NULL_HANDLE;
-  VkImageView view = VK_NULL_HANDLE;
-  VkBuffer buffer = VK_NULL_HANDLE;
-  VkMemoryRequirements requirements{};
-  int slot = -1;
-  ~Transient() {
-    if (view) vkDestroyImageView(ctx->device(), view, nullptr);
-    if (image) vkDestroyImage(ctx->device(), image, nullptr);
-    if (buffer) vkDestroyBuffer(ctx->device(), buffer, nullptr);
-  }
-};
-
-// One memory range shared by transients whose lifetimes do not overlap.
-struct FrameGraph::Slot {
-  vk::Allocation allocation;
-  VkDeviceSize size = 0, alignment = 1;
-  uint32_t typeBits = 0;
-  std::vector<std::pair<int, int>> lifetimes;  // first/last kept-pass index of each occupant
-  // During execute: every stage that touched the memory this frame. A transient's first use
-  // waits for them, since an earlier occupant's reads and writes share its memory.
-  VkPipelineStageFlags2 usedStages = VK_PIPELINE_STAGE_2_NONE;
-};
+using namespace graph_detail;  // NOLINT(google-build-using-namespace): this module's helpers
 
 FrameGraph::FrameGraph(vk::Context& ctx, VkExtent2D outputExtent)
     : ctx_(ctx), outputExtent_(outputExtent) {
@@ -206,18 +24,91 @@ FrameGraph::FrameGraph(vk::Context& ctx, VkExtent2D outputExtent)
 
 FrameGraph::~FrameGraph() {
   reset();
+  releasePersistent();
 }
 
 void FrameGraph::reset() {
+  resources_.clear();  // imported images' views first
   pool_.clear();
   for (Slot& s : slots_) ctx_.allocator().free(s.allocation);
   slots_.clear();
-  resources_.clear();
   passes_.clear();
   outputs_.clear();
   blackboard_.clear();
+  fallbackIds_.clear();
+  for (auto& [name, p] : persistent_) p->declared = false;
   stats_ = {};
   compiled_ = false;
+}
+
+void FrameGraph::setOutputExtent(VkExtent2D e) {
+  if (compiled_)
+    throw Error(ErrorKind::Usage, "",
+                "frame graph: setOutputExtent() after compile() (reset() first)");
+  if (e.width == 0 || e.height == 0)
+    throw Error(ErrorKind::Usage, "", "frame graph output size must be at least 1x1");
+  outputExtent_ = e;
+}
+
+void FrameGraph::releasePersistent() {
+  if (compiled_)
+    throw Error(
+        ErrorKind::Usage, "",
+        "frame graph: releasePersistent() while a compiled graph uses them (reset() first)");
+  for (auto& r : resources_)
+    if (r->owned)
+      throw Error(
+          ErrorKind::Usage, "",
+          "frame graph: releasePersistent() while '" + r->name + "' is declared (reset() first)");
+  persistent_.clear();
+  fallbacks_.clear();
+}
+
+void FrameGraph::declareFallback(const std::string& name, VkFormat format,
+                                 VkClearColorValue value) {
+  if (vk::isDepthFormat(format))
+    throw Error(ErrorKind::Usage, "", "frame graph: fallback '" + name + "' needs a color format");
+  auto it = fallbacks_.find(name);
+  if (it != fallbacks_.end() && it->second->dims.format == format &&
+      std::memcmp(&it->second->clear, &value, sizeof value) == 0)
+    return;  // already declared like this
+  if (fallbackIds_.count(name) || compiled_)
+    throw Error(
+        ErrorKind::Usage, "",
+        "frame graph: fallback '" + name + "' changed while a graph uses it (reset() first)");
+  TextureDims dims;
+  dims.format = format;
+  dims.extent = {1, 1};
+  auto owned = std::make_unique<Owned>(ctx_, dims);
+  owned->clear = value;
+  fallbacks_[name] = std::move(owned);
+}
+
+TextureHandle FrameGraph::persistentTexture(const std::string& name, const TextureDesc& desc) {
+  for (auto& r : resources_)
+    if (r->persistent && r->name == name)
+      throw Error(ErrorKind::Usage, "",
+                  "frame graph: persistent texture '" + name + "' declared twice");
+  if (desc.sizeClass == SizeClass::InputRelative && !desc.relativeTo.valid())
+    throw Error(ErrorKind::Usage, "",
+                "frame graph: '" + name + "' is input-relative but names no input");
+  uint32_t id = addResource(name, true);
+  Resource& r = *resources_[id];
+  r.persistent = true;
+  r.textureDesc = desc;
+  return {id, 0};
+}
+
+bool FrameGraph::historyValid(TextureHandle h) const {
+  const Resource& r = resource(h.id);
+  if (!r.persistent)
+    throw Error(ErrorKind::Usage, "",
+                "frame graph: historyValid('" + r.name + "'): not a persistent texture");
+  auto it = persistent_.find(r.name);
+  if (it == persistent_.end() || !it->second->written) return false;
+  if (compiled_) return it->second.get() == r.owned;
+  // Before compile(): valid if compile() will keep the image (its resolved shape is the same).
+  return it->second->dims == graph_detail::resolveDims(r.name, r.textureDesc, resolveExtent(h.id));
 }
 
 const FrameGraph::Resource& FrameGraph::resource(uint32_t id) const {
@@ -273,12 +164,13 @@ BufferHandle PassBuilder::create(const std::string& name, const BufferDesc& desc
   return {id, 0};
 }
 
-TextureHandle PassBuilder::read(TextureHandle h, TextureUsage usage) {
+TextureHandle PassBuilder::read(TextureHandle h, TextureUsage usage, const Subresource& sub) {
   graph_.checkCurrent(h.id, h.version, "a read");
   FrameGraph::Access a;
   a.resource = h.id;
   a.version = h.version;
   a.textureUsage = usage;
+  a.sub = sub;
   graph_.passes_[pass_]->accesses.push_back(a);
   return h;
 }
@@ -293,13 +185,19 @@ BufferHandle PassBuilder::read(BufferHandle h, BufferUsage usage) {
   return h;
 }
 
-TextureHandle PassBuilder::write(TextureHandle h, TextureUsage usage) {
+TextureHandle PassBuilder::write(TextureHandle h, TextureUsage usage, const Subresource& sub) {
   graph_.checkCurrent(h.id, h.version, "a write");
+  FrameGraph::Resource& r = *graph_.resources_[h.id];
+  if (r.fallback)
+    throw Error(ErrorKind::Usage, "",
+                "frame graph: pass '" + graph_.passes_[pass_]->name + "' writes the fallback '" +
+                    r.name + "' (fallbacks are read-only)");
   FrameGraph::Access a;
   a.resource = h.id;
-  a.version = ++graph_.resources_[h.id]->version;
+  a.version = ++r.version;
   a.write = true;
   a.textureUsage = usage;
+  a.sub = sub;
   graph_.passes_[pass_]->accesses.push_back(a);
   return {h.id, a.version};
 }
@@ -315,6 +213,31 @@ BufferHandle PassBuilder::write(BufferHandle h, BufferUsage usage) {
   return {h.id, a.version};
 }
 
+TextureHandle PassBuilder::readOptional(const std::string& name, TextureUsage usage) {
+  if (TextureHandle h = graph_.blackboard_.texture(name); h.valid()) return read(h, usage);
+  auto it = graph_.fallbacks_.find(name);
+  if (it == graph_.fallbacks_.end())
+    throw Error(ErrorKind::Usage, "",
+                "frame graph: pass '" + graph_.passes_[pass_]->name + "' reads optional '" + name +
+                    "', which no pass published and which has no fallback "
+                    "(FrameGraph::declareFallback)");
+  auto [id, isNew] = graph_.fallbackIds_.try_emplace(name, 0u);
+  if (isNew) {
+    id->second = graph_.addResource(name + " (fallback)", true);
+    FrameGraph::Resource& r = *graph_.resources_[id->second];
+    r.fallback = true;
+    r.owned = it->second.get();
+    r.textureDesc.format = r.owned->dims.format;
+    r.textureDesc.sizeClass = SizeClass::Absolute;
+    r.textureDesc.width = r.textureDesc.height = 1;
+  }
+  return read({id->second, 0}, usage);
+}
+
+bool PassBuilder::isFallback(TextureHandle h) const {
+  return h.id < graph_.resources_.size() && graph_.resources_[h.id]->fallback;
+}
+
 void PassBuilder::sideEffect() {
   graph_.passes_[pass_]->sideEffect = true;
 }
@@ -328,8 +251,8 @@ TextureHandle FrameGraph::importTexture(const std::string& name, VkImage image, 
   r.textureDesc = desc;
   r.image = image;
   r.view = view;
+  r.importLayout = currentLayout;
   r.finalLayout = finalLayout;
-  r.state = {currentLayout, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT};
   return {id, 0};
 }
 
@@ -371,12 +294,91 @@ VkExtent2D FrameGraph::resolveExtent(uint32_t id) const {
   return outputExtent_;
 }
 
+void FrameGraph::resolveTextures() {
+  for (uint32_t id = 0; id < resources_.size(); ++id) {
+    Resource& r = *resources_[id];
+    if (!r.texture) continue;
+    r.dims = r.fallback ? r.owned->dims
+                        : graph_detail::resolveDims(r.name, r.textureDesc, resolveExtent(id));
+  }
+  for (auto& p : passes_)
+    for (Access& a : p->accesses) {
+      const Resource& r = *resources_[a.resource];
+      if (!r.texture) continue;
+      a.range = graph_detail::resolveRange(r.name, a.sub, r.dims);
+      a.partial = a.write && !a.range.covers(r.dims);
+    }
+  // One subresource has one layout during a pass.
+  for (auto& p : passes_)
+    for (size_t i = 0; i < p->accesses.size(); ++i)
+      for (size_t j = 0; j < i; ++j) {
+        const Access& a = p->accesses[i];
+        const Access& b = p->accesses[j];
+        const Resource& r = *resources_[a.resource];
+        if (a.resource != b.resource || !r.texture) continue;
+        const bool overlap = a.range.mip < b.range.mip + b.range.mipCount &&
+                             b.range.mip < a.range.mip + a.range.mipCount &&
+                             a.range.layer < b.range.layer + b.range.layerCount &&
+                             b.range.layer < a.range.layer + a.range.layerCount;
+        const bool depth = vk::isDepthFormat(r.dims.format);
+        if (overlap &&
+            required(a.textureUsage, depth).layout != required(b.textureUsage, depth).layout)
+          throw Error(ErrorKind::Usage, "",
+                      "frame graph: pass '" + p->name + "' uses '" + r.name +
+                          graph_detail::describeSubresource(a.sub) +
+                          "' in two conflicting layouts");
+      }
+}
+
+// Links this graph's persistent textures to their images, (re)creating those whose shape
+// changed and freeing those no longer declared.
+void FrameGraph::preparePersistent() {
+  for (auto& r : resources_)
+    if (r->persistent) {
+      auto it = persistent_.find(r->name);
+      if (it != persistent_.end() && !(it->second->dims == r->dims)) {
+        persistent_.erase(it);  // resized or reshaped: the history is gone
+        it = persistent_.end();
+      }
+      if (it == persistent_.end())
+        it = persistent_.emplace(r->name, std::make_unique<Owned>(ctx_, r->dims)).first;
+      it->second->declared = true;
+      r->owned = it->second.get();
+    }
+  std::erase_if(persistent_, [](const auto& kv) { return !kv.second->declared; });
+  for (auto& r : resources_)
+    if (r->owned) {
+      r->image = r->owned->image;
+      r->views = r->owned->views.get();
+      r->subs = &r->owned->subs;
+      if (r->dims.type != TextureType::CubeArray) r->view = r->views->natural();
+    } else if (r->imported && r->texture) {
+      r->importedViews = std::make_unique<ImageViews>(ctx_, r->image, r->dims);
+      r->views = r->importedViews.get();
+      // Whatever came before is unknown: a write waits for all of it, a read in the same
+      // layout needs no barrier.
+      r->ownSubs.assign(r->dims.subresources(),
+                        SubState{{r->importLayout, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
+                                  VK_ACCESS_2_MEMORY_WRITE_BIT},
+                                 {},
+                                 {}});
+    }
+}
+
 void FrameGraph::compile() {
   if (compiled_)
     throw Error(ErrorKind::Usage, "", "frame graph: compile() called twice (reset() first)");
+  resolveTextures();
+  preparePersistent();
+  // A persistent texture's last version is next frame's history: an implicit output.
+  std::vector<std::pair<uint32_t, uint32_t>> outputs = outputs_;
+  for (uint32_t id = 0; id < resources_.size(); ++id)
+    if (resources_[id]->persistent && resources_[id]->version > 0)
+      outputs.emplace_back(id, resources_[id]->version);
   // Cull: walk passes backwards from the outputs, keeping each pass that writes a needed
-  // version (or has a side effect) and marking what it reads as needed.
-  std::set<std::pair<uint32_t, uint32_t>> needed(outputs_.begin(), outputs_.end());
+  // version (or has a side effect) and marking what it reads as needed. A partial write also
+  // needs the previous version: the subresources it leaves alone carry over.
+  std::set<std::pair<uint32_t, uint32_t>> needed(outputs.begin(), outputs.end());
   for (auto it = passes_.rbegin(); it != passes_.rend(); ++it) {
     Pass& p = **it;
     bool keep = p.sideEffect;
@@ -384,13 +386,15 @@ void FrameGraph::compile() {
       keep = keep || (a.write && needed.count({a.resource, a.version}));
     p.culled = !keep;
     if (!keep) continue;
-    for (const Access& a : p.accesses)
+    for (const Access& a : p.accesses) {
       if (!a.write) needed.insert({a.resource, a.version});
+      if (a.partial) needed.insert({a.resource, a.version - 1});
+    }
   }
-  // Every kept read must have a producer (a kept write of that version, or an import).
+  // Every kept read must have a producer (a kept write of that version, or an external one).
   std::set<std::pair<uint32_t, uint32_t>> produced;
   for (uint32_t id = 0; id < resources_.size(); ++id)
-    if (resources_[id]->imported) produced.insert({id, 0});
+    if (resources_[id]->external()) produced.insert({id, 0});
   int order = 0;
   for (auto& p : passes_) {
     if (p->culled) continue;
@@ -401,6 +405,11 @@ void FrameGraph::compile() {
             ErrorKind::Usage, "",
             "frame graph: pass '" + p->name + "' reads '" + r.name + "' but no pass writes it");
       if (a.write) produced.insert({a.resource, a.version});
+      if (r.owned && r.texture && (imageUsageOf(a.textureUsage, false) & ~r.owned->usage) != 0)
+        throw Error(ErrorKind::Usage, "",
+                    "frame graph: pass '" + p->name + "' uses '" + r.name +
+                        "' in a way its format does not support (format " +
+                        std::to_string(int(r.dims.format)) + ")");
       if (r.firstUse < 0) r.firstUse = order;
       r.lastUse = order;
     }
@@ -419,7 +428,7 @@ void FrameGraph::allocateTransients() {
   std::vector<uint32_t> transientIds;
   for (uint32_t id = 0; id < resources_.size(); ++id) {
     Resource& r = *resources_[id];
-    if (r.imported || r.firstUse < 0) continue;  // imported, or only used by culled passes
+    if (r.external() || r.firstUse < 0) continue;  // not transient, or only used by culled passes
     auto t = std::make_unique<Transient>();
     t->ctx = &ctx_;
     if (r.texture) {
@@ -430,18 +439,9 @@ void FrameGraph::allocateTransients() {
         if (!p->culled)
           for (const Access& a : p->accesses)
             if (a.resource == id) usage |= imageUsageOf(a.textureUsage, depth);
-      r.extent = resolveExtent(id);
-      VkImageCreateInfo info{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
-      info.imageType = VK_IMAGE_TYPE_2D;
-      info.format = r.textureDesc.format;
-      info.extent = {r.extent.width, r.extent.height, 1};
-      info.mipLevels = 1;
-      info.arrayLayers = 1;
-      info.samples = VK_SAMPLE_COUNT_1_BIT;
-      info.tiling = VK_IMAGE_TILING_OPTIMAL;
-      info.usage = usage;
-      vk::check(vkCreateImage(device, &info, nullptr, &t->image), "vkCreateImage (frame graph)");
+      t->image = graph_detail::createImage(ctx_, r.dims, usage);
       vkGetImageMemoryRequirements(device, t->image, &t->requirements);
+      r.ownSubs.resize(r.dims.subresources());
       ++stats_.transientTextures;
     } else {
       VkBufferUsageFlags usage = 0;
@@ -498,17 +498,11 @@ void FrameGraph::allocateTransients() {
     if (t.image) {
       vk::check(vkBindImageMemory(device, t.image, slot.allocation.memory, slot.allocation.offset),
                 "vkBindImageMemory");
-      VkImageViewCreateInfo view{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
-      view.image = t.image;
-      view.viewType = VK_IMAGE_VIEW_TYPE_2D;
-      view.format = r.textureDesc.format;
-      const VkImageAspectFlags aspect = vk::isDepthFormat(r.textureDesc.format)
-                                            ? VK_IMAGE_ASPECT_DEPTH_BIT
-                                            : VK_IMAGE_ASPECT_COLOR_BIT;
-      view.subresourceRange = {aspect, 0, 1, 0, 1};
-      vk::check(vkCreateImageView(device, &view, nullptr, &t.view), "vkCreateImageView");
+      t.views = std::make_unique<ImageViews>(ctx_, t.image, r.dims);
+      r.views = t.views.get();
+      // A cube array's natural view needs the imageCubeArray feature: made only when asked.
+      if (r.dims.type != TextureType::CubeArray) r.view = t.views->natural();
       r.image = t.image;
-      r.view = t.view;
     } else {
       vk::check(
           vkBindBufferMemory(device, t.buffer, slot.allocation.memory, slot.allocation.offset),
@@ -518,173 +512,14 @@ void FrameGraph::allocateTransients() {
   }
 }
 
-void FrameGraph::execute(VkCommandBuffer cmd, vk::DescriptorArena& descriptors, vk::GpuTimer* timer,
-                         const PassBoundary& afterPass) {
-  if (!compiled_) throw Error(ErrorKind::Usage, "", "frame graph: execute() before compile()");
-  // Transient contents never survive a frame: they start undefined.
-  for (auto& r : resources_)
-    if (!r->imported) r->state = r->lastWrite = r->visible = {};
-  for (Slot& slot : slots_) slot.usedStages = VK_PIPELINE_STAGE_2_NONE;
-  // The memory slot under a transient (nullptr for imported resources).
-  auto slotOf = [this](const Resource& r) -> Slot* {
-    if (r.imported || r.transient < 0) return nullptr;
-    const int slot = pool_[size_t(r.transient)]->slot;
-    return slot >= 0 ? &slots_[size_t(slot)] : nullptr;
-  };
-
-  // A read needs no barrier when nothing wrote the resource yet, or a barrier already made the
-  // last write visible to this stage and access.
-  auto alreadyVisible = [](const Resource& r, const SyncState& need) {
-    return r.lastWrite.access == VK_ACCESS_2_NONE ||
-           ((need.stage & ~r.visible.stage) == 0 && (need.access & ~r.visible.access) == 0);
-  };
-  // Bookkeeping after a barrier for a write or a layout change to `need`.
-  auto afterBarrier = [](Resource& r, const SyncState& need, bool write) {
-    r.state = need;
-    if (write) {
-      r.lastWrite = {need.layout, need.stage, need.access & kWriteAccess};
-      r.visible = {};  // nothing has seen this write yet
-    } else {
-      r.visible = need;
-    }
-  };
-
-  PassContext pc;
-  pc.graph_ = this;
-  pc.ctx_ = &ctx_;
-  pc.descriptors_ = &descriptors;
-  pc.cmd_ = cmd;
-  for (auto& p : passes_) {
-    if (p->culled) continue;
-    std::vector<VkImageMemoryBarrier2> imageBarriers;
-    std::vector<VkBufferMemoryBarrier2> bufferBarriers;
-    // Does this pass read the resource's previous contents? If not, they may be discarded.
-    auto readsResource = [&](uint32_t id) {
-      for (const Access& a : p->accesses)
-        if (a.resource == id && !a.write) return true;
-      return false;
-    };
-    for (const Access& a : p->accesses) {
-      Resource& r = *resources_[a.resource];
-      if (r.texture) {
-        SyncState need = required(a.textureUsage, vk::isDepthFormat(r.textureDesc.format));
-        const bool sameLayoutRead = !a.write && r.state.layout == need.layout;
-        if (sameLayoutRead && alreadyVisible(r, need)) {
-          r.state.stage |= need.stage;  // a later write waits for this reader too
-          if (Slot* slot = slotOf(r)) slot->usedStages |= need.stage;
-          continue;
-        }
-        VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
-        // A read in the same layout waits for the last write only; a write or a layout change
-        // waits for every use since (write-after-read needs the readers done).
-        b.srcStageMask = sameLayoutRead ? r.lastWrite.stage : r.state.stage;
-        b.srcAccessMask = r.lastWrite.access;
-        b.dstStageMask = need.stage;
-        b.dstAccessMask = need.access;
-        const bool discard = a.write && !readsResource(a.resource) && !r.imported;
-        b.oldLayout = discard ? VK_IMAGE_LAYOUT_UNDEFINED : r.state.layout;
-        b.newLayout = need.layout;
-        Slot* slot = slotOf(r);
-        if (b.srcStageMask == VK_PIPELINE_STAGE_2_NONE && slot)  // first use of aliased memory
-          b.srcStageMask = slot->usedStages;
-        if (b.srcStageMask == VK_PIPELINE_STAGE_2_NONE)
-          b.srcStageMask = VK_PIPELINE_STAGE_2_TOP_OF_PIPE_BIT;
-        if (slot) slot->usedStages |= need.stage;
-        b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-        b.image = r.image;
-        const VkImageAspectFlags aspect = vk::isDepthFormat(r.textureDesc.format)
-                                              ? VK_IMAGE_ASPECT_DEPTH_BIT
-                                              : VK_IMAGE_ASPECT_COLOR_BIT;
-        b.subresourceRange = {aspect, 0, VK_REMAINING_MIP_LEVELS, 0, VK_REMAINING_ARRAY_LAYERS};
-        // Merge with an earlier barrier of this pass on the same image (read + write).
-        bool merged = false;
-        for (auto& e : imageBarriers)
-          if (e.image == b.image) {
-            if (e.newLayout != b.newLayout)
-              throw Error(ErrorKind::Usage, "",
-                          "frame graph: pass '" + p->name + "' uses '" + r.name +
-                              "' in two conflicting layouts");
-            e.srcStageMask |= b.srcStageMask;
-            e.srcAccessMask |= b.srcAccessMask;
-            e.dstStageMask |= b.dstStageMask;
-            e.dstAccessMask |= b.dstAccessMask;
-            merged = true;
-          }
-        if (!merged) imageBarriers.push_back(b);
-        if (sameLayoutRead) {
-          r.state.stage |= need.stage;
-          r.visible.stage |= need.stage;
-          r.visible.access |= need.access;
-        } else {
-          afterBarrier(r, need, a.write);
-        }
-      } else {
-        SyncState need = required(a.bufferUsage);
-        if (!a.write && alreadyVisible(r, need)) {
-          r.state.stage |= need.stage;
-          if (Slot* slot = slotOf(r)) slot->usedStages |= need.stage;
-          continue;
-        }
-        Slot* slot = slotOf(r);
-        VkPipelineStageFlags2 src = a.write ? r.state.stage : r.lastWrite.stage;
-        if (src == VK_PIPELINE_STAGE_2_NONE && slot) src = slot->usedStages;  // aliased memory
-        if (slot) slot->usedStages |= need.stage;
-        if (src != VK_PIPELINE_STAGE_2_NONE) {
-          VkBufferMemoryBarrier2 b{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2};
-          b.srcStageMask = src;
-          b.srcAccessMask = r.lastWrite.access;
-          b.dstStageMask = need.stage;
-          b.dstAccessMask = need.access;
-          b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-          b.buffer = r.buffer;
-          b.size = VK_WHOLE_SIZE;
-          bufferBarriers.push_back(b);
-        }
-        if (a.write) {
-          afterBarrier(r, need, true);
-        } else {
-          r.state.stage |= need.stage;
-          r.visible.stage |= need.stage;
-          r.visible.access |= need.access;
-        }
-      }
-    }
-    if (!imageBarriers.empty() || !bufferBarriers.empty()) {
-      VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-      dep.imageMemoryBarrierCount = uint32_t(imageBarriers.size());
-      dep.pImageMemoryBarriers = imageBarriers.data();
-      dep.bufferMemoryBarrierCount = uint32_t(bufferBarriers.size());
-      dep.pBufferMemoryBarriers = bufferBarriers.data();
-      vkCmdPipelineBarrier2(cmd, &dep);
-    }
-    if (timer) timer->begin(cmd, p->name);
-    p->execute(pc);
-    if (timer) timer->end(cmd);
-    if (afterPass) pc.cmd_ = cmd = afterPass(cmd);
-  }
-  // Leave imported images in the layout their owner asked for.
-  for (auto& r : resources_) {
-    if (!r->imported || !r->texture || r->finalLayout == VK_IMAGE_LAYOUT_UNDEFINED ||
-        r->finalLayout == r->state.layout)
-      continue;
-    const VkImageAspectFlags aspect = vk::isDepthFormat(r->textureDesc.format)
-                                          ? VK_IMAGE_ASPECT_DEPTH_BIT
-                                          : VK_IMAGE_ASPECT_COLOR_BIT;
-    vk::imageBarrier(cmd, r->image, aspect, r->state.layout, r->finalLayout,
-                     r->state.stage ? r->state.stage : VK_PIPELINE_STAGE_2_TOP_OF_PIPE_BIT,
-                     r->state.access & kWriteAccess, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
-                     VK_ACCESS_2_MEMORY_READ_BIT | VK_ACCESS_2_MEMORY_WRITE_BIT);
-    r->state = {r->finalLayout, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT};
-  }
-}
-
 FrameGraph::TextureState FrameGraph::textureState(TextureHandle h) const {
   const Resource& r = resource(h.id);
   if (!r.texture || !r.image)
     throw Error(ErrorKind::Usage, "",
                 "frame graph: '" + r.name + "' was not produced (its passes were culled)");
-  return {r.image, r.view, r.textureDesc.format, r.imported ? resolveExtent(h.id) : r.extent,
-          r.state.layout};
+  const VkImageLayout layout = r.subs->empty() ? r.importLayout : (*r.subs)[0].state.layout;
+  return {r.image, r.view, r.textureDesc.format, r.imported ? resolveExtent(h.id) : r.dims.extent,
+          layout};
 }
 
 std::vector<std::string> FrameGraph::executedPasses() const {
@@ -708,8 +543,11 @@ std::string FrameGraph::describe() const {
   for (auto& p : passes_) {
     s << (p->culled ? "  [culled] " : "  [run]    ") << p->name;
     std::string reads, writes;
-    for (const Access& a : p->accesses)
-      (a.write ? writes : reads) += " " + resources_[a.resource]->name;
+    for (const Access& a : p->accesses) {
+      const Resource& r = *resources_[a.resource];
+      (a.write ? writes : reads) += " " + r.name + (r.persistent ? " (persistent)" : "") +
+                                    (r.texture ? graph_detail::describeSubresource(a.sub) : "");
+    }
     s << "\n      reads:" << (reads.empty() ? " -" : reads)
       << "\n      writes:" << (writes.empty() ? " -" : writes) << "\n";
   }
@@ -727,42 +565,28 @@ std::string FrameGraph::toDot() const {
     s << "  p" << i << " [shape=box, label=\"" << passes_[i]->name << "\""
       << (passes_[i]->culled ? ", style=dashed, color=gray" : ", style=filled, fillcolor=lightblue")
       << "];\n";
-  for (size_t r = 0; r < resources_.size(); ++r)
-    s << "  r" << r << " [shape=ellipse, label=\"" << resources_[r]->name << "\""
-      << (resources_[r]->imported ? ", peripheries=2" : "") << "];\n";
+  for (size_t r = 0; r < resources_.size(); ++r) {
+    const Resource& res = *resources_[r];
+    s << "  r" << r << " [shape=ellipse, label=\"" << res.name
+      << (res.persistent ? "\\n(persistent)\", style=bold, color=darkgreen" : "\"")
+      << (res.imported ? ", peripheries=2" : "") << "];\n";
+  }
   for (size_t i = 0; i < passes_.size(); ++i)
     for (const Access& a : passes_[i]->accesses) {
-      const char* style = passes_[i]->culled ? " [style=dashed, color=gray]" : "";
+      const std::string sub =
+          resources_[a.resource]->texture ? graph_detail::describeSubresource(a.sub) : "";
+      std::string attrs;
+      if (!sub.empty()) attrs += "label=\"" + sub + "\"";
+      if (passes_[i]->culled)
+        attrs += std::string(attrs.empty() ? "" : ", ") + "style=dashed, color=gray";
+      if (!attrs.empty()) attrs = " [" + attrs + "]";
       if (a.write)
-        s << "  p" << i << " -> r" << a.resource << style << ";\n";
+        s << "  p" << i << " -> r" << a.resource << attrs << ";\n";
       else
-        s << "  r" << a.resource << " -> p" << i << style << ";\n";
+        s << "  r" << a.resource << " -> p" << i << attrs << ";\n";
     }
   s << "}\n";
   return s.str();
-}
-
-VkImage PassContext::image(TextureHandle h) const {
-  return graph_->resource(h.id).image;
-}
-VkImageView PassContext::view(TextureHandle h) const {
-  return graph_->resource(h.id).view;
-}
-VkFormat PassContext::format(TextureHandle h) const {
-  return graph_->resource(h.id).textureDesc.format;
-}
-VkBuffer PassContext::buffer(BufferHandle h) const {
-  return graph_->resource(h.id).buffer;
-}
-VkDeviceSize PassContext::bufferSize(BufferHandle h) const {
-  return graph_->resource(h.id).bufferDesc.size;
-}
-VkExtent2D PassContext::outputExtent() const {
-  return graph_->outputExtent();
-}
-VkExtent2D PassContext::extent(TextureHandle h) const {
-  const auto& r = graph_->resource(h.id);
-  return r.imported ? graph_->resolveExtent(h.id) : r.extent;
 }
 
 TextureHandle Blackboard::texture(const std::string& name) const {

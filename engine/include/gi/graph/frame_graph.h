@@ -3,6 +3,11 @@
 // images and buffers (aliasing memory between resources whose lifetimes do not overlap) and
 // derives synchronization2 barriers from the declared usage; execute() records the kept
 // passes, each timed with timestamp queries.
+//
+// Textures may have layers, mips, cube faces or depth (TextureDesc::type); passes may access a
+// range of them (Subresource) and barriers are derived per (mip, layer). Persistent textures
+// keep their contents across frames (history); readOptional() falls back to a neutral 1x1
+// texture when no pass published an input.
 #pragma once
 
 #include <vulkan/vulkan.h>
@@ -33,12 +38,21 @@ class PassContext {
   vk::Context& context() const { return *ctx_; }
   vk::DescriptorArena& descriptors() const { return *descriptors_; }
   VkImage image(TextureHandle h) const;
-  VkImageView view(TextureHandle h) const;
-  VkExtent2D extent(TextureHandle h) const;
+  VkImageView view(TextureHandle h) const;  // whole texture, natural view type
+  // That range: a 2-D view for one layer, 2-D array for several (3-D textures: a 3-D view of
+  // those mips). Created on first use and cached with the image.
+  VkImageView view(TextureHandle h, const Subresource& sub) const;
+  VkExtent2D extent(TextureHandle h, uint32_t mip = 0) const;
+  uint32_t layers(TextureHandle h) const;
+  uint32_t mips(TextureHandle h) const;
   VkFormat format(TextureHandle h) const;
   VkBuffer buffer(BufferHandle h) const;
   VkDeviceSize bufferSize(BufferHandle h) const;
   VkExtent2D outputExtent() const;
+  // Inside a pass that reads and writes the same range in the layout it declared (e.g. a
+  // StorageWrite of all mips, generating mip i from mip i-1 with imageLoad/imageStore): makes
+  // the pass's shader writes to `sub` so far visible to its later shader reads and writes.
+  void barrier(TextureHandle h, const Subresource& sub) const;
 
  private:
   friend class FrameGraph;
@@ -55,12 +69,21 @@ class PassBuilder {
  public:
   TextureHandle create(const std::string& name, const TextureDesc& desc);
   BufferHandle create(const std::string& name, const BufferDesc& desc);
-  // Declares a read of the current version of a resource. Throws on a stale handle.
-  TextureHandle read(TextureHandle h, TextureUsage usage = TextureUsage::Sampled);
+  // Declares a read of the current version of a resource (of `sub` only: the pass may access
+  // other ranges of the same texture in other ways). Throws on a stale handle.
+  TextureHandle read(TextureHandle h, TextureUsage usage = TextureUsage::Sampled,
+                     const Subresource& sub = {});
   BufferHandle read(BufferHandle h, BufferUsage usage = BufferUsage::StorageRead);
-  // Declares a write; the returned handle names the new version (use it from now on).
-  [[nodiscard]] TextureHandle write(TextureHandle h, TextureUsage usage);
+  // Declares a write; the returned handle names the new version (use it from now on). A write
+  // of part of a texture keeps the rest of the previous version: its producers stay alive.
+  [[nodiscard]] TextureHandle write(TextureHandle h, TextureUsage usage,
+                                    const Subresource& sub = {});
   [[nodiscard]] BufferHandle write(BufferHandle h, BufferUsage usage);
+  // The blackboard texture `name` if a pass published it, else the graph's 1x1 neutral texture
+  // declared with FrameGraph::declareFallback(name, ...) (throws gi::Error if neither). Shaders
+  // must sample optional inputs with normalized coordinates (texture/textureLod), so 1x1 works.
+  TextureHandle readOptional(const std::string& name, TextureUsage usage = TextureUsage::Sampled);
+  bool isFallback(TextureHandle h) const;  // true when readOptional returned the neutral texture
   // Never culled (e.g. a pass that reads back to the host).
   void sideEffect();
 
@@ -119,6 +142,22 @@ class FrameGraph {
 
   Blackboard& blackboard() { return blackboard_; }
   VkExtent2D outputExtent() const { return outputExtent_; }
+  void setOutputExtent(VkExtent2D e);  // only between reset() and compile()
+
+  // A neutral 1x1 texture readOptional(name) returns when no pass published `name` (e.g. "ao"
+  // = 1). Kept across reset(); declaring it again with the same format and value is a no-op.
+  void declareFallback(const std::string& name, VkFormat format, VkClearColorValue value);
+  // Persistent texture owned by the graph: survives reset()/compile() and frames, so at the
+  // start of a frame it holds what the last executed frame left (history for temporal effects).
+  // Must be declared again (same name) after every reset(); recreated and cleared to zero when
+  // its resolved size/format/type changes (e.g. output resize); persistent textures not declared
+  // by the time of compile() are freed. Its last version is an implicit output: passes writing
+  // it are not culled. The handle's version 0 is last frame's contents.
+  TextureHandle persistentTexture(const std::string& name, const TextureDesc& desc);
+  // False until one frame has written it since (re)creation (also answers during setup).
+  bool historyValid(TextureHandle h) const;
+  // Frees persistent and fallback textures (and forgets the fallbacks); not while compiled.
+  void releasePersistent();
 
   void compile();
   // Records every kept pass into `cmd` (after compile()); timer may be null. `afterPass`,
@@ -128,7 +167,8 @@ class FrameGraph {
   using PassBoundary = std::function<VkCommandBuffer(VkCommandBuffer)>;
   void execute(VkCommandBuffer cmd, vk::DescriptorArena& descriptors, vk::GpuTimer* timer,
                const PassBoundary& afterPass = {});
-  // Drops all passes and resources declared so far and frees transient memory.
+  // Drops all passes and resources declared so far and frees transient memory (persistent and
+  // fallback textures stay).
   void reset();
 
   std::vector<std::string> executedPasses() const;
@@ -143,8 +183,8 @@ class FrameGraph {
     VkImage image;
     VkImageView view;
     VkFormat format;
-    VkExtent2D extent;
-    VkImageLayout layout;
+    VkExtent2D extent;     // of mip 0
+    VkImageLayout layout;  // of mip 0, layer 0
   };
   TextureState textureState(TextureHandle h) const;
 
@@ -156,11 +196,15 @@ class FrameGraph {
   struct Access;
   struct Transient;
   struct Slot;
+  struct Owned;  // a persistent or fallback image
 
   uint32_t addResource(const std::string& name, bool texture);
   void checkCurrent(uint32_t id, uint32_t version, const char* what) const;
   VkExtent2D resolveExtent(uint32_t id) const;
+  void resolveTextures();
   void allocateTransients();
+  void preparePersistent();
+  void clearOwned(VkCommandBuffer cmd);
   const Resource& resource(uint32_t id) const;
 
   vk::Context& ctx_;
@@ -170,6 +214,8 @@ class FrameGraph {
   std::vector<std::pair<uint32_t, uint32_t>> outputs_;  // (resource, version)
   std::vector<std::unique_ptr<Transient>> pool_;        // transient images and buffers
   std::vector<Slot> slots_;                             // their (aliased) memory
+  std::unordered_map<std::string, std::unique_ptr<Owned>> persistent_, fallbacks_;
+  std::unordered_map<std::string, uint32_t> fallbackIds_;  // fallback resources of this graph
   Blackboard blackboard_;
   GraphStats stats_;
   bool compiled_ = false;
