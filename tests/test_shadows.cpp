@@ -154,7 +154,7 @@ TEST_F(ShadowGraphTest, ShadowPassOnlyForShadowCastingLightsThatLightingReads) {
     Renderer r(ctx(), scene, rs);
     r.renderFrame();
     EXPECT_EQ(r.passNames(), (Passes{"gbuffer", "shadow_0", "lighting", "tonemap"}));
-    const ImageRGBA32F map = r.readTarget("shadow_map_0");
+    const ImageRGBA32F map = r.readTarget("shadow_maps");  // layer 0
     EXPECT_EQ(map.width, 256);
     float maxDepth = 0.0f;
     for (size_t i = 0; i < map.pixels.size(); i += 4) maxDepth = std::max(maxDepth, map.pixels[i]);
@@ -186,9 +186,52 @@ TEST_F(ShadowGraphTest, PointLightRendersSixFacesIntoOneAtlas) {
   rs.shadowMapSize = 128;
   Renderer r(ctx(), scene, rs);
   r.renderFrame();
-  const ImageRGBA32F map = r.readTarget("shadow_map_0");
+  const ImageRGBA32F map = r.readTarget("shadow_maps");
   EXPECT_EQ(map.width, 3 * 128);
   EXPECT_EQ(map.height, 2 * 128);
+}
+
+// No limit on shadowed lights (the maps are layers of one array): six spot lights all cast, and
+// the sixth light's shadow is really there (turning it off changes the image).
+TEST_F(ShadowGraphTest, MoreThanFourShadowedLights) {
+  std::string lights;
+  for (int i = 0; i < 6; ++i) {
+    const float a = float(i) * 1.047f;
+    lights += std::string(i ? "," : "") + R"({"type": "spot", "position": [)" +
+              std::to_string(1.5f * std::cos(a)) + ", 3, " + std::to_string(1.5f * std::sin(a)) +
+              R"(], "direction": [)" + std::to_string(-0.4f * std::cos(a)) + ", -1, " +
+              std::to_string(-0.4f * std::sin(a)) +
+              R"(], "outer_cone_deg": 50, "inner_cone_deg": 40, "intensity": 8})";
+  }
+  const std::string dir = test::makeTempDir("six-lights");
+  const std::string path = dir + "/scene.json";
+  std::ofstream(path) << R"({
+    "models": [
+      {"primitive": "plane", "size": 5, "material": {"base_color": [0.8, 0.8, 0.8]}},
+      {"primitive": "box", "size": 0.5, "translation": [0, 1, 0]}],
+    "camera": {"position": [0, 5, 0], "target": [0, 0, 0], "up": [0, 0, -1], "yfov_deg": 60},
+    "lights": [)" + lights + R"(]})";
+  Scene scene = loadScene(path);
+  RenderSettings rs;
+  rs.width = 80;
+  rs.height = 60;
+  rs.shadowMapSize = 128;
+  rs.view = "lit";
+  Renderer all(ctx(), scene, rs);
+  all.renderFrame();
+  EXPECT_EQ(all.passNames(), (Passes{"gbuffer", "shadow_0", "shadow_1", "shadow_2", "shadow_3",
+                                     "shadow_4", "shadow_5", "lighting"}));
+  const ImageRGBA32F withSixth = all.readTarget("lit");
+  scene.lights[5].castsShadows = false;
+  Renderer five(ctx(), scene, rs);
+  five.renderFrame();
+  const ImageRGBA32F withoutSixth = five.readTarget("lit");
+  int brighter = 0;
+  for (size_t i = 0; i < withSixth.pixels.size(); i += 4)
+    brighter += withoutSixth.pixels[i] > withSixth.pixels[i] + 1e-3f;
+  EXPECT_GT(brighter, 20) << "the sixth light's shadow is missing";
+  for (size_t i = 0; i < withSixth.pixels.size(); i += 4)
+    EXPECT_LE(withSixth.pixels[i], withoutSixth.pixels[i] + 1e-6f);
 }
 
 }  // namespace

@@ -1,5 +1,5 @@
-// Shared declarations of the engine's shaders. Keep in sync with FrameUniforms in
-// engine/src/render/gpu_types.h (std140).
+// Shared declarations of the engine's and the effects' shaders. Keep in sync with the C++
+// mirrors in engine/include/gi/frame_uniforms.h and gi/gpu_scene.h.
 #ifndef GI_COMMON_GLSL
 #define GI_COMMON_GLSL
 
@@ -18,9 +18,11 @@ struct FrameUniforms {
   vec4 params;        // exposure, light count, near, far
   vec4 irradianceSH[9];  // rgb: SH9 of the environment's irradiance (cosine lobe convolved,
                          // intensity included), world space; see gi/environment.h
+  vec4 time;          // seconds (animation clock), frame index, seconds since last frame, 0
+  vec4 options;       // PCF radius in texels, 0, 0, 0
 };
 
-// One drawn mesh instance. Keep in sync with gpu::Instance in engine/src/render/gpu_types.h.
+// One drawn mesh instance. Keep in sync with gi::GpuInstance in gi/gpu_scene.h.
 struct Instance {
   mat4 model;
   mat4 prevModel;

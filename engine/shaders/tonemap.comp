@@ -3,7 +3,7 @@
 #include "common.glsl"
 
 // Exposure, ACES filmic curve (Narkowicz fit) and sRGB encoding into the 8-bit output.
-layout(local_size_x = 8, local_size_y = 8) in;
+layout(local_size_x = 32, local_size_y = 16) in;  // kScreenGroupX/Y (builtin_passes.h)
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 layout(set = 0, binding = 1) uniform sampler2D litColor;
 layout(set = 0, binding = 2, rgba8) uniform writeonly image2D outColor;

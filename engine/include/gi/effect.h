@@ -11,7 +11,10 @@
 #include <string>
 #include <vector>
 
+#include "gi/frame_uniforms.h"
+#include "gi/gpu_scene.h"
 #include "gi/graph/frame_graph.h"
+#include "gi/lights.h"
 #include "gi/settings.h"
 
 // Bumped whenever this header, settings.h, frame_graph.h or the shader interface change in a
@@ -32,8 +35,15 @@ inline constexpr const char* kAlbedo = "albedo";      // RGBA8 sRGB
 inline constexpr const char* kMaterial = "material";  // RGBA8 roughness, metallic
 inline constexpr const char* kEmission = "emission";  // RGBA16F linear radiance
 inline constexpr const char* kMotion = "motion";      // RG16F current - previous, UV units
-inline constexpr const char* kLit = "lit";            // RGBA16F direct lighting (linear HDR)
-inline constexpr const char* kAO = "ao";              // R8/R16F ambient occlusion, 1 = open
+inline constexpr const char* kLit = "lit";            // RGBA16F lit image (linear HDR radiance)
+// Optional inputs of the lighting pass (neutral when no effect publishes them; sample them with
+// normalized coordinates: the neutral stand-in is 1x1). See "Lighting composition" in
+// effects/README.md.
+inline constexpr const char* kAO = "ao";  // R ambient visibility of the environment term, 1 = open
+// RGBA16F: rgb the outgoing radiance of the environment term (albedo included), a = 1 where it
+// replaces the engine's SH9 x albedo x AO term (directional occlusion), 0 to keep the engine's.
+inline constexpr const char* kAmbient = "ambient";
+inline constexpr const char* kIndirect = "indirect";  // RGBA16F outgoing indirect radiance, added
 inline constexpr const char* kOutput = "output";      // RGBA8 tonemapped final image
 inline constexpr const char* kFloor = "floor";        // RGBA8 cost-floor pass output
 // Buffer: the point representation (gi/surface_points.h), two vec4 per point: world
@@ -42,6 +52,10 @@ inline constexpr const char* kFloor = "floor";        // RGBA8 cost-floor pass o
 // deformed vertices, so points follow animated meshes.
 inline constexpr const char* kSurfacePoints = "surface_points";
 inline constexpr const char* kPointsView = "points";  // RGBA16F debug view of the points
+// The environment (environment.glsl): equirect RGBA32F radiance map (Sky/Constant tabulated)
+// and the std430 importance-sampling tables.
+inline constexpr const char* kEnvironmentMap = "environment_map";
+inline constexpr const char* kEnvironmentSampling = "environment_sampling";
 }  // namespace resources
 
 // When an effect's passes are added: before the lighting pass (it can feed lighting, e.g.
@@ -55,14 +69,29 @@ enum class GroundTruth {
   IndirectLight,     // the lit image against direct light + one diffuse bounce
 };
 
+// Camera uniforms of an extra view (EffectContext::createView): a FrameUniforms buffer the engine
+// refreshes every frame (time, environment, light count from the main view) with this view's
+// camera and extent. Lives as long as the effect holds it.
+class ViewUniforms {
+ public:
+  virtual ~ViewUniforms() = default;
+  virtual void setCamera(const CameraView& camera, VkExtent2D extent) = 0;
+  virtual VkBuffer buffer() const = 0;
+  virtual const FrameUniforms& current() const = 0;  // what the next frame uploads
+};
+
 struct EffectInfo {
   std::string name;         // unique, lower case, used in scenes, presets, --effects and --view
   std::string version;      // the effect's own version
   std::string description;  // one line
   EffectStage stage = EffectStage::BeforeLighting;
-  std::vector<std::string> reads;   // well-known resources it reads
-  std::vector<std::string> writes;  // resources it publishes on the blackboard
-  std::string debugView;            // resource shown by `gi-render --view <name>`
+  // Blackboard resources its passes look up and publish. Checked on every graph build: a lookup
+  // or publication not declared here is an error naming the effect, and so is a declared write
+  // it did not publish. Effects of one stage run in the order these imply (a reader after the
+  // writer), whatever their order in the scene.
+  std::vector<std::string> reads;
+  std::vector<std::string> writes;
+  std::string debugView;  // resource shown by `gi-render --view <name>`
   GroundTruth estimates = GroundTruth::DirectLight;
 };
 
@@ -73,12 +102,19 @@ class EffectContext {
   virtual vk::Context& vulkan() = 0;
   // Per-frame uniforms (camera matrices, viewport, ...): `FrameUniforms` in gi/common.glsl.
   virtual VkBuffer frameUniforms() = 0;
-  virtual VkSampler nearestSampler() = 0;  // clamp to edge
-  virtual VkSampler linearSampler() = 0;   // clamp to edge
+  virtual const FrameUniforms& frame() = 0;  // the main view's values for the coming frame
+  virtual VkSampler nearestSampler() = 0;    // clamp to edge
+  virtual VkSampler linearSampler() = 0;     // clamp to edge
   virtual VkExtent2D outputExtent() = 0;
   // Asks for the point representation (resources::kSurfacePoints) with at least `count`
   // points; call from prepare(). The engine samples max(requests) points once per renderer.
   virtual void requestSurfacePoints(uint32_t count) = 0;
+  // The scene on the GPU: buffers and draws from any view (gi/gpu_scene.h).
+  virtual GpuScene& scene() = 0;
+  // Uniforms of an extra view with the main view's frame-wide values (gi::ViewUniforms).
+  virtual std::shared_ptr<ViewUniforms> createView() = 0;
+  virtual const CameraView& camera() = 0;              // the main camera of the current pose
+  virtual const std::vector<LightInfo>& lights() = 0;  // world space, current pose
 };
 
 class Effect {
@@ -92,6 +128,12 @@ class Effect {
   // Declares the effect's passes (reads through the blackboard, publishes its outputs there).
   // Called on every graph compile.
   virtual void addPasses(FrameGraph& graph, EffectContext& ctx, const SettingValues& settings) = 0;
+  // Once per frame, before any uniform is uploaded or pass recorded, after the pose and camera
+  // of the frame are known: move extra views (ViewUniforms::setCamera) here.
+  virtual void update(EffectContext& ctx, const SettingValues& settings) {
+    (void)ctx;
+    (void)settings;
+  }
 };
 
 }  // namespace gi

@@ -27,8 +27,8 @@ struct RenderSettings {
   float exposure = 1.0f;
   bool floorPass = false;  // also keep the floor pass (for timing baselines)
   // Shadow maps: texels per side of a directional/spot map and of each point-light cube face
-  // (a point light renders its 6 faces into one 3x2 atlas). Up to 4 lights cast shadows (the
-  // first 4 with castsShadows, in scene node order); one "shadow_<light index>" pass each.
+  // (a point light renders its 6 faces into one 3x2 atlas). Every light with castsShadows that
+  // sees the scene gets one "shadow_<light index>" pass drawing its layer of "shadow_maps".
   uint32_t shadowMapSize = 1024;
   uint32_t pcfRadius = 1;             // PCF kernel (2r+1)^2 texels
   float environmentIntensity = 1.0f;  // scales the environment (sky/map) radiance
@@ -82,14 +82,25 @@ class Renderer {
   const std::vector<PassTiming>& lastTimings() const;
   std::vector<std::string> passNames() const;        // passes the graph executes, in order
   std::vector<std::string> culledPassNames() const;  // passes declared but culled
-  std::string graphDescription() const;              // gi-render --print-graph
-  std::string graphDot() const;                      // Graphviz
-  double lastCompileMs() const;                      // CPU time of the last graph build + compile
+  // True for passes the engine's built-in stages added (G-buffer, skinning, surface points,
+  // shadows, lighting, tonemap, floor), false for effects' passes.
+  bool isEnginePass(const std::string& pass) const;
+  std::string graphDescription() const;  // gi-render --print-graph
+  std::string graphDot() const;          // Graphviz
+  double lastCompileMs() const;          // CPU time of the last graph build + compile
 
   // Changes one effect's settings: uniform-only changes apply next frame; a change of a
   // setting marked `changesGraph` re-prepares the effect and recompiles the graph.
   void setEffectSettings(const std::string& effect, const SettingValues& values);
   bool graphRecompiledByLastChange() const;
+  // Live changes (no reconstruction; the graph is recompiled). Effects that stay keep their
+  // instance; a configuration that fails (unknown effect or view) throws and leaves the
+  // renderer as it was.
+  void setEffects(const std::vector<EffectConfig>& effects);
+  void setView(const std::string& view);
+  // Everything in RenderSettings at once: size (resize), engine settings, view, effects.
+  void applySettings(const RenderSettings& settings);
+  const RenderSettings& settings() const;
 
   ImageRGBA8 readOutput();                           // tonemapped 8-bit image (view "output")
   ImageRGBA32F readTarget(const std::string& name);  // any produced resource as float RGBA

@@ -522,6 +522,12 @@ FrameGraph::TextureState FrameGraph::textureState(TextureHandle h) const {
           layout};
 }
 
+std::vector<std::string> FrameGraph::passNames() const {
+  std::vector<std::string> out;
+  for (auto& p : passes_) out.push_back(p->name);
+  return out;
+}
+
 std::vector<std::string> FrameGraph::executedPasses() const {
   std::vector<std::string> out;
   for (auto& p : passes_)
@@ -590,11 +596,13 @@ std::string FrameGraph::toDot() const {
 }
 
 TextureHandle Blackboard::texture(const std::string& name) const {
+  lookedUp_.insert(name);
   auto it = textures_.find(name);
   return it == textures_.end() ? TextureHandle{} : it->second;
 }
 
 BufferHandle Blackboard::buffer(const std::string& name) const {
+  lookedUp_.insert(name);
   auto it = buffers_.find(name);
   return it == buffers_.end() ? BufferHandle{} : it->second;
 }
@@ -610,6 +618,8 @@ std::vector<std::string> Blackboard::names() const {
 void Blackboard::clear() {
   textures_.clear();
   buffers_.clear();
+  lookedUp_.clear();
+  published_.clear();
 }
 
 }  // namespace gi

@@ -1,6 +1,7 @@
 // Light records and shadow-map planning (see light_setup.h).
 #include "light_setup.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -27,7 +28,7 @@ glm::vec3 safeDir(const glm::vec3& v) {
 // the scene bounds. Returns false when the light cannot see the scene (nothing to render).
 bool addShadowMap(const Light& l, const glm::mat4& world, uint32_t lightIndex,
                   const glm::vec3& bmin, const glm::vec3& bmax, const CameraView& camera,
-                  uint32_t res, std::vector<gpu::ShadowView>& out, std::vector<ShadowMap>& maps) {
+                  uint32_t res, std::vector<GpuShadowView>& out, std::vector<ShadowMap>& maps) {
   const glm::mat4 invView = glm::inverse(camera.view);
   const glm::vec3 pos = glm::vec3(world * glm::vec4(0, 0, 0, 1));
   const glm::vec3 dir = safeDir(glm::vec3(world * glm::vec4(0, 0, -1, 0)));
@@ -97,6 +98,18 @@ bool addShadowMap(const Light& l, const glm::mat4& world, uint32_t lightIndex,
 
 }  // namespace
 
+uint32_t LightSetup::layerWidth() const {
+  uint32_t w = 1;
+  for (const ShadowMap& m : maps) w = std::max(w, m.width);
+  return w;
+}
+
+uint32_t LightSetup::layerHeight() const {
+  uint32_t h = 1;
+  for (const ShadowMap& m : maps) h = std::max(h, m.height);
+  return h;
+}
+
 bool LightSetup::sameLayout(const LightSetup& o) const {
   if (lights.size() != o.lights.size() || maps.size() != o.maps.size()) return false;
   for (size_t i = 0; i < maps.size(); ++i)
@@ -113,7 +126,7 @@ LightSetup planLights(const Scene& scene, const std::vector<Node>& nodes, const 
   for (const Node& node : nodes) {
     if (node.light < 0 || size_t(node.light) >= scene.lights.size()) continue;
     const Light& l = scene.lights[node.light];
-    gpu::Light g{};
+    GpuLight g{};
     glm::vec3 pos = glm::vec3(camera.view * node.world * glm::vec4(0, 0, 0, 1));
     glm::vec3 dir = glm::vec3(camera.view * node.world * glm::vec4(0, 0, -1, 0));
     float type = l.type == LightType::Directional ? 0.0f : l.type == LightType::Point ? 1.0f : 2.0f;
@@ -122,14 +135,28 @@ LightSetup planLights(const Scene& scene, const std::vector<Node>& nodes, const 
     g.radiance = glm::vec4(l.color * std::max(l.intensity, 0.0f), 0.0f);
     g.cone = glm::vec4(std::cos(l.innerConeAngle), std::cos(l.outerConeAngle), 0, 0);
     g.shadow = glm::vec4(-1.0f, 0.0f, 0.0f, 0.0f);
-    if (l.castsShadows && hasBounds && out.maps.size() < kMaxShadowMaps) {
+    LightInfo info;
+    info.type = l.type;
+    info.position = glm::vec3(node.world * glm::vec4(0, 0, 0, 1));
+    info.direction = glm::vec3(node.world * glm::vec4(0, 0, -1, 0));
+    const float len = glm::length(info.direction);
+    info.direction =
+        len > 1e-20f && std::isfinite(len) ? info.direction / len : glm::vec3(0, -1, 0);
+    info.radiance = glm::vec3(g.radiance);
+    info.range = g.positionRange.w;
+    info.cosInner = g.cone.x;
+    info.cosOuter = g.cone.y;
+    info.index = uint32_t(out.lights.size());
+    if (l.castsShadows && hasBounds) {
       const float first = float(out.views.size());
       if (addShadowMap(l, node.world, uint32_t(out.lights.size()), bmin, bmax, camera,
                        shadowMapSize, out.views, out.maps))
         g.shadow = glm::vec4(first, std::max(l.shadowBias.constant, 0.0f),
                              std::max(l.shadowBias.slope, 0.0f), float(out.maps.size() - 1));
     }
+    info.shadowLayer = int(g.shadow.x) >= 0 ? int(g.shadow.w) : -1;
     out.lights.push_back(g);
+    out.world.push_back(info);
   }
   return out;
 }

@@ -8,14 +8,13 @@
 
 #include <vulkan/vulkan.h>
 
+#include "gi/lights.h"
 #include "gi/scene.h"
-#include "gpu_types.h"
 
 namespace gi {
 
-inline constexpr uint32_t kMaxShadowMaps = 4;  // lighting.comp binds shadowMap0..3
-
-// One shadow map (slot): rendered as one view, or six cube faces in a 3x2 atlas.
+// One shadow map: one layer of the "shadow_maps" array (its slot), rendered as one view, or six
+// cube faces in a 3x2 atlas.
 struct ShadowMap {
   uint32_t light = 0;  // index into the light records (names the pass "shadow_<light>")
   uint32_t width = 0, height = 0;
@@ -27,9 +26,12 @@ struct ShadowMap {
 };
 
 struct LightSetup {
-  std::vector<gpu::Light> lights;      // one per light node, in node order
-  std::vector<gpu::ShadowView> views;  // every shadow map's views, in slot order
-  std::vector<ShadowMap> maps;         // the first kMaxShadowMaps shadow-casting lights
+  std::vector<GpuLight> lights;      // one per light node, in node order
+  std::vector<LightInfo> world;      // the same lights in world space
+  std::vector<GpuShadowView> views;  // every shadow map's views, in slot order
+  std::vector<ShadowMap> maps;       // one per shadow-casting light that sees the scene
+  uint32_t layerWidth() const;       // the array's layer size: the largest map
+  uint32_t layerHeight() const;
   // Same slots, lights and view counts: only the buffers' contents change, not the graph.
   bool sameLayout(const LightSetup& o) const;
 };

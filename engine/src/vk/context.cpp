@@ -265,6 +265,12 @@ void Context::createDevice(bool swapchain) {
   features.features.shaderStorageImageWriteWithoutFormat =
       supported.shaderStorageImageWriteWithoutFormat;
   features.features.geometryShader = supported.geometryShader;
+  // GpuScene's paraboloid views clip the back hemisphere with gl_ClipDistance.
+  if (!supported.shaderClipDistance)
+    throw Error(ErrorKind::Unsupported, "", "the Vulkan device lacks shaderClipDistance");
+  features.features.shaderClipDistance = VK_TRUE;
+  features.features.fragmentStoresAndAtomics = supported.fragmentStoresAndAtomics;
+  features.features.imageCubeArray = supported.imageCubeArray;  // frame-graph cube arrays
 
   std::vector<const char*> extensions;
   if (swapchain) extensions.push_back(VK_KHR_SWAPCHAIN_EXTENSION_NAME);

@@ -14,6 +14,7 @@
 
 #include <functional>
 #include <memory>
+#include <set>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -95,11 +96,25 @@ class PassBuilder {
 };
 
 // Named handles shared between passes and effects ("depth", "normal", "ao", ...): the one
-// place where well-known resources are published and looked up.
+// place where well-known resources are published and looked up. It records the names looked
+// up and published since startTracking(), which the renderer checks against what an effect
+// declared (EffectInfo::reads/writes).
 class Blackboard {
  public:
-  void put(const std::string& name, TextureHandle h) { textures_[name] = h; }
-  void put(const std::string& name, BufferHandle h) { buffers_[name] = h; }
+  void put(const std::string& name, TextureHandle h) {
+    textures_[name] = h;
+    published_.insert(name);
+  }
+  void put(const std::string& name, BufferHandle h) {
+    buffers_[name] = h;
+    published_.insert(name);
+  }
+  void startTracking() {
+    lookedUp_.clear();
+    published_.clear();
+  }
+  const std::set<std::string>& lookedUp() const { return lookedUp_; }
+  const std::set<std::string>& published() const { return published_; }
   TextureHandle texture(const std::string& name) const;  // invalid handle if absent
   BufferHandle buffer(const std::string& name) const;
   bool has(const std::string& name) const { return textures_.count(name) || buffers_.count(name); }
@@ -109,6 +124,8 @@ class Blackboard {
  private:
   std::unordered_map<std::string, TextureHandle> textures_;
   std::unordered_map<std::string, BufferHandle> buffers_;
+  mutable std::set<std::string> lookedUp_;
+  std::set<std::string> published_;
 };
 
 struct GraphStats {
@@ -171,6 +188,7 @@ class FrameGraph {
   // fallback textures stay).
   void reset();
 
+  std::vector<std::string> passNames() const;  // every pass added so far, in order
   std::vector<std::string> executedPasses() const;
   std::vector<std::string> culledPasses() const;
   std::string toDot() const;     // Graphviz: kept passes solid, culled passes dashed

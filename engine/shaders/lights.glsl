@@ -1,0 +1,110 @@
+// The scene's lights and shadow maps for the lighting pass and effects alike (C++ mirrors:
+// gi/lights.h). Include after common.glsl, with the FrameUniforms block named `frame` declared,
+// and after defining the set and bindings of the three resources:
+//   #define GI_LIGHTS_SET 0
+//   #define GI_LIGHTS_BINDING 6        // buffer "lights"
+//   #define GI_SHADOW_VIEWS_BINDING 7  // buffer "shadow_views"
+//   #define GI_SHADOW_MAPS_BINDING 8   // texture "shadow_maps" (sampler2DArray, nearest)
+#ifndef GI_LIGHTS_GLSL
+#define GI_LIGHTS_GLSL
+
+struct Light {
+  vec4 positionRange;   // view-space position, range (0: infinite)
+  vec4 directionType;   // view-space direction the light points to, type (0 dir, 1 point, 2 spot)
+  vec4 radiance;        // colour * intensity
+  vec4 cone;            // cos(inner), cos(outer)
+  vec4 shadow;          // first shadow view (-1: unshadowed), bias constant, bias slope, layer
+};
+
+// One rendered shadow view (a directional/spot map, or one cube face of a point light).
+// Depth is reverse-Z (1 at the light's near plane, 0 at far) like the G-buffer.
+struct ShadowView {
+  mat4 viewToClip;  // camera view space -> light clip space
+  vec4 params;      // perspective (1) or orthographic (0), near, far, texel footprint*
+  vec4 tile;        // texel offset x, y and size of the view in its layer
+};
+// * world size of one texel: orthographic: params.w; perspective: params.w * light-space depth.
+
+layout(set = GI_LIGHTS_SET, binding = GI_LIGHTS_BINDING, std430) readonly buffer Lights {
+  Light lights[];
+};
+layout(set = GI_LIGHTS_SET, binding = GI_SHADOW_VIEWS_BINDING, std430) readonly buffer ShadowViews {
+  ShadowView shadowViews[];
+};
+layout(set = GI_LIGHTS_SET, binding = GI_SHADOW_MAPS_BINDING) uniform sampler2DArray shadowMaps;
+
+int lightCount() { return int(frame.params.y); }
+
+// Guard: squared light distance is clamped so a light on the surface stays finite.
+const float kMinLightDistance2 = 1e-4;
+
+// Radiance arriving at view-space `pos` from light `light` without shadowing (irradiance
+// normal to the light for a directional light), and the unit direction `l` toward the light.
+vec3 lightIncident(Light light, vec3 pos, out vec3 l) {
+  int type = int(light.directionType.w);
+  if (type == 0) {
+    l = safeNormalize(-light.directionType.xyz, vec3(0, 1, 0));
+    return light.radiance.rgb;
+  }
+  vec3 toLight = light.positionRange.xyz - pos;
+  float d2 = max(dot(toLight, toLight), kMinLightDistance2);
+  l = toLight * inversesqrt(d2);
+  float attenuation = 1.0 / d2;
+  float range = light.positionRange.w;
+  if (range > 0.0) {  // glTF's recommended smooth range window
+    float r = d2 / (range * range);
+    attenuation *= clamp(1.0 - r * r, 0.0, 1.0);
+  }
+  if (type == 2) {
+    float cd = dot(safeNormalize(light.directionType.xyz, vec3(0, -1, 0)), -l);
+    attenuation *= smoothstep(light.cone.y, max(light.cone.x, light.cone.y + 1e-4), cd);
+  }
+  return light.radiance.rgb * attenuation;
+}
+
+// Fraction of the light reaching view-space position `pos` ((2r+1)^2 PCF, r = frame.options.x).
+// `ndl` sets the slope-scaled part of the bias.
+float shadowFactor(Light light, vec3 pos, float ndl) {
+  int first = int(light.shadow.x);
+  if (first < 0) return 1.0;
+  int view = first;
+  if (int(light.directionType.w) == 1) {  // point: the cube face of the major axis
+    vec3 d = mat3(frame.invView) * (pos - light.positionRange.xyz);
+    vec3 a = abs(d);
+    int axis = a.x >= a.y && a.x >= a.z ? 0 : (a.y >= a.z ? 1 : 2);
+    view += 2 * axis + (d[axis] < 0.0 ? 1 : 0);
+  }
+  ShadowView sv = shadowViews[view];
+  vec4 clip = sv.viewToClip * vec4(pos, 1.0);
+  if (clip.w <= 0.0) return 1.0;
+  vec3 ndc = clip.xyz / clip.w;
+  vec2 uv = ndc.xy * 0.5 + 0.5;
+  if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0))) || ndc.z < 0.0) return 1.0;
+  float near = sv.params.y, far = sv.params.z;
+  bool perspective = sv.params.x > 0.5;
+  float receiver = perspective ? clip.w : near + (1.0 - ndc.z) * (far - near);
+  float texel = perspective ? sv.params.w * receiver : sv.params.w;
+  float tanTheta = min(sqrt(max(1.0 - ndl * ndl, 0.0)) / max(ndl, 1e-4), 10.0);
+  float biased = receiver - texel * (light.shadow.y + light.shadow.z * tanTheta);
+  float layer = light.shadow.w;
+  ivec2 lo = ivec2(sv.tile.xy), size = ivec2(sv.tile.z);
+  ivec2 center = lo + clamp(ivec2(uv * vec2(size)), ivec2(0), size - 1);
+  int r = clamp(int(frame.options.x), 0, 3);
+  // Compare in reverse-Z depth instead of converting every tap to a distance: the biased
+  // receiver distance maps once to the depth an occluder must exceed.
+  float threshold = perspective ? near * far / max(biased, 1e-20) : 0.0;
+  float limit = perspective ? (threshold - near) / (far - near)
+                            : 1.0 - (biased - near) / (far - near);
+  float lit = 0.0;
+  for (int dy = -r; dy <= r; ++dy)
+    for (int dx = -r; dx <= r; ++dx) {
+      ivec2 t = clamp(center + ivec2(dx, dy), lo, lo + size - 1);
+      float d = texelFetch(shadowMaps, ivec3(t, int(layer)), 0).r;
+      // Lit when nothing was drawn (cleared 0) or the occluder is not in front of the receiver.
+      lit += (d <= 0.0 || d <= limit) ? 1.0 : 0.0;
+    }
+  float taps = float((2 * r + 1) * (2 * r + 1));
+  return lit / taps;
+}
+
+#endif

@@ -1,0 +1,48 @@
+// The engine's own passes, each a gi::Effect on the same API as the plugins (declared reads
+// and writes, checked like theirs; frame-graph passes added in addPasses). The renderer
+// orchestrates them (renderer.cpp); what they share with it is EngineState.
+#pragma once
+
+#include <memory>
+
+#include "gi/effect.h"
+#include "gi/renderer.h"
+#include "gi/vk/resources.h"
+#include "render/environment_gpu.h"
+#include "render/light_setup.h"
+#include "render/scene_gpu.h"
+#include "render/surface_points_pass.h"
+
+namespace gi {
+
+// Owned by the renderer; the passes keep a reference. (The passes build their EffectInfo by
+// aggregate initialisation: GCC 12 at -O3 warns, -Wrestrict, on assigning short literals.)
+struct EngineState {
+  vk::Context& ctx;
+  RenderSettings& settings;
+  SceneGpu& scene;
+  LightSetup& lights;
+  EnvironmentGpu& environment;
+  std::unique_ptr<SurfacePointsPass>& surfacePoints;
+  vk::Image& output;     // the tonemapped RGBA8 image (imported as "output")
+  vk::Image& noShadows;  // 1x1 one-layer D32 array cleared to 0: "shadow_maps" without shadows
+  VkSampler nearest, linear;
+  uint32_t skinnedThisFrame = 0;  // written by the skinning pass
+};
+
+std::unique_ptr<Effect> makeSkinningPass(EngineState& state);
+std::unique_ptr<Effect> makeGBufferPass();
+std::unique_ptr<Effect> makeSurfacePointsPass(EngineState& state);
+std::unique_ptr<Effect> makeShadowPass(EngineState& state);
+std::unique_ptr<Effect> makeLightingPass(EngineState& state);
+std::unique_ptr<Effect> makeTonemapPass(EngineState& state);
+std::unique_ptr<Effect> makeFloorPass(EngineState& state);
+
+// Workgroup of the engine's full-screen compute passes (lighting, tonemap, floor): llvmpipe
+// pays a fixed cost per workgroup, so large groups are faster there (measured for SSAO).
+inline constexpr uint32_t kScreenGroupX = 32, kScreenGroupY = 16;
+inline uint32_t screenGroups(uint32_t n, uint32_t size) {
+  return (n + size - 1) / size;
+}
+
+}  // namespace gi

@@ -1,0 +1,61 @@
+// "floor": the cost floor (one G-buffer read and one 8-bit write per pixel); gi-bench reports
+// other passes' times as ratios to it measured in the same run.
+#include "gi/vk/pipeline.h"
+#include "render/passes/builtin_passes.h"
+
+namespace gi {
+namespace {
+
+namespace res = resources;
+
+class FloorPass final : public Effect {
+ public:
+  explicit FloorPass(EngineState& s) : s_(s) {}
+  EffectInfo info() const override {
+    EffectInfo i{"floor", "1", "cost floor: one G-buffer read and one 8-bit write per pixel"};
+    i.reads = {res::kNormal};
+    i.writes = {res::kFloor};
+    return i;
+  }
+  std::vector<SettingDesc> settings() const override { return {}; }
+  void prepare(EffectContext& ctx, const SettingValues&) override {
+    if (pipeline_.handle()) return;
+    pipeline_ = vk::Pipeline::compute(ctx.vulkan(), vk::loadSpirv("floor.comp"),
+                                      {{0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
+                                       {1, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER},
+                                       {2, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE}});
+  }
+  void addPasses(FrameGraph& graph, EffectContext& ctx, const SettingValues&) override {
+    auto io = std::make_shared<std::pair<TextureHandle, TextureHandle>>();
+    graph.addPass(
+        "floor",
+        [&](PassBuilder& b) {
+          io->first = b.read(graph.blackboard().texture(res::kNormal));
+          io->second = b.write(b.create(res::kFloor, TextureDesc{VK_FORMAT_R8G8B8A8_UNORM}),
+                               TextureUsage::StorageWrite);
+        },
+        [this, io, frame = ctx.frameUniforms()](PassContext& pc) {
+          vk::DescriptorWriter w;
+          w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame)
+              .sampled(1, pc.view(io->first), s_.nearest)
+              .storageImage(2, pc.view(io->second));
+          pc.descriptors().bind(pc.cmd(), pipeline_, w);
+          const VkExtent2D e = pc.extent(io->second);
+          vkCmdDispatch(pc.cmd(), screenGroups(e.width, kScreenGroupX),
+                        screenGroups(e.height, kScreenGroupY), 1);
+        });
+    graph.blackboard().put(res::kFloor, io->second);
+  }
+
+ private:
+  EngineState& s_;
+  vk::Pipeline pipeline_;
+};
+
+}  // namespace
+
+std::unique_ptr<Effect> makeFloorPass(EngineState& state) {
+  return std::make_unique<FloorPass>(state);
+}
+
+}  // namespace gi

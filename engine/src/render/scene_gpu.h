@@ -1,0 +1,103 @@
+// The engine's implementation of gi::GpuScene: uploads the scene, keeps the animated pose
+// (instance matrices, joint matrices, morphed rest vertices) and records draws of it from any
+// view. The skinning pass (passes/skinning_pass.cpp) deforms the vertices it owns.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <vector>
+
+#include "gi/gpu_scene.h"
+#include "gi/vk/pipeline.h"
+#include "gi/vk/resources.h"
+#include "render/surface_points_pass.h"
+
+namespace gi {
+
+// Frame-graph name of the shared vertex buffer once deformed meshes are written into it.
+inline constexpr const char* kVerticesResource = "vertices";
+
+class SceneGpu final : public GpuScene {
+ public:
+  SceneGpu(vk::Context& ctx, const Scene& scene);
+  ~SceneGpu() override;
+
+  // GpuScene
+  VkBuffer vertices() const override { return vertexBuffer_.handle(); }
+  VkBuffer indices() const override { return indexBuffer_.handle(); }
+  VkBuffer instances() const override { return instanceBuffer_.handle(); }
+  VkBuffer materials() const override { return materialBuffer_.handle(); }
+  const std::vector<SceneDrawItem>& drawItems() const override { return draws_; }
+  uint64_t triangleCount() const override;
+  void bounds(glm::vec3& lo, glm::vec3& hi) const override;
+  void declareRead(PassBuilder& builder, BufferUsage usage) const override;
+  void drawDepth(PassContext& pc, const SceneTargets& targets,
+                 std::span<const SceneView> views) override;
+  void drawGBuffer(PassContext& pc, const SceneTargets& targets, VkBuffer viewUniforms) override;
+  void drawRsm(PassContext& pc, const SceneTargets& targets, const SceneView& view,
+               const LightInfo& light) override;
+
+  // The deformed vertices' current version in the graph being built (invalid: no skinning
+  // pass), which declareRead() makes passes read.
+  void setVertices(BufferHandle h) { vertices_ = h; }
+  BufferHandle currentVertices() const { return vertices_; }
+  // Start of a frame: uploads changed instance matrices, recycles the per-view uniform slots.
+  void beginFrame();
+  // Poses the scene at `seconds`; returns false when nothing was animated.
+  void setTime(double seconds, bool firstFrame);
+  const Scene& pose() const { return pose_; }
+  const Scene& source() const { return scene_; }
+
+  // Skinned/morphed mesh instances: each owns a copy of its mesh's vertices in the vertex
+  // buffer, rewritten by the skinning pass from its rest vertices.
+  struct Deformed {
+    int node = 0, mesh = 0;
+    uint32_t srcFirst = 0, dstFirst = 0, count = 0, jointFirst = 0, jointCount = 0;
+    std::vector<glm::mat4> lastJoints;
+    std::vector<float> lastWeights;
+    bool dirty = true;
+  };
+  std::vector<Deformed>& deformed() { return deformed_; }
+  const vk::Buffer& restBuffer() const { return restBuffer_; }
+  const vk::Buffer& jointIndexBuffer() const { return jointIndexBuffer_; }
+  const vk::Buffer& jointWeightBuffer() const { return jointWeightBuffer_; }
+  const vk::Buffer& jointBuffer() const { return jointBuffer_; }
+  const vk::Buffer& vertexBuffer() const { return vertexBuffer_; }
+  const std::vector<SurfacePointsPass::InstanceRef>& instanceRefs() const { return instanceRefs_; }
+  VkSampler linearRepeat() const { return linearRepeat_.handle(); }
+
+ private:
+  void upload();
+  void updateDeformations();
+  void createPipelines();
+  const std::pair<glm::vec3, glm::vec3>& morphDeltaBounds(int mesh, size_t target) const;
+  VkDescriptorBufferInfo viewSlot(const SceneView& view, const LightInfo* light, VkExtent2D extent);
+  void bindMaterial(PassContext& pc, const vk::Pipeline& p, uint32_t material, VkBuffer uniforms,
+                    VkDeviceSize offset, VkDeviceSize range);
+  void beginRendering(PassContext& pc, const SceneTargets& t, size_t colorCount);
+  void bindGeometry(VkCommandBuffer cmd);
+
+  vk::Context& ctx_;
+  const Scene& scene_;
+  Scene pose_;  // the renderer's own copy of the node hierarchy, posed by setTime()
+  BufferHandle vertices_;
+  vk::Buffer vertexBuffer_, indexBuffer_, materialBuffer_, instanceBuffer_;
+  vk::Buffer restBuffer_, jointIndexBuffer_, jointWeightBuffer_, jointBuffer_;
+  std::vector<SceneDrawItem> draws_;
+  std::vector<int> instanceNodes_;  // node of each GpuInstance
+  std::vector<GpuInstance> instances_;
+  bool instancesDirty_ = true;
+  std::vector<Deformed> deformed_;
+  std::vector<SurfacePointsPass::InstanceRef> instanceRefs_;
+  std::vector<Material> materials_;
+  std::vector<vk::Image> textures_;
+  vk::Image whiteTexture_;
+  vk::Sampler linearRepeat_;
+  mutable std::map<int, std::vector<std::pair<glm::vec3, glm::vec3>>> morphBounds_;
+  vk::Pipeline gbufferPipeline_, depthPipeline_, rsmPipeline_;
+  // Per-view uniform slots of drawDepth/drawRsm, host-visible, recycled every frame.
+  std::vector<vk::Buffer> viewChunks_;
+  size_t viewSlotsUsed_ = 0;
+};
+
+}  // namespace gi
