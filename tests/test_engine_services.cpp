@@ -1,0 +1,326 @@
+// Engine services on the plugin API (gi/gpu_scene.h, gi/lights.h, EffectContext): an effect
+// draws the scene from an extra view (depth only, G-buffer), from a light (reflective shadow
+// map), as a paraboloid hemisphere and as cube faces, and the results match the main G-buffer
+// and closed forms.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <functional>
+
+#include "gi/effect.h"
+#include "gi/effect_registry.h"
+#include "gi/renderer.h"
+#include "gi/scene_io.h"
+#include "process.h"
+#include "vulkan_fixture.h"
+
+namespace gi {
+namespace {
+
+using test::VulkanTest;
+
+// What the probe draws and how.
+struct ProbeConfig {
+  enum class Mode { CameraDepth, CameraGBuffer, Rsm, Paraboloid, Cube } mode;
+  float scale = 1.0f;  // extent of the probe's targets relative to the output
+  uint32_t size = 0;   // absolute square size (Rsm, Paraboloid, Cube face) when non-zero
+  std::function<SceneView(EffectContext&)> view;  // Rsm/Paraboloid/Cube: the view(s) to draw
+};
+
+// An effect that only uses the public services: draws the scene into its own targets and
+// publishes them as "probe_<attachment>".
+class Probe : public Effect {
+ public:
+  explicit Probe(ProbeConfig c) : c_(std::move(c)) {}
+  EffectInfo info() const override {
+    EffectInfo i{"probe", "1", "draws the scene through GpuScene (test)"};
+    i.stage = EffectStage::AfterLighting;
+    i.writes = outputs();
+    return i;
+  }
+  std::vector<SettingDesc> settings() const override { return {}; }
+  void prepare(EffectContext& ctx, const SettingValues&) override {
+    if (!view_) view_ = ctx.createView();
+  }
+  void update(EffectContext& ctx, const SettingValues&) override {
+    const VkExtent2D e = ctx.outputExtent();
+    view_->setCamera(ctx.camera(), {uint32_t(std::lround(e.width * c_.scale)),
+                                    uint32_t(std::lround(e.height * c_.scale))});
+  }
+  void addPasses(FrameGraph& graph, EffectContext& ctx, const SettingValues&) override {
+    const SceneOutputs outputsKind =
+        c_.mode == ProbeConfig::Mode::CameraGBuffer ? SceneOutputs::GBuffer
+        : c_.mode == ProbeConfig::Mode::Rsm         ? SceneOutputs::ReflectiveShadowMap
+                                                    : SceneOutputs::Depth;
+    const std::vector<VkFormat> formats = sceneColorFormats(outputsKind);
+    const std::vector<std::string> names = outputs();
+    auto handles = std::make_shared<std::vector<TextureHandle>>();
+    auto desc = [&](VkFormat f) {
+      TextureDesc d{f};
+      d.scale = c_.scale;
+      if (c_.size) {
+        d.sizeClass = SizeClass::Absolute;
+        d.width = c_.mode == ProbeConfig::Mode::Cube ? 3 * c_.size : c_.size;
+        d.height = c_.mode == ProbeConfig::Mode::Cube ? 2 * c_.size : c_.size;
+      }
+      return d;
+    };
+    GpuScene& scene = ctx.scene();
+    graph.addPass(
+        "probe",
+        [&](PassBuilder& b) {
+          scene.declareRead(b);
+          handles->push_back(
+              b.write(b.create(names[0], desc(kSceneDepthFormat)), TextureUsage::DepthAttachment));
+          for (size_t i = 0; i < formats.size(); ++i)
+            handles->push_back(
+                b.write(b.create(names[1 + i], desc(formats[i])), TextureUsage::ColorAttachment));
+        },
+        [this, handles, &scene, &ctx](PassContext& pc) {
+          SceneTargets t;
+          t.depth = pc.view((*handles)[0]);
+          for (size_t i = 1; i < handles->size(); ++i) t.colors.push_back(pc.view((*handles)[i]));
+          t.extent = pc.extent((*handles)[0]);
+          switch (c_.mode) {
+            case ProbeConfig::Mode::CameraDepth: {
+              const SceneView v = SceneView::fromCamera(ctx.camera());
+              scene.drawDepth(pc, t, {&v, 1});
+              break;
+            }
+            case ProbeConfig::Mode::CameraGBuffer:
+              scene.drawGBuffer(pc, t, view_->buffer());
+              break;
+            case ProbeConfig::Mode::Rsm:
+              scene.drawRsm(pc, t, c_.view(ctx), ctx.lights().at(0));
+              break;
+            case ProbeConfig::Mode::Paraboloid: {
+              const SceneView v = c_.view(ctx);
+              scene.drawDepth(pc, t, {&v, 1});
+              break;
+            }
+            case ProbeConfig::Mode::Cube: {
+              std::array<SceneView, 6> faces = SceneView::cube(c_.view(ctx).view[3], 0.05f, 50.0f);
+              for (uint32_t f = 0; f < 6; ++f)
+                faces[f].viewport = {{int32_t((f % 3) * c_.size), int32_t((f / 3) * c_.size)},
+                                     {c_.size, c_.size}};
+              scene.drawDepth(pc, t, faces);
+              break;
+            }
+          }
+        });
+    for (size_t i = 0; i < names.size(); ++i) graph.blackboard().put(names[i], (*handles)[i]);
+  }
+
+ private:
+  std::vector<std::string> outputs() const {
+    switch (c_.mode) {
+      case ProbeConfig::Mode::CameraGBuffer:
+        return {"probe_depth",    "probe_normal",   "probe_albedo",
+                "probe_material", "probe_emission", "probe_motion"};
+      case ProbeConfig::Mode::Rsm:
+        return {"probe_depth", "probe_position", "probe_rsm_normal", "probe_flux"};
+      default:
+        return {"probe_depth"};
+    }
+  }
+  ProbeConfig c_;
+  std::shared_ptr<ViewUniforms> view_;
+};
+
+Scene sceneFromJson(const std::string& json) {
+  const std::string dir = test::makeTempDir("services-scene");
+  const std::string path = dir + "/scene.json";
+  std::ofstream(path) << json;
+  return loadScene(path);
+}
+
+struct Rendered {
+  std::unique_ptr<Renderer> renderer;
+};
+
+std::unique_ptr<Renderer> render(vk::Context& ctx, const Scene& scene, EffectRegistry& reg,
+                                 const ProbeConfig& config, uint32_t w = 160, uint32_t h = 120) {
+  reg.add([config] { return std::make_unique<Probe>(config); }, "test");
+  RenderSettings rs;
+  rs.width = w;
+  rs.height = h;
+  rs.view = "probe_depth";
+  rs.effects = {{"probe", reg.defaultSettings("probe")}};
+  auto r = std::make_unique<Renderer>(ctx, scene, rs, &reg);
+  r->renderFrame();
+  return r;
+}
+
+class EngineServicesTest : public VulkanTest {};
+
+TEST_F(EngineServicesTest, ExtraViewDepthAndGBufferEqualTheMainGBufferWhereViewsCoincide) {
+  const Scene scene = loadScene("default");
+  for (auto mode : {ProbeConfig::Mode::CameraDepth, ProbeConfig::Mode::CameraGBuffer}) {
+    EffectRegistry reg;
+    auto r = render(ctx(), scene, reg, {mode});
+    r->setView("depth");
+    r->renderFrame();
+    const ImageRGBA32F mainDepth = r->readTarget("depth");
+    r->setView("probe_depth");
+    r->renderFrame();
+    const ImageRGBA32F probeDepth = r->readTarget("probe_depth");
+    ASSERT_EQ(mainDepth.pixels.size(), probeDepth.pixels.size());
+    size_t geometry = 0;
+    double worst = 0.0;
+    for (size_t i = 0; i < mainDepth.pixels.size(); i += 4) {
+      geometry += mainDepth.pixels[i] > 0.0f;
+      worst = std::max(worst, double(std::abs(mainDepth.pixels[i] - probeDepth.pixels[i])));
+    }
+    EXPECT_GT(geometry, mainDepth.pixels.size() / 8);
+    // Same transforms in the same order: equal to float rounding (1e-6 of the depth range).
+    EXPECT_LE(worst, 1e-6) << "mode " << int(mode);
+    if (mode == ProbeConfig::Mode::CameraGBuffer) {
+      r->setView("normal");
+      r->renderFrame();
+      const ImageRGBA32F n = r->readTarget("normal");
+      r->setView("probe_normal");
+      r->renderFrame();
+      const ImageRGBA32F pn = r->readTarget("probe_normal");
+      double worstN = 0.0;
+      for (size_t i = 0; i < n.pixels.size(); ++i)
+        worstN = std::max(worstN, double(std::abs(n.pixels[i] - pn.pixels[i])));
+      EXPECT_LE(worstN, 1e-3) << "normals of the extra view differ from the main G-buffer's";
+    }
+  }
+}
+
+TEST_F(EngineServicesTest, QuarterResolutionExtraView) {
+  const Scene scene = loadScene("default");
+  EffectRegistry reg;
+  auto r = render(ctx(), scene, reg, {ProbeConfig::Mode::CameraGBuffer, 0.5f});
+  const ImageRGBA32F d = r->readTarget("probe_depth");
+  EXPECT_EQ(d.width, 80);
+  EXPECT_EQ(d.height, 60);
+  size_t geometry = 0;
+  for (size_t i = 0; i < d.pixels.size(); i += 4) geometry += d.pixels[i] > 0.0f;
+  EXPECT_GT(geometry, d.pixels.size() / 16) << "the quarter-size view sees the room";
+}
+
+// The flux a white surface reflects, summed over a reflective shadow map that sees all the
+// light's output, is the light's power into that solid angle (spot) or E x area (directional).
+TEST_F(EngineServicesTest, ReflectiveShadowMapFluxIntegratesToTheLightsPower) {
+  // Spot straight down over a large white plane: sum = I x integral of the cone falloff.
+  const Scene spot = sceneFromJson(R"({
+    "models": [{"primitive": "plane", "size": 40, "material": {"base_color": [1, 1, 1]}}],
+    "camera": {"position": [0, 5, 3], "target": [0, 0, 0]},
+    "lights": [{"type": "spot", "position": [0, 2, 0], "direction": [0, -1, 0],
+                "outer_cone_deg": 30, "inner_cone_deg": 20, "intensity": 10}]})");
+  ProbeConfig c{ProbeConfig::Mode::Rsm};
+  c.size = 256;
+  c.view = [](EffectContext& ctx) {
+    const LightInfo& l = ctx.lights().at(0);
+    return SceneView::perspective(l.position, l.direction, glm::radians(64.0f), 1.0f, 0.05f, 50.0f);
+  };
+  EffectRegistry reg;
+  auto r = render(ctx(), spot, reg, c);
+  const ImageRGBA32F flux = r->readTarget("probe_flux");
+  double sum = 0.0;
+  for (size_t i = 0; i < flux.pixels.size(); i += 4) sum += flux.pixels[i];
+  const double cosOuter = std::cos(glm::radians(30.0)), cosInner = std::cos(glm::radians(20.0));
+  double expected = 0.0;  // 2 pi I integral over cos of smoothstep(cosOuter, cosInner, cos)
+  const int n = 200000;
+  for (int i = 0; i < n; ++i) {
+    const double c0 = cosOuter + (1.0 - cosOuter) * (i + 0.5) / n;
+    const double t = std::clamp((c0 - cosOuter) / (cosInner - cosOuter), 0.0, 1.0);
+    expected += t * t * (3.0 - 2.0 * t) * (1.0 - cosOuter) / n;
+  }
+  expected *= 2.0 * M_PI * 10.0;
+  EXPECT_NEAR(sum, expected, 0.01 * expected) << "spot power into its cone";
+  // Positions are on the plane, normals face up.
+  const ImageRGBA32F pos = r->readTarget("probe_position"), nrm = r->readTarget("probe_rsm_normal");
+  const size_t centre = (size_t(128) * 256 + 128) * 4;
+  EXPECT_NEAR(pos.pixels[centre + 1], 0.0f, 1e-4f);
+  EXPECT_EQ(pos.pixels[centre + 3], 1.0f);
+  EXPECT_NEAR(nrm.pixels[centre + 1], 1.0f, 1e-3f);
+
+  // Directional light E = 3 straight down, orthographic 2 x 2 window: sum = E x 4.
+  const Scene sun = sceneFromJson(R"({
+    "models": [{"primitive": "plane", "size": 40, "material": {"base_color": [1, 1, 1]}}],
+    "camera": {"position": [0, 5, 3], "target": [0, 0, 0]},
+    "lights": [{"type": "directional", "direction": [0, -1, 0], "intensity": 3}]})");
+  c.view = [](EffectContext&) {
+    return SceneView::orthographic({0.3f, 5.0f, -0.2f}, {0, -1, 0}, 1.0f, 1.0f, 0.1f, 20.0f);
+  };
+  EffectRegistry reg2;
+  r = render(ctx(), sun, reg2, c);
+  const ImageRGBA32F flux2 = r->readTarget("probe_flux");
+  double sum2 = 0.0;
+  for (size_t i = 0; i < flux2.pixels.size(); i += 4) sum2 += flux2.pixels[i];
+  EXPECT_NEAR(sum2, 12.0, 1e-3 * 12.0) << "irradiance x the window's area";
+}
+
+// Paraboloid hemisphere looking down (-y) from 2 above the centre of a sphere of radius 5 seen
+// from inside: the radial depth of the texel at disk position p is the distance to the sphere
+// along the direction whose cosine to the axis is (1 - |p|^2) / (1 + |p|^2).
+TEST_F(EngineServicesTest, ParaboloidViewStoresRadialDistance) {
+  const Scene scene = sceneFromJson(R"({
+    "models": [{"primitive": "sphere", "radius": 5, "segments": 256, "rings": 128}],
+    "camera": {"position": [0, 1, 3], "target": [0, 0, 0]}})");
+  ProbeConfig c{ProbeConfig::Mode::Paraboloid};
+  c.size = 128;
+  const float h = 2.0f, radius = 5.0f, znear = 0.1f, zfar = 20.0f;
+  c.view = [&](EffectContext&) {
+    return SceneView::paraboloid({0, h, 0}, {0, -1, 0}, znear, zfar);
+  };
+  EffectRegistry reg;
+  auto r = render(ctx(), scene, reg, c);
+  const ImageRGBA32F d = r->readTarget("probe_depth");
+  int checked = 0;
+  for (int y = 4; y < 128; y += 12)
+    for (int x = 4; x < 128; x += 12) {
+      const glm::vec2 p((x + 0.5f) / 64.0f - 1.0f, (y + 0.5f) / 64.0f - 1.0f);
+      const float r2 = glm::dot(p, p);
+      if (r2 > 0.95f) continue;  // the rim: triangles there bend the most
+      const float cosTheta = (1.0f - r2) / (1.0f + r2);
+      // |(0, h, 0) + t u| = radius with u.y = -cosTheta.
+      const float expected =
+          h * cosTheta + std::sqrt(h * h * cosTheta * cosTheta - h * h + radius * radius);
+      const float depth = d.pixels[(size_t(y) * 128 + x) * 4];
+      const float distance = znear + (1.0f - depth) * (zfar - znear);
+      EXPECT_NEAR(distance, expected, 0.01f * expected) << x << "," << y;
+      ++checked;
+    }
+  EXPECT_GT(checked, 40);
+  // Outside the disk nothing is drawn.
+  EXPECT_EQ(d.pixels[0], 0.0f);
+}
+
+// Cube faces from the centre of a closed box room: every face sees a wall at the expected
+// distance (half the room's size along its axis at the face's centre).
+TEST_F(EngineServicesTest, CubeFacesSeeTheSurroundingRoom) {
+  const Scene scene = loadScene("default");
+  glm::vec3 lo, hi;
+  scene.worldBounds(lo, hi);
+  const glm::vec3 centre = 0.5f * (lo + hi) + glm::vec3(0.0f, 0.3f, 0.0f);
+  ProbeConfig c{ProbeConfig::Mode::Cube};
+  c.size = 32;
+  c.view = [&](EffectContext&) {
+    SceneView v;
+    v.view[3] = glm::vec4(centre, 1.0f);  // the probe reads the cube's centre from here
+    return v;
+  };
+  EffectRegistry reg;
+  auto r = render(ctx(), scene, reg, c);
+  const ImageRGBA32F d = r->readTarget("probe_depth");
+  ASSERT_EQ(d.width, 96);
+  ASSERT_EQ(d.height, 64);
+  for (int f = 0; f < 6; ++f) {
+    int covered = 0;
+    for (int y = 0; y < 32; ++y)
+      for (int x = 0; x < 32; ++x)
+        covered += d.pixels[(size_t((f / 3) * 32 + y) * 96 + (f % 3) * 32 + x) * 4] > 0.0f;
+    // The default room is closed except the side the main camera looks in from.
+    if (f != 4) {
+      EXPECT_GT(covered, 32 * 32 * 9 / 10) << "face " << f;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace gi
