@@ -56,6 +56,7 @@ configure_and_build "$src/tests/external_effect" "$tmp/vignette-build"
 configure_and_build "$tmp/ext_grey" "$tmp/ext_grey-build"
 [ -f "$tmp/vignette-build/plugins/gi_effect_vignette.so" ] || fail "no vignette module built"
 [ -f "$tmp/ext_grey-build/plugins/gi_effect_ext_grey.so" ] || fail "no ext_grey module built"
+[ -f "$tmp/vignette-build/plugins/gi_effect_second_view.so" ] || fail "no second_view module built"
 
 export GI_PLUGIN_PATH="$tmp/vignette-build/plugins:$tmp/ext_grey-build/plugins"
 step "installed gi-render --list-effects"
@@ -105,6 +106,33 @@ render both vignette,ext_grey
 expect "$tmp/both.log" "^  \[run\] +vignette$" "vignette pass not executed"
 expect "$tmp/both.log" "^  \[run\] +ext_grey$" "ext_grey pass not executed"
 render grey_view ext_grey --view ext_grey
+
+step "second_view: the scene drawn again through GpuScene equals the main G-buffer's depth"
+render_pfm() {  # NAME VIEW: the second_view effect, that view as linear floats
+  "$gi" --scene default --effects second_view --print-graph --validation --width 160 \
+    --height 120 --view "$2" --out "$tmp/$1.pfm" >"$tmp/$1.log" 2>&1 || {
+    cat "$tmp/$1.log" >&2
+    fail "gi-render --view $2"
+  }
+}
+render_pfm main_depth depth
+render_pfm sv_depth second_view_depth
+render_pfm sv_gdepth second_view_gdepth
+render_pfm sv_flux second_view_flux
+expect "$tmp/sv_depth.log" "^  \[run\] +second_view$" "second_view pass not executed"
+python3 "$src/tests/external_effect/compare_pfm.py" "$tmp/main_depth.pfm" "$tmp/sv_depth.pfm" 1e-6 ||
+  fail "depth-only second view differs from the main G-buffer's depth"
+python3 "$src/tests/external_effect/compare_pfm.py" "$tmp/main_depth.pfm" "$tmp/sv_gdepth.pfm" 1e-6 ||
+  fail "G-buffer second view differs from the main G-buffer's depth"
+python3 - "$tmp/sv_flux.pfm" <<'PY' || fail "reflective shadow map flux not positive and finite"
+import math, struct, sys
+data = open(sys.argv[1], "rb").read().split(b"\n", 3)
+w, h = map(int, data[1].split())
+v = struct.unpack("<" + "f" * (w * h * 3), data[3][:w * h * 12])
+assert all(math.isfinite(x) and x >= 0 for x in v), "non-finite or negative flux"
+assert sum(v) > 0, "no flux"
+print(f"rsm flux sum {sum(v):.4g} W over {w}x{h}")
+PY
 
 step "SSAO (in-tree plugin) together with the out-of-tree vignette: exact executed passes"
 if [ -f "$(dirname "$gi")/plugins/gi_effect_ssao.so" ]; then
