@@ -415,11 +415,6 @@ std::string knownEffects(const gi::EffectRegistry& registry) {
 // ---- Measuring one configuration
 // -----------------------------------------------------------------
 
-bool isEnginePass(const std::string& n) {
-  return n == "gbuffer" || n == "lighting" || n == "tonemap" || n == "floor" || n == "skinning" ||
-         n.starts_with("shadow_");  // the engine's shadow maps, one pass per shadowed light
-}
-
 double median(std::vector<double> v) {
   if (v.empty()) return 0.0;
   std::sort(v.begin(), v.end());
@@ -514,7 +509,7 @@ Measurement measure(gi::vk::Context& ctx, const gi::EffectRegistry& registry,
       continue;
     }
     m.totalMs += ms;
-    if (!isEnginePass(name)) m.effectMs += ms;
+    if (!renderer.isEnginePass(name)) m.effectMs += ms;
   }
   // Error against the reference, over pixels that are geometry in both.
   const gi::ImageRGBA32F out = renderer.readTarget(cmp.resource);
@@ -669,6 +664,13 @@ std::vector<Config> buildConfigs(const Options& o, const Setup& s,
           c.effects = gi::resolveEffects(s.scenes[si].scene, c.presetPtr, ov, s.registry);
           c.engine = gi::resolveEngineSettings(s.scenes[si].scene, c.presetPtr, ov, {});
           c.comparison = comparisonFor(c.effects, s.registry, o.aoSplit);
+          // The reference renders the scene's environment as it is: a scaled one would be
+          // compared with the wrong ground truth.
+          if (c.engine.number("environment_intensity") != 1.0 && !isAo(c.comparison.quantity))
+            throw gi::Error(gi::ErrorKind::Usage, "",
+                            "engine.environment_intensity must be 1 when lit images are "
+                            "compared with the reference (preset '" +
+                                c.preset + "')");
           configs.push_back(std::move(c));
           size_t k = 0;
           for (; k < idx.size(); ++k) {
