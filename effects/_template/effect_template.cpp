@@ -4,8 +4,12 @@
 // frame-graph passes it adds (addPasses). It sees only the engine's public headers. This one
 // runs after lighting: it reads the lit colour, writes a desaturated copy into its own texture
 // and publishes that as the new "lit", so tonemapping (and any later effect) uses it. An
-// effect that runs before lighting would instead publish e.g. gi::resources::kAO, which the
-// lighting pass then samples.
+// effect that runs before lighting would instead publish gi::resources::kAO (ambient
+// visibility), kAmbient (a replacement of the environment term) or kIndirect (indirect light
+// added), which the lighting pass composes. Beyond the G-buffer, EffectContext offers the
+// scene on the GPU (ctx.scene(): draw it from any view), extra views (ctx.createView()), the
+// lights (ctx.lights(), buffers "lights"/"shadow_views", texture "shadow_maps", lights.glsl)
+// and the environment ("environment_map", environment.glsl): see effects/README.md.
 #include <memory>
 
 #include "gi/effect.h"
@@ -25,15 +29,18 @@ class EffectTemplate : public gi::Effect {
     i.version = "0.1";
     i.description = "desaturates the lit colour (template effect)";
     i.stage = gi::EffectStage::AfterLighting;
+    // Every blackboard resource the passes look up or publish, checked by the engine on each
+    // graph build; they also order effects (a reader runs after the producer).
     i.reads = {gi::resources::kLit};
     i.writes = {gi::resources::kLit, "effect_template"};
     i.debugView = "effect_template";  // `gi-render --view effect_template` shows this resource
     return i;
   }
 
-  // Typed settings: name, type, default, range, help, and whether a change needs a new graph
-  // (true: prepare() and addPasses() run again; false: read at execute time, applied next
-  // frame). Values are validated by the engine before the effect sees them.
+  // Typed settings (bool, int, float, enum, vec3, color): name, type, default, range, help, and
+  // whether a change needs a new graph (true: prepare() and addPasses() run again; false: read
+  // at execute time, applied next frame). Values are validated by the engine before the effect
+  // sees them. Builders: gi::SettingDesc::enumeration / vec3 / color; UI hints: step, logScale.
   std::vector<gi::SettingDesc> settings() const override {
     return {{"strength", gi::SettingType::Float, 0.5, 0.0, 1.0,
              "0 keeps the colour, 1 turns it grey", false}};
