@@ -7,9 +7,10 @@
 
 layout(location = 0) in vec3 inPosition;
 
-layout(set = 0, binding = 0, std430) readonly buffer Instances { Instance instances[]; };
 layout(set = 0, binding = 1) uniform View { DrawView drawView; };
-layout(push_constant) uniform Push { uint instance; } pc;
+// The instance's model matrix as a push constant (DrawPush in scene_gpu.cpp): a per-vertex
+// read of the instance buffer costs one load per lane on llvmpipe.
+layout(push_constant) uniform Push { mat4 model; } pc;
 
 out gl_PerVertex {
   vec4 gl_Position;
@@ -19,7 +20,6 @@ out gl_PerVertex {
 void main() {
   float clipDistance;
   // view * (model * p) in the order gbuffer.vert uses, so equal views give equal depth.
-  gl_Position = projectWorld(drawView, (instances[pc.instance].model * vec4(inPosition, 1.0)).xyz,
-                             clipDistance);
+  gl_Position = projectWorld(drawView, (pc.model * vec4(inPosition, 1.0)).xyz, clipDistance);
   gl_ClipDistance[0] = clipDistance;
 }

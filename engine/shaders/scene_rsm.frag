@@ -6,20 +6,13 @@
 #include "common.glsl"
 #include "scene_view.glsl"
 
-struct Material {
-  vec4 baseColor;
-  vec4 emission;
-  vec4 params;  // roughness, metallic, texture index (-1 none), unused
-};
-
 layout(set = 0, binding = 1) uniform View { DrawView drawView; };
-layout(set = 0, binding = 2, std430) readonly buffer Materials { Material materials[]; };
 layout(set = 0, binding = 3) uniform sampler2D baseColorTexture;
 
 layout(location = 0) in vec3 inWorldPos;
 layout(location = 1) in vec3 inWorldNormal;
 layout(location = 2) in vec2 inUV;
-layout(location = 3) flat in uint inMaterial;
+layout(location = 3) flat in vec4 inBaseColor;  // a: textured (1/0)
 
 layout(location = 0) out vec4 outPosition;  // world, w = 1 marks geometry
 layout(location = 1) out vec4 outNormal;    // world, facing the light
@@ -27,9 +20,8 @@ layout(location = 2) out vec4 outFlux;      // reflected flux (W), rgb
 
 void main() {
   DrawView v = drawView;
-  Material m = materials[inMaterial];
-  vec3 albedo = m.baseColor.rgb;
-  if (m.params.z >= 0.0) albedo *= texture(baseColorTexture, inUV).rgb;
+  vec3 albedo = inBaseColor.rgb;
+  if (inBaseColor.a > 0.5) albedo *= texture(baseColorTexture, inUV).rgb;
   albedo = clamp(albedo, 0.0, 1.0);
 
   int type = int(v.lightPosType.w);

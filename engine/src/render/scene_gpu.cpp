@@ -24,6 +24,17 @@ struct DrawViewUniforms {
   glm::vec4 params, lightPosType, lightDirRange, lightRadiance, lightCone, viewport;
 };
 constexpr VkDeviceSize kViewSlotBytes = 256;
+
+// Push constants of one draw (gbuffer.vert, scene_depth.vert, scene_rsm.vert): what every
+// vertex of the draw needs, read once for all lanes instead of from the instance buffer per
+// vertex (llvmpipe loads a non-uniform buffer index once per lane). std430: the mat3 is three
+// vec4 columns. The depth shader declares only `model`.
+struct DrawPush {
+  glm::mat4 model;
+  glm::vec4 normalMatrix[3];
+  uint32_t instance, material;
+};
+static_assert(sizeof(DrawPush) == 120 && sizeof(DrawPush) <= 128, "guaranteed push range");
 constexpr size_t kViewSlotsPerChunk = 256;
 static_assert(sizeof(DrawViewUniforms) <= kViewSlotBytes);
 
@@ -279,7 +290,7 @@ void SceneGpu::createPipelines() {
   g.vertex = loadSpirv("gbuffer.vert");
   g.fragment = loadSpirv("gbuffer.frag");
   g.bindings = {{0, ubo}, {1, ssbo}, {2, ssbo}, {3, tex}};
-  g.pushConstantBytes = sizeof(uint32_t);
+  g.pushConstantBytes = sizeof(DrawPush);
   g.vertexLayout.stride = sizeof(Vertex);
   g.vertexLayout.attributes = fullVertex;
   g.colorFormats = sceneColorFormats(SceneOutputs::GBuffer);
@@ -290,7 +301,7 @@ void SceneGpu::createPipelines() {
   d.vertex = loadSpirv("scene_depth.vert");
   d.fragment = loadSpirv("scene_depth.frag");
   d.bindings = {{0, ssbo}, {1, ubo}};
-  d.pushConstantBytes = sizeof(uint32_t);
+  d.pushConstantBytes = sizeof(glm::mat4);
   d.vertexLayout.stride = sizeof(Vertex);
   d.vertexLayout.attributes = {fullVertex[0]};
   d.depthFormat = kSceneDepthFormat;
@@ -508,6 +519,18 @@ void SceneGpu::bindMaterial(PassContext& pc, const Pipeline& p, uint32_t materia
   pc.descriptors().bind(pc.cmd(), p, w);
 }
 
+void SceneGpu::pushDraw(VkCommandBuffer cmd, const Pipeline& p, const SceneDrawItem& d,
+                        bool modelOnly) const {
+  const GpuInstance& inst = instances_[d.instance];
+  DrawPush push;
+  push.model = inst.model;
+  for (int c = 0; c < 3; ++c) push.normalMatrix[c] = inst.normalMatrix[c];
+  push.instance = d.instance;
+  push.material = d.material;
+  vkCmdPushConstants(cmd, p.layout(), VK_SHADER_STAGE_ALL, 0,
+                     modelOnly ? uint32_t(sizeof(glm::mat4)) : uint32_t(sizeof push), &push);
+}
+
 void SceneGpu::drawGBuffer(PassContext& pc, const SceneTargets& t, VkBuffer viewUniforms) {
   VkCommandBuffer c = pc.cmd();
   beginRendering(pc, t, 5);
@@ -523,8 +546,7 @@ void SceneGpu::drawGBuffer(PassContext& pc, const SceneTargets& t, VkBuffer view
         bindMaterial(pc, gbufferPipeline_, d.material, viewUniforms, 0, VK_WHOLE_SIZE);
         boundMaterial = d.material;
       }
-      vkCmdPushConstants(c, gbufferPipeline_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof(uint32_t),
-                         &d.instance);
+      pushDraw(c, gbufferPipeline_, d, false);
       vkCmdDrawIndexed(c, d.indexCount, 1, d.firstIndex, d.vertexOffset, 0);
     }
   }
@@ -551,8 +573,7 @@ void SceneGpu::drawDepth(PassContext& pc, const SceneTargets& t, std::span<const
         .buffer(1, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, slot.buffer, slot.offset, slot.range);
     pc.descriptors().bind(c, depthPipeline_, w);
     for (const SceneDrawItem& d : draws_) {
-      vkCmdPushConstants(c, depthPipeline_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof(uint32_t),
-                         &d.instance);
+      pushDraw(c, depthPipeline_, d, true);
       vkCmdDrawIndexed(c, d.indexCount, 1, d.firstIndex, d.vertexOffset, 0);
     }
   }
@@ -581,8 +602,7 @@ void SceneGpu::drawRsm(PassContext& pc, const SceneTargets& t, const SceneView& 
         bindMaterial(pc, rsmPipeline_, d.material, slot.buffer, slot.offset, slot.range);
         boundMaterial = d.material;
       }
-      vkCmdPushConstants(c, rsmPipeline_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof(uint32_t),
-                         &d.instance);
+      pushDraw(c, rsmPipeline_, d, false);
       vkCmdDrawIndexed(c, d.indexCount, 1, d.firstIndex, d.vertexOffset, 0);
     }
   }

@@ -76,6 +76,8 @@ class SceneGpu final : public GpuScene {
                     VkDeviceSize offset, VkDeviceSize range);
   void beginRendering(PassContext& pc, const SceneTargets& t, size_t colorCount);
   void bindGeometry(VkCommandBuffer cmd);
+  void pushDraw(VkCommandBuffer cmd, const vk::Pipeline& p, const SceneDrawItem& d,
+                bool modelOnly) const;
 
   vk::Context& ctx_;
   const Scene& scene_;
