@@ -30,6 +30,15 @@ layout(set = 0, binding = 13) uniform sampler2D environmentMap;
 
 const float PI = 3.14159265358979;
 
+// An optional input at pixel `p`: one fetch for the neutral 1x1 stand-in and for a
+// full-resolution input (on llvmpipe the cost goes with the fetch count), bilinear otherwise.
+vec4 optionalInput(sampler2D t, ivec2 p, ivec2 size, vec2 uv) {
+  ivec2 s = textureSize(t, 0);
+  if (s == ivec2(1)) return texelFetch(t, ivec2(0), 0);
+  if (s == size) return texelFetch(t, p, 0);
+  return textureLod(t, uv, 0.0);
+}
+
 void main() {
   ivec2 p = ivec2(gl_GlobalInvocationID.xy);
   ivec2 size = ivec2(frame.viewport.xy);
@@ -72,14 +81,14 @@ void main() {
     vec3 brdf = diffuseColor / PI + f0 * spec;
     color += brdf * incident * ndl * visibility;
   }
-  vec4 ambient = textureLod(ambientTexture, uv, 0.0);
+  vec4 ambient = optionalInput(ambientTexture, p, size, uv);
   if (ambient.a > 0.5) {
     color += max(ambient.rgb, vec3(0.0));
   } else {
     vec3 nWorld = mat3(frame.invView) * n;
-    float ao = clamp(textureLod(aoTexture, uv, 0.0).r, 0.0, 1.0);
+    float ao = clamp(optionalInput(aoTexture, p, size, uv).r, 0.0, 1.0);
     color += diffuseColor * environmentIrradianceOverPi(frame, nWorld) * ao;
   }
-  color += max(textureLod(indirectTexture, uv, 0.0).rgb, vec3(0.0));
+  color += max(optionalInput(indirectTexture, p, size, uv).rgb, vec3(0.0));
   imageStore(outLit, p, vec4(color, 1.0));
 }

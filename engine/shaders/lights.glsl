@@ -67,14 +67,17 @@ vec3 lightIncident(Light light, vec3 pos, out vec3 l) {
 float shadowFactor(Light light, vec3 pos, float ndl) {
   int first = int(light.shadow.x);
   if (first < 0) return 1.0;
-  int view = first;
+  // Directional and spot lights read their one view with the light's (uniform) index, which
+  // llvmpipe loads once for all lanes; only a point light's face differs per pixel.
+  ShadowView sv;
   if (int(light.directionType.w) == 1) {  // point: the cube face of the major axis
     vec3 d = mat3(frame.invView) * (pos - light.positionRange.xyz);
     vec3 a = abs(d);
     int axis = a.x >= a.y && a.x >= a.z ? 0 : (a.y >= a.z ? 1 : 2);
-    view += 2 * axis + (d[axis] < 0.0 ? 1 : 0);
+    sv = shadowViews[first + 2 * axis + (d[axis] < 0.0 ? 1 : 0)];
+  } else {
+    sv = shadowViews[first];
   }
-  ShadowView sv = shadowViews[view];
   vec4 clip = sv.viewToClip * vec4(pos, 1.0);
   if (clip.w <= 0.0) return 1.0;
   vec3 ndc = clip.xyz / clip.w;
@@ -85,26 +88,26 @@ float shadowFactor(Light light, vec3 pos, float ndl) {
   float receiver = perspective ? clip.w : near + (1.0 - ndc.z) * (far - near);
   float texel = perspective ? sv.params.w * receiver : sv.params.w;
   float tanTheta = min(sqrt(max(1.0 - ndl * ndl, 0.0)) / max(ndl, 1e-4), 10.0);
-  float biased = receiver - texel * (light.shadow.y + light.shadow.z * tanTheta);
-  float layer = light.shadow.w;
-  ivec2 lo = ivec2(sv.tile.xy), size = ivec2(sv.tile.z);
+  float r = receiver - texel * (light.shadow.y + light.shadow.z * tanTheta);
+  // The occluder test "biased receiver <= linear occluder depth" as a test on the stored
+  // reverse-Z depth, once per pixel instead of a division per tap (both maps are monotonic):
+  // perspective d -> near*far / (d*(far-near) + near), orthographic d -> near + (1-d)(far-near).
+  // A tap is lit when its depth is at most the threshold (cleared 0 = nothing: lit too).
+  float threshold = perspective ? (r > 0.0 ? near * (far / r - 1.0) / (far - near) : 1.0)
+                                : 1.0 - (r - near) / (far - near);
+  threshold = max(threshold, 0.0);
+  int layer = int(light.shadow.w);
+  ivec2 lo = ivec2(sv.tile.xy), size = ivec2(sv.tile.z), hi = lo + size - 1;
   ivec2 center = lo + clamp(ivec2(uv * vec2(size)), ivec2(0), size - 1);
-  int r = clamp(int(frame.options.x), 0, 3);
-  // Compare in reverse-Z depth instead of converting every tap to a distance: the biased
-  // receiver distance maps once to the depth an occluder must exceed.
-  float threshold = perspective ? near * far / max(biased, 1e-20) : 0.0;
-  float limit = perspective ? (threshold - near) / (far - near)
-                            : 1.0 - (biased - near) / (far - near);
+  int k = clamp(int(frame.options.x), 0, 3);
   float lit = 0.0;
-  for (int dy = -r; dy <= r; ++dy)
-    for (int dx = -r; dx <= r; ++dx) {
-      ivec2 t = clamp(center + ivec2(dx, dy), lo, lo + size - 1);
-      float d = texelFetch(shadowMaps, ivec3(t, int(layer)), 0).r;
-      // Lit when nothing was drawn (cleared 0) or the occluder is not in front of the receiver.
-      lit += (d <= 0.0 || d <= limit) ? 1.0 : 0.0;
-    }
-  float taps = float((2 * r + 1) * (2 * r + 1));
-  return lit / taps;
+  for (int dy = -k; dy <= k; ++dy)
+    for (int dx = -k; dx <= k; ++dx)
+      lit += texelFetch(shadowMaps, ivec3(clamp(center + ivec2(dx, dy), lo, hi), layer), 0).r <=
+                     threshold
+                 ? 1.0
+                 : 0.0;
+  return lit / float((2 * k + 1) * (2 * k + 1));
 }
 
 #endif
