@@ -4,7 +4,7 @@
 
 // The cost floor: one G-buffer read and one 8-bit write per pixel. Later effects report their
 // time as a ratio to this pass measured in the same run.
-layout(local_size_x = 32, local_size_y = 16) in;  // kScreenGroupX/Y (builtin_passes.h)
+layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 layout(set = 0, binding = 1) uniform sampler2D gNormal;
 layout(set = 0, binding = 2, rgba8) uniform writeonly image2D outFloor;

@@ -38,7 +38,7 @@ std::unique_ptr<Effect> makeLightingPass(EngineState& state);
 std::unique_ptr<Effect> makeTonemapPass(EngineState& state);
 std::unique_ptr<Effect> makeFloorPass(EngineState& state);
 
-// Workgroup of the engine's full-screen compute passes (lighting, tonemap, floor): llvmpipe
+// Workgroup of the engine's full-screen compute passes (lighting, tonemap): llvmpipe
 // pays a fixed cost per workgroup, so large groups are faster there (measured for SSAO).
 inline constexpr uint32_t kScreenGroupX = 32, kScreenGroupY = 16;
 inline uint32_t screenGroups(uint32_t n, uint32_t size) {
