@@ -1,19 +1,16 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "common.glsl"
+#include "material.glsl"
 
-// The draw's material comes flat from the vertex shader (gbuffer.vert).
+layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 // The draw's base-colour texture (lavapipe has no descriptor indexing: one set per material).
 layout(set = 0, binding = 3) uniform sampler2D baseColorTexture;
 
 layout(location = 0) in vec3 inViewNormal;
 layout(location = 1) in vec2 inUV;
-layout(location = 2) in vec4 inClip;
-layout(location = 3) in vec4 inPrevClip;
-layout(location = 4) in vec3 inViewPos;
-layout(location = 5) flat in vec4 inBaseColor;
-layout(location = 6) flat in vec4 inEmission;  // rgb, 1
-layout(location = 7) flat in vec4 inParams;    // clamped roughness, metallic; textured (1/0)
+layout(location = 2) in vec4 inPrevClip;
+layout(location = 3) in vec3 inViewPos;
 
 layout(location = 0) out vec4 outNormal;    // view-space normal, w = 1 marks geometry
 layout(location = 1) out vec4 outAlbedo;    // sRGB target: stored encoded, read back linear
@@ -22,8 +19,8 @@ layout(location = 3) out vec4 outEmission;  // linear radiance
 layout(location = 4) out vec2 outMotion;    // current minus previous position, in UV units
 
 void main() {
-  vec4 albedo = inBaseColor;
-  if (inParams.z > 0.5) albedo *= texture(baseColorTexture, inUV);
+  vec4 albedo = material.baseColor;
+  if (material.params.z > 0.5) albedo *= texture(baseColorTexture, inUV);
 
   // Geometric fallback when the interpolated normal is degenerate; facing the camera so
   // double-sided surfaces shade from either side.
@@ -33,9 +30,10 @@ void main() {
 
   outNormal = vec4(n, 1.0);
   outAlbedo = vec4(clamp(albedo.rgb, 0.0, 1.0), 1.0);
-  outMaterial = vec4(inParams.xy, 0.0, 1.0);
-  outEmission = inEmission;
-  vec2 cur = inClip.xy / inClip.w;
+  outMaterial = vec4(material.params.xy, 0.0, 1.0);
+  outEmission = material.emission;
+  // This pixel's centre in NDC (what the interpolated clip position divided by w gives).
+  vec2 cur = gl_FragCoord.xy * frame.viewport.zw * 2.0 - 1.0;
   vec2 prev = inPrevClip.w > 0.0 ? inPrevClip.xy / inPrevClip.w : cur;
   outMotion = 0.5 * (cur - prev);
 }

@@ -4,6 +4,7 @@
 // texel's world area; point/spot: intensity x the texel's solid angle x cone and range falloff.
 #extension GL_GOOGLE_include_directive : require
 #include "common.glsl"
+#include "material.glsl"
 #include "scene_view.glsl"
 
 layout(set = 0, binding = 1) uniform View { DrawView drawView; };
@@ -12,7 +13,6 @@ layout(set = 0, binding = 3) uniform sampler2D baseColorTexture;
 layout(location = 0) in vec3 inWorldPos;
 layout(location = 1) in vec3 inWorldNormal;
 layout(location = 2) in vec2 inUV;
-layout(location = 3) flat in vec4 inBaseColor;  // a: textured (1/0)
 
 layout(location = 0) out vec4 outPosition;  // world, w = 1 marks geometry
 layout(location = 1) out vec4 outNormal;    // world, facing the light
@@ -20,8 +20,8 @@ layout(location = 2) out vec4 outFlux;      // reflected flux (W), rgb
 
 void main() {
   DrawView v = drawView;
-  vec3 albedo = inBaseColor.rgb;
-  if (inBaseColor.a > 0.5) albedo *= texture(baseColorTexture, inUV).rgb;
+  vec3 albedo = material.baseColor.rgb;
+  if (material.params.z > 0.5) albedo *= texture(baseColorTexture, inUV).rgb;
   albedo = clamp(albedo, 0.0, 1.0);
 
   int type = int(v.lightPosType.w);

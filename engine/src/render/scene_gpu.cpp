@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -35,6 +36,13 @@ struct DrawPush {
   uint32_t instance, material;
 };
 static_assert(sizeof(DrawPush) == 120 && sizeof(DrawPush) <= 128, "guaranteed push range");
+
+// material.glsl's uniform block, one 256-byte slot per material (the largest offset alignment
+// Vulkan allows), bound with the material's descriptor set.
+struct MaterialUniforms {
+  glm::vec4 baseColor, emission, params;
+};
+constexpr VkDeviceSize kMaterialSlotBytes = 256;
 constexpr size_t kViewSlotsPerChunk = 256;
 static_assert(sizeof(DrawViewUniforms) <= kViewSlotBytes);
 
@@ -265,6 +273,17 @@ void SceneGpu::upload() {
   materialBuffer_ =
       createDeviceBuffer(ctx_, materials.data(), materials.size() * sizeof(GpuMaterial),
                          VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  std::vector<uint8_t> slots(materials.size() * kMaterialSlotBytes, 0);
+  for (size_t i = 0; i < materials.size(); ++i) {
+    const GpuMaterial& m = materials[i];
+    const MaterialUniforms u{
+        m.baseColor, glm::vec4(glm::vec3(m.emission), 1.0f),
+        glm::vec4(std::clamp(m.params.x, 0.0f, 1.0f), std::clamp(m.params.y, 0.0f, 1.0f),
+                  m.params.z >= 0.0f ? 1.0f : 0.0f, 0.0f)};
+    std::memcpy(&slots[i * kMaterialSlotBytes], &u, sizeof u);
+  }
+  materialUniforms_ =
+      createDeviceBuffer(ctx_, slots.data(), slots.size(), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
 
   const uint8_t white[4] = {255, 255, 255, 255};
   for (const Texture& t : scene_.textures) {
@@ -289,7 +308,7 @@ void SceneGpu::createPipelines() {
   GraphicsDesc g;
   g.vertex = loadSpirv("gbuffer.vert");
   g.fragment = loadSpirv("gbuffer.frag");
-  g.bindings = {{0, ubo}, {1, ssbo}, {2, ssbo}, {3, tex}};
+  g.bindings = {{0, ubo}, {1, ssbo}, {2, ubo}, {3, tex}};
   g.pushConstantBytes = sizeof(DrawPush);
   g.vertexLayout.stride = sizeof(Vertex);
   g.vertexLayout.attributes = fullVertex;
@@ -310,7 +329,7 @@ void SceneGpu::createPipelines() {
   GraphicsDesc r = g;
   r.vertex = loadSpirv("scene_rsm.vert");
   r.fragment = loadSpirv("scene_rsm.frag");
-  r.bindings = {{0, ssbo}, {1, ubo}, {2, ssbo}, {3, tex}};
+  r.bindings = {{0, ssbo}, {1, ubo}, {2, ubo}, {3, tex}};
   r.colorFormats = sceneColorFormats(SceneOutputs::ReflectiveShadowMap);
   rsmPipeline_ = Pipeline::graphics(ctx_, r);
 }
@@ -513,7 +532,8 @@ void SceneGpu::bindMaterial(PassContext& pc, const Pipeline& p, uint32_t materia
   DescriptorWriter w;
   w.buffer(gbuffer ? 0 : 1, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms, offset, range)
       .buffer(gbuffer ? 1 : 0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, instanceBuffer_.handle())
-      .buffer(2, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, materialBuffer_.handle())
+      .buffer(2, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, materialUniforms_.handle(),
+              material * kMaterialSlotBytes, sizeof(MaterialUniforms))
       .sampled(3, textured ? textures_[m.baseColorTexture].view() : whiteTexture_.view(),
                linearRepeat_.handle());
   pc.descriptors().bind(pc.cmd(), p, w);

@@ -84,6 +84,7 @@ class SceneGpu final : public GpuScene {
   Scene pose_;  // the renderer's own copy of the node hierarchy, posed by setTime()
   BufferHandle vertices_;
   vk::Buffer vertexBuffer_, indexBuffer_, materialBuffer_, instanceBuffer_;
+  vk::Buffer materialUniforms_;  // per-material uniform slots of the G-buffer and RSM draws
   vk::Buffer restBuffer_, jointIndexBuffer_, jointWeightBuffer_, jointBuffer_;
   std::vector<SceneDrawItem> draws_;
   std::vector<int> instanceNodes_;  // node of each GpuInstance
