@@ -573,21 +573,26 @@ void SceneGpu::drawGBuffer(PassContext& pc, const SceneTargets& t, VkBuffer view
   vkCmdEndRendering(c);
 }
 
+// The view's region of the targets (all of them when its viewport is empty).
+void SceneGpu::setViewport(VkCommandBuffer cmd, const SceneView& view, VkExtent2D extent) {
+  const VkRect2D rect = view.viewport.extent.width > 0 ? view.viewport : VkRect2D{{0, 0}, extent};
+  const VkViewport viewport{float(rect.offset.x),
+                            float(rect.offset.y),
+                            float(rect.extent.width),
+                            float(rect.extent.height),
+                            0.0f,
+                            1.0f};
+  vkCmdSetViewport(cmd, 0, 1, &viewport);
+  vkCmdSetScissor(cmd, 0, 1, &rect);
+}
+
 void SceneGpu::drawDepth(PassContext& pc, const SceneTargets& t, std::span<const SceneView> views) {
   VkCommandBuffer c = pc.cmd();
   beginRendering(pc, t, 0);
   if (!draws_.empty()) bindGeometry(c);
   for (const SceneView& v : views) {
     const VkDescriptorBufferInfo slot = viewSlot(v, nullptr, t.extent);
-    const VkRect2D rect = v.viewport.extent.width > 0 ? v.viewport : VkRect2D{{0, 0}, t.extent};
-    VkViewport viewport{float(rect.offset.x),
-                        float(rect.offset.y),
-                        float(rect.extent.width),
-                        float(rect.extent.height),
-                        0.0f,
-                        1.0f};
-    vkCmdSetViewport(c, 0, 1, &viewport);
-    vkCmdSetScissor(c, 0, 1, &rect);
+    setViewport(c, v, t.extent);
     DescriptorWriter w;
     w.buffer(0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, instanceBuffer_.handle())
         .buffer(1, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, slot.buffer, slot.offset, slot.range);
@@ -605,15 +610,7 @@ void SceneGpu::drawRsm(PassContext& pc, const SceneTargets& t, const SceneView& 
   VkCommandBuffer c = pc.cmd();
   beginRendering(pc, t, 3);
   const VkDescriptorBufferInfo slot = viewSlot(view, &light, t.extent);
-  const VkRect2D rect = view.viewport.extent.width > 0 ? view.viewport : VkRect2D{{0, 0}, t.extent};
-  VkViewport viewport{float(rect.offset.x),
-                      float(rect.offset.y),
-                      float(rect.extent.width),
-                      float(rect.extent.height),
-                      0.0f,
-                      1.0f};
-  vkCmdSetViewport(c, 0, 1, &viewport);
-  vkCmdSetScissor(c, 0, 1, &rect);
+  setViewport(c, view, t.extent);
   if (!draws_.empty()) {
     bindGeometry(c);
     uint32_t boundMaterial = UINT32_MAX;

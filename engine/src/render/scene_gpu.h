@@ -76,6 +76,7 @@ class SceneGpu final : public GpuScene {
                     VkDeviceSize offset, VkDeviceSize range);
   void beginRendering(PassContext& pc, const SceneTargets& t, size_t colorCount);
   void bindGeometry(VkCommandBuffer cmd);
+  static void setViewport(VkCommandBuffer cmd, const SceneView& view, VkExtent2D extent);
   void pushDraw(VkCommandBuffer cmd, const vk::Pipeline& p, const SceneDrawItem& d,
                 bool modelOnly) const;
 

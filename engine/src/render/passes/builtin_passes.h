@@ -4,9 +4,11 @@
 #pragma once
 
 #include <memory>
+#include <string>
 
 #include "gi/effect.h"
 #include "gi/renderer.h"
+#include "gi/vk/pipeline.h"
 #include "gi/vk/resources.h"
 #include "render/environment_gpu.h"
 #include "render/light_setup.h"
@@ -44,5 +46,13 @@ inline constexpr uint32_t kScreenGroupX = 32, kScreenGroupY = 16;
 inline uint32_t screenGroups(uint32_t n, uint32_t size) {
   return (n + size - 1) / size;
 }
+
+// The shape tonemap and floor share: a compute shader with (0) the frame uniforms, (1) one
+// sampled input and (2) one storage output, dispatched over the output in groupX x groupY
+// workgroups (image_filter.cpp).
+vk::Pipeline makeImageFilterPipeline(vk::Context& ctx, const std::string& spirvName);
+void recordImageFilter(PassContext& pc, const vk::Pipeline& pipeline, VkBuffer frame,
+                       VkSampler sampler, TextureHandle in, TextureHandle out, uint32_t groupX,
+                       uint32_t groupY);
 
 }  // namespace gi

@@ -1,6 +1,5 @@
 // "floor": the cost floor (one G-buffer read and one 8-bit write per pixel); gi-bench reports
 // other passes' times as ratios to it measured in the same run.
-#include "gi/vk/pipeline.h"
 #include "render/passes/builtin_passes.h"
 
 namespace gi {
@@ -24,10 +23,7 @@ class FloorPass final : public Effect {
   std::vector<SettingDesc> settings() const override { return {}; }
   void prepare(EffectContext& ctx, const SettingValues&) override {
     if (pipeline_.handle()) return;
-    pipeline_ = vk::Pipeline::compute(ctx.vulkan(), vk::loadSpirv("floor.comp"),
-                                      {{0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
-                                       {1, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER},
-                                       {2, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE}});
+    pipeline_ = makeImageFilterPipeline(ctx.vulkan(), "floor.comp");
   }
   void addPasses(FrameGraph& graph, EffectContext& ctx, const SettingValues&) override {
     auto io = std::make_shared<std::pair<TextureHandle, TextureHandle>>();
@@ -39,14 +35,8 @@ class FloorPass final : public Effect {
                                TextureUsage::StorageWrite);
         },
         [this, io, frame = ctx.frameUniforms()](PassContext& pc) {
-          vk::DescriptorWriter w;
-          w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame)
-              .sampled(1, pc.view(io->first), s_.nearest)
-              .storageImage(2, pc.view(io->second));
-          pc.descriptors().bind(pc.cmd(), pipeline_, w);
-          const VkExtent2D e = pc.extent(io->second);
-          vkCmdDispatch(pc.cmd(), screenGroups(e.width, kFloorGroup),
-                        screenGroups(e.height, kFloorGroup), 1);
+          recordImageFilter(pc, pipeline_, frame, s_.nearest, io->first, io->second, kFloorGroup,
+                            kFloorGroup);
         });
     graph.blackboard().put(res::kFloor, io->second);
   }

@@ -1,6 +1,5 @@
 // "tonemap": exposure, ACES filmic curve and sRGB encoding of "lit" into the 8-bit output
 // image (imported: it outlives the graph, presenters copy it).
-#include "gi/vk/pipeline.h"
 #include "render/passes/builtin_passes.h"
 
 namespace gi {
@@ -20,10 +19,7 @@ class TonemapPass final : public Effect {
   std::vector<SettingDesc> settings() const override { return {}; }
   void prepare(EffectContext& ctx, const SettingValues&) override {
     if (pipeline_.handle()) return;
-    pipeline_ = vk::Pipeline::compute(ctx.vulkan(), vk::loadSpirv("tonemap.comp"),
-                                      {{0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
-                                       {1, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER},
-                                       {2, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE}});
+    pipeline_ = makeImageFilterPipeline(ctx.vulkan(), "tonemap.comp");
   }
   void addPasses(FrameGraph& graph, EffectContext& ctx, const SettingValues&) override {
     // GENERAL at the end of every frame: presenters and read-back expect it.
@@ -38,14 +34,8 @@ class TonemapPass final : public Effect {
           io->second = b.write(output, TextureUsage::StorageWrite);
         },
         [this, io, frame = ctx.frameUniforms()](PassContext& pc) {
-          vk::DescriptorWriter w;
-          w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame)
-              .sampled(1, pc.view(io->first), s_.nearest)
-              .storageImage(2, pc.view(io->second));
-          pc.descriptors().bind(pc.cmd(), pipeline_, w);
-          const VkExtent2D e = pc.extent(io->second);
-          vkCmdDispatch(pc.cmd(), screenGroups(e.width, kScreenGroupX),
-                        screenGroups(e.height, kScreenGroupY), 1);
+          recordImageFilter(pc, pipeline_, frame, s_.nearest, io->first, io->second, kScreenGroupX,
+                            kScreenGroupY);
         });
     graph.blackboard().put(res::kOutput, io->second);
   }
