@@ -4,8 +4,8 @@
 # run time. Each shader is compiled (and validated) by glslangValidator at build time into a
 # header `<file>.h` (e.g. `ssao.comp.h`) holding `const uint32_t <file_with_underscores>[]`
 # (e.g. `ssao_comp`), so a module is one self-contained file. Shaders may
-# `#include "common.glsl"` (the engine's FrameUniforms and helpers) and "environment.glsl"
-# (environment importance sampling).
+# `#include "common.glsl"` (the engine's FrameUniforms and helpers), "environment.glsl"
+# (environment importance sampling) and "lights.glsl" (lights and shadow maps).
 #
 # Works in the engine's own tree and against an installed package (find_package(gi), which
 # includes this file and sets GI_SHADER_INCLUDE_DIR). GI_PLUGIN_OUTPUT_DIR sets where modules

@@ -3,7 +3,8 @@
 # modules and the presets:
 #
 #   <prefix>/bin/gi-render               <prefix>/include/gi/...
-#   <prefix>/bin/shaders/*.spv           <prefix>/share/gi/shaders/common.glsl, environment.glsl
+#   <prefix>/bin/shaders/*.spv           <prefix>/share/gi/shaders/common.glsl, environment.glsl,
+#                                                                 lights.glsl
 #   <prefix>/bin/plugins/gi_effect_*.so  <prefix>/share/gi/presets/*.json
 #   <prefix>/<libdir>/libgi_engine.so, libgi_scene.so
 #   <prefix>/<libdir>/cmake/gi/giConfig.cmake, giConfigVersion.cmake, giTargets.cmake,
@@ -34,7 +35,8 @@ install(TARGETS gi_scene gi_engine EXPORT giTargets
   INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(DIRECTORY ${CMAKE_SOURCE_DIR}/engine/include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(FILES ${CMAKE_SOURCE_DIR}/engine/shaders/common.glsl
-  ${CMAKE_SOURCE_DIR}/engine/shaders/environment.glsl DESTINATION ${GI_INSTALL_SHADERDIR})
+  ${CMAKE_SOURCE_DIR}/engine/shaders/environment.glsl
+  ${CMAKE_SOURCE_DIR}/engine/shaders/lights.glsl DESTINATION ${GI_INSTALL_SHADERDIR})
 install(EXPORT giTargets NAMESPACE gi:: DESTINATION ${GI_INSTALL_CMAKEDIR})
 
 # The executable keeps the layout of the build tree (bin/, bin/shaders, bin/plugins,

@@ -119,6 +119,7 @@ render_pfm main_depth depth
 render_pfm sv_depth second_view_depth
 render_pfm sv_gdepth second_view_gdepth
 render_pfm sv_flux second_view_flux
+render_pfm sv_irradiance second_view_irradiance
 expect "$tmp/sv_depth.log" "^  \[run\] +second_view$" "second_view pass not executed"
 python3 "$src/tests/external_effect/compare_pfm.py" "$tmp/main_depth.pfm" "$tmp/sv_depth.pfm" 1e-6 ||
   fail "depth-only second view differs from the main G-buffer's depth"
@@ -132,6 +133,21 @@ v = struct.unpack("<" + "f" * (w * h * 3), data[3][:w * h * 12])
 assert all(math.isfinite(x) and x >= 0 for x in v), "non-finite or negative flux"
 assert sum(v) > 0, "no flux"
 print(f"rsm flux sum {sum(v):.4g} W over {w}x{h}")
+PY
+
+python3 - "$tmp/sv_irradiance.pfm" <<'PY' || fail "irradiance from lights.glsl/environment.glsl wrong"
+import math, struct, sys
+data = open(sys.argv[1], "rb").read().split(b"\n", 3)
+w, h = map(int, data[1].split())
+v = struct.unpack("<" + "f" * (w * h * 3), data[3][:w * h * 12])
+assert all(math.isfinite(x) and x >= 0 for x in v), "non-finite or negative irradiance"
+lum = sorted(v[i] + v[i + 1] + v[i + 2] for i in range(0, len(v), 3))
+lum = [x for x in lum if x > 0]  # geometry (sky pixels are 0)
+assert len(lum) > len(v) // 6, "no irradiance on the geometry"
+# The default room: directly lit pixels and the point light's shadows (only the environment).
+low, high = lum[len(lum) // 20], lum[len(lum) * 19 // 20]
+print(f"irradiance 5%: {low:.3g}, 95%: {high:.3g}")
+assert high > 4 * low, "no contrast between lit and shadowed pixels"
 PY
 
 step "SSAO (in-tree plugin) together with the out-of-tree vignette: exact executed passes"

@@ -2,10 +2,13 @@
 // engine's tree (built against the installed package, like the vignette): a depth-only view and
 // a G-buffer through its own ViewUniforms, both with the main camera (so they must equal the
 // main G-buffer's depth), and a reflective shadow map of the first light seen from above.
-// Publishes "second_view_depth", "second_view_gdepth", "second_view_normal" and
-// "second_view_flux"; run_test.sh compares them with the main G-buffer. Settings pick what is
-// drawn and the views' size relative to the output (tools/bench-core times a quarter-size
-// G-buffer with it; the engine's build also has it in <build>/example_plugins).
+// A second pass computes the irradiance from the engine's lights, shadow maps and environment
+// with lights.glsl and environment.glsl ("second_view_irradiance").
+// Publishes "second_view_depth", "second_view_gdepth", "second_view_normal",
+// "second_view_flux" and "second_view_irradiance"; run_test.sh compares them with the main
+// G-buffer. Settings pick what is drawn and the views' size relative to the output
+// (tools/bench-core times a quarter-size G-buffer with it; the engine's build also has it in
+// <build>/example_plugins).
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -13,6 +16,8 @@
 
 #include "gi/effect.h"
 #include "gi/effect_registry.h"
+#include "gi/vk/pipeline.h"
+#include "second_view_light.comp.h"  // const uint32_t second_view_light_comp[]
 
 namespace {
 
@@ -24,8 +29,15 @@ class SecondViewEffect : public gi::Effect {
     i.version = "1.0";
     i.description = "the scene drawn again from an extra view and a light (engine services)";
     i.stage = gi::EffectStage::BeforeLighting;
-    i.writes = {"second_view_depth", "second_view_gdepth", "second_view_normal",
-                "second_view_flux"};
+    i.reads = {gi::resources::kDepth,
+               gi::resources::kNormal,
+               gi::resources::kLights,
+               gi::resources::kShadowViews,
+               gi::resources::kShadowMaps,
+               gi::resources::kEnvironmentMap,
+               gi::resources::kEnvironmentSampling};
+    i.writes = {"second_view_depth", "second_view_gdepth", "second_view_normal", "second_view_flux",
+                "second_view_irradiance"};
     i.debugView = "second_view_depth";
     return i;
   }
@@ -41,6 +53,21 @@ class SecondViewEffect : public gi::Effect {
   }
   void prepare(gi::EffectContext& ctx, const gi::SettingValues&) override {
     if (!view_) view_ = ctx.createView();
+    if (!light_.handle()) {
+      const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                 tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+      light_ = gi::vk::Pipeline::compute(
+          ctx.vulkan(), {std::begin(second_view_light_comp), std::end(second_view_light_comp)},
+          {{0, ubo},
+           {1, tex},
+           {2, tex},
+           {3, ssbo},
+           {4, ssbo},
+           {5, tex},
+           {6, tex},
+           {7, ssbo},
+           {8, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE}});
+    }
   }
   void update(gi::EffectContext& ctx, const gi::SettingValues& settings) override {
     const VkExtent2D e = ctx.outputExtent();
@@ -120,9 +147,53 @@ class SecondViewEffect : public gi::Effect {
     bb.put("second_view_gdepth", io->gdepth);
     bb.put("second_view_normal", io->gbuffer[0]);
     bb.put("second_view_flux", io->flux);
+    addIrradiancePass(graph, ctx);
   }
 
  private:
+  // Irradiance from the published lights, shadow maps and environment at each main-view pixel.
+  void addIrradiancePass(gi::FrameGraph& graph, gi::EffectContext& ctx) {
+    namespace res = gi::resources;
+    struct Io {
+      gi::TextureHandle depth, normal, shadowMaps, environment, out;
+      gi::BufferHandle lights, shadowViews, sampling;
+    };
+    auto io = std::make_shared<Io>();
+    gi::Blackboard& bb = graph.blackboard();
+    graph.addPass(
+        "second_view_irradiance",
+        [&](gi::PassBuilder& b) {
+          io->depth = b.read(bb.texture(res::kDepth));
+          io->normal = b.read(bb.texture(res::kNormal));
+          io->lights = b.read(bb.buffer(res::kLights));
+          io->shadowViews = b.read(bb.buffer(res::kShadowViews));
+          io->shadowMaps = b.read(bb.texture(res::kShadowMaps));
+          io->environment = b.read(bb.texture(res::kEnvironmentMap));
+          io->sampling = b.read(bb.buffer(res::kEnvironmentSampling));
+          io->out = b.write(
+              b.create("second_view_irradiance", gi::TextureDesc{VK_FORMAT_R16G16B16A16_SFLOAT}),
+              gi::TextureUsage::StorageWrite);
+        },
+        [this, io, frame = ctx.frameUniforms(),
+         nearest = ctx.nearestSampler()](gi::PassContext& pc) {
+          gi::vk::DescriptorWriter w;
+          w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame)
+              .sampled(1, pc.view(io->depth), nearest)
+              .sampled(2, pc.view(io->normal), nearest)
+              .buffer(3, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, pc.buffer(io->lights))
+              .buffer(4, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, pc.buffer(io->shadowViews))
+              .sampled(5, pc.view(io->shadowMaps), nearest)
+              .sampled(6, pc.view(io->environment), nearest)
+              .buffer(7, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, pc.buffer(io->sampling))
+              .storageImage(8, pc.view(io->out));
+          pc.descriptors().bind(pc.cmd(), light_, w);
+          const VkExtent2D e = pc.extent(io->out);
+          vkCmdDispatch(pc.cmd(), (e.width + 15) / 16, (e.height + 15) / 16, 1);
+        });
+    bb.put("second_view_irradiance", io->out);
+  }
+
+  gi::vk::Pipeline light_;
   std::shared_ptr<gi::ViewUniforms> view_;
 };
 
