@@ -177,6 +177,54 @@ TEST_F(AnimatedViewTest, MovingCameraFollowsItsNodeAndWritesMotionVectors) {
   EXPECT_GT(std::abs(want.x), 0.01f);
   EXPECT_NEAR(motion.pixels[centre * 4], want.x, 2e-3f);
   EXPECT_NEAR(motion.pixels[centre * 4 + 1], want.y, 2e-3f);
+  // Motion is against the last rendered frame: the same pose again moves nothing.
+  r.renderFrame();
+  const ImageRGBA32F again = r.readTarget("motion");
+  for (size_t i = 0; i < again.pixels.size(); i += 4)
+    ASSERT_EQ(again.pixels[i], 0.0f) << "camera motion repeated, pixel " << i / 4;
+}
+
+// Object motion follows the same rule as the camera's: against the last rendered frame, so a
+// pose set twice between frames and a frame rendered twice give consistent vectors.
+TEST_F(AnimatedViewTest, ObjectMotionIsAgainstTheLastRenderedFrame) {
+  Scene scene = boxScene();
+  int box = -1;
+  for (size_t i = 0; i < scene.nodes.size(); ++i)
+    if (!scene.nodes[i].meshes.empty() && scene.nodes[i].world[3].y > 0.5f) box = int(i);
+  ASSERT_GE(box, 0);
+  toTRS(scene.nodes[box]);
+  AnimationClip clip;
+  AnimationSampler sampler;
+  sampler.times = {0.0f, 1.0f};
+  sampler.components = 3;
+  sampler.values = {0, 1, 0, 1.0f, 1, 0};  // slides 1 along +x
+  clip.samplers.push_back(sampler);
+  clip.channels.push_back({0, box, AnimationPath::Translation});
+  clip.duration = 2.0f;
+  scene.animations.push_back(clip);
+  RenderSettings rs;
+  rs.width = 80;
+  rs.height = 60;
+  rs.view = "motion";
+  Renderer r(ctx(), scene, rs);
+  r.setTime(0.0);
+  r.renderFrame();
+  r.setTime(0.5);  // never rendered
+  r.setTime(0.25);
+  r.renderFrame();
+  const ImageRGBA32F moved = r.readTarget("motion");
+  float largest = 0.0f;
+  for (size_t i = 0; i < moved.pixels.size(); i += 4)
+    largest = std::max(largest, std::abs(moved.pixels[i]));
+  // 0.25 along x seen from 5 above with a 60-degree view (half-width 5 tan 30 = 2.89 at the
+  // plane, less at the box's top 1 higher): about 0.25 / (2 x 2.31) = 0.054 in UV units; the
+  // unrendered pose at 0.5 would double it.
+  EXPECT_NEAR(largest, 0.25f / (2.0f * 4.0f * std::tan(glm::radians(30.0f))), 0.01f);
+  r.renderFrame();
+  const ImageRGBA32F still = r.readTarget("motion");
+  // (Rounding: the current position comes from gl_FragCoord, the previous one from matrices.)
+  for (size_t i = 0; i < still.pixels.size(); i += 4)
+    ASSERT_NEAR(still.pixels[i], 0.0f, 1e-5f) << "object motion repeated, pixel " << i / 4;
 }
 
 }  // namespace

@@ -127,5 +127,39 @@ TEST_F(LiveChangesTest, AFailedChangeKeepsThePreviousConfiguration) {
   EXPECT_EQ(live.settings().view, "output");
 }
 
+// With effects active, failed changes of every kind leave the renderer working with its
+// previous configuration, and settings() reports what is really active.
+TEST_F(LiveChangesTest, FailedChangesWithEffectsActiveKeepEverything) {
+  RenderSettings rs = base();
+  rs.effects = {ssao(2)};
+  Renderer live(ctx(), scene_, rs, &registry_);
+  live.renderFrame();
+  const ImageRGBA32F before = live.readTarget("output");
+
+  RenderSettings badView = rs;
+  badView.width = 64;  // a resize that must be undone too
+  badView.view = "no_such_view";
+  EXPECT_THROW(live.applySettings(badView), Error);
+  RenderSettings badEffect = rs;
+  badEffect.shadowMapSize = 256;
+  badEffect.effects.push_back({"no_such_effect", SettingValues()});
+  EXPECT_THROW(live.applySettings(badEffect), Error);
+  EXPECT_THROW(live.setEffects({ssao(0), {"no_such_effect", SettingValues()}}), Error);
+  live.renderFrame();
+  expectSame(live.readTarget("output"), before, "after failed changes");
+  EXPECT_EQ(live.settings().width, 96u);
+  EXPECT_EQ(live.settings().shadowMapSize, rs.shadowMapSize);
+  ASSERT_EQ(live.settings().effects.size(), 1u);
+  EXPECT_EQ(live.settings().effects[0].settings.integer("blur_radius"), 2);
+
+  // setEffectSettings is reflected in settings(), so applying the old list changes it back.
+  live.setEffectSettings("ssao", ssao(0).settings);
+  EXPECT_EQ(live.settings().effects[0].settings.integer("blur_radius"), 0);
+  live.applySettings(rs);
+  EXPECT_TRUE(live.graphRecompiledByLastChange());
+  live.renderFrame();
+  expectSame(live.readTarget("output"), before, "back to blur radius 2");
+}
+
 }  // namespace
 }  // namespace gi

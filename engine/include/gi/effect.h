@@ -126,10 +126,12 @@ class Effect {
   // `changesGraph` changed. `settings` are validated against settings().
   virtual void prepare(EffectContext& ctx, const SettingValues& settings) = 0;
   // Declares the effect's passes (reads through the blackboard, publishes its outputs there).
-  // Called on every graph compile.
+  // Called on every graph compile. `settings` stays valid, and is updated in place by
+  // uniform-only changes, until the next graph build: execute callbacks may keep a pointer.
   virtual void addPasses(FrameGraph& graph, EffectContext& ctx, const SettingValues& settings) = 0;
-  // Once per frame, before any uniform is uploaded or pass recorded, after the pose and camera
-  // of the frame are known: move extra views (ViewUniforms::setCamera) here.
+  // Once per frame, after the pose, the camera and the main view's uniforms (frame()) of the
+  // frame are known, before extra views are uploaded and passes recorded: move extra views
+  // (ViewUniforms::setCamera) here.
   virtual void update(EffectContext& ctx, const SettingValues& settings) {
     (void)ctx;
     (void)settings;

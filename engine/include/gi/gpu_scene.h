@@ -5,6 +5,9 @@
 // Views: perspective, orthographic, the six faces of a cube (six perspective views with their
 // own viewports) and a paraboloid hemisphere (Brabec et al.: the hemisphere around the view's
 // -z axis maps to the unit disk; depth is the radial distance, reverse-Z between near and far).
+// Image orientation: perspective views (perspectiveReverseZ) put view-space +y at the top of
+// the image like the main camera; orthographic views and paraboloid disks keep +y at the
+// bottom (texel row increases with +y). Culling is off, so either orientation draws the same.
 #pragma once
 
 #include <vulkan/vulkan.h>

@@ -48,7 +48,8 @@ Image makeOutputImage(Context& ctx, uint32_t w, uint32_t h) {
 Image makeNoShadowsImage(Context& ctx) {
   ImageDesc d;
   d.format = VK_FORMAT_D32_SFLOAT;
-  d.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+  d.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT |
+            VK_IMAGE_USAGE_TRANSFER_SRC_BIT;  // readTarget("shadow_maps") copies from it
   d.viewType = VK_IMAGE_VIEW_TYPE_2D_ARRAY;
   Image img(ctx, d);
   ctx.submitAndWait([&](VkCommandBuffer c) {
@@ -96,6 +97,7 @@ class ViewUniformsImpl final : public ViewUniforms {
     seen_ = true;
   }
   glm::mat4 viewProj() const { return camera_.proj * camera_.view; }
+  void forgetHistory() { seen_ = false; }  // no motion into the next frame (resize)
 
  private:
   Buffer buffer_;
@@ -148,7 +150,8 @@ struct Renderer::Impl : EffectContext {
   bool graphDirty = true, recompiledByLastChange = false;
   double compileMs = 0.0;
   DescriptorArena descriptors;
-  GpuTimer timer;
+  std::unique_ptr<GpuTimer> timer;  // sized to the compiled graph
+  uint32_t timerScopes = 0;
   VkCommandBuffer cmd = VK_NULL_HANDLE;
   VkFence fence = VK_NULL_HANDLE;
   std::vector<PassTiming> timings;
@@ -160,8 +163,7 @@ struct Renderer::Impl : EffectContext {
         registry(reg),
         pointsRequested(rs.surfacePoints),
         graph(c, {std::max(rs.width, 1u), std::max(rs.height, 1u)}),
-        descriptors(c),
-        timer(c) {
+        descriptors(c) {
     validateSettings(settings);
     cameraView = activeCamera(source, aspect());
     prevViewProj = cameraView.proj * cameraView.view;
@@ -173,6 +175,7 @@ struct Renderer::Impl : EffectContext {
     nearestClamp = Sampler(ctx, VK_FILTER_NEAREST, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE);
     frameBuffer = Buffer(ctx, sizeof(FrameUniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true);
     updateLights();
+    updateFrameUniforms();  // frame() is valid from the first prepare() on
     state.reset(new EngineState{ctx, settings, *sceneGpu, lightSetup, *environment, surfacePoints,
                                 output, noShadows, nearestClamp.handle(), linearClamp.handle()});
     ctx.requireWorkgroup(256, 1, "skinning / surface points");  // local_size_x 256
@@ -267,6 +270,18 @@ struct Renderer::Impl : EffectContext {
                                 VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true);
       graphDirty = true;
     }
+    const VkPhysicalDeviceLimits& limits = ctx.properties().limits;
+    if (next.layerWidth() > limits.maxImageDimension2D ||
+        next.layerHeight() > limits.maxImageDimension2D)
+      throw Error(ErrorKind::Unsupported, "",
+                  "shadow maps of " + std::to_string(next.layerWidth()) + "x" +
+                      std::to_string(next.layerHeight()) + " texels exceed the device's " +
+                      std::to_string(limits.maxImageDimension2D) +
+                      " (a point light's six faces take 3x2 maps: lower engine.shadow_map_size)");
+    if (next.maps.size() > limits.maxImageArrayLayers)
+      throw Error(ErrorKind::Unsupported, "",
+                  std::to_string(next.maps.size()) + " shadow-casting lights exceed the device's " +
+                      std::to_string(limits.maxImageArrayLayers) + " shadow-map layers");
     if (!next.lights.empty())
       lightBuffer.write(next.lights.data(), next.lights.size() * sizeof(GpuLight));
     if (!next.views.empty())
@@ -276,11 +291,10 @@ struct Renderer::Impl : EffectContext {
 
   void setTime(double seconds) {
     timeSeconds = seconds;
-    sceneGpu->setTime(seconds, framesRendered == 0);
-    // Animated cameras and lights: the camera of the last frame feeds the motion vectors.
-    prevViewProj = cameraView.proj * cameraView.view;
+    sceneGpu->setTime(seconds);
+    // Animated cameras and lights. The motion vectors compare with the camera of the last
+    // rendered frame (renderFrame keeps it); before the first frame nothing moved.
     if (source.activeCameraNode >= 0) cameraView = activeCamera(sceneGpu->pose(), aspect());
-    // No frame was seen before this pose: nothing moved (no motion from the load pose).
     if (framesRendered == 0) prevViewProj = cameraView.proj * cameraView.view;
     updateLights();
   }
@@ -413,6 +427,12 @@ struct Renderer::Impl : EffectContext {
     if (settings.floorPass) graph.markOutput(bb.texture(res::kFloor));
     graph.compile();
     graphDirty = false;
+    // One timestamp scope per executed pass (any number of shadow-casting lights).
+    const uint32_t scopes = std::max(uint32_t(graph.executedPasses().size()) + 8, 64u);
+    if (!timer || timerScopes < scopes) {
+      timer = std::make_unique<GpuTimer>(ctx, scopes);
+      timerScopes = scopes;
+    }
     compileMs =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   }
@@ -425,6 +445,7 @@ struct Renderer::Impl : EffectContext {
       buildGraph();
     } catch (...) {
       undo();
+      dropGraph();
       buildGraph();
       throw;
     }
@@ -432,6 +453,7 @@ struct Renderer::Impl : EffectContext {
 
   // ---- frames ---------------------------------------------------------------------------
 
+  // The main view's uniforms of the coming frame (frameData, uploaded).
   void updateFrameUniforms() {
     FrameUniforms f{};
     const CameraView& c = cameraView;
@@ -461,13 +483,17 @@ struct Renderer::Impl : EffectContext {
     f.options = glm::vec4(float(settings.pcfRadius), 0.0f, 0.0f, 0.0f);
     frameData = f;
     frameBuffer.write(&f, sizeof f);
-    // Extra views: frame-wide values from the main view, their own camera.
+  }
+
+  // Extra views: frame-wide values from the main view, their own camera (after the effects'
+  // update() hooks moved them).
+  void updateViews() {
     views.erase(std::remove_if(views.begin(), views.end(),
                                [](const TrackedView& v) { return v.view.expired(); }),
                 views.end());
     for (TrackedView& v : views) {
       auto view = v.view.lock();
-      view->refresh(f, v.prevViewProj);
+      view->refresh(frameData, v.prevViewProj);
       v.prevViewProj = view->viewProj();
     }
   }
@@ -488,14 +514,15 @@ struct Renderer::Impl : EffectContext {
   void renderFrame() {
     if (graphDirty) buildGraph();
     sceneGpu->beginFrame();
-    for (ActiveEffect& a : effects) a.effect->update(*this, a.settings);
     updateFrameUniforms();
+    for (ActiveEffect& a : effects) a.effect->update(*this, a.settings);
+    updateViews();
     descriptors.reset();
     check(vkResetCommandBuffer(cmd, 0), "vkResetCommandBuffer");
     VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
     begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
     check(vkBeginCommandBuffer(cmd, &begin), "vkBeginCommandBuffer");
-    timer.beginFrame(cmd);
+    timer->beginFrame(cmd);
     FrameGraph::PassBoundary isolate;
     if (settings.isolatePasses)
       isolate = [this, &begin](VkCommandBuffer c) {
@@ -504,10 +531,10 @@ struct Renderer::Impl : EffectContext {
         check(vkBeginCommandBuffer(c, &begin), "vkBeginCommandBuffer");
         return c;
       };
-    graph.execute(cmd, descriptors, &timer, isolate);
+    graph.execute(cmd, descriptors, timer.get(), isolate);
     submitAndWait(cmd);
     timings.clear();
-    for (auto& [name, ms] : timer.collect()) timings.push_back({name, ms});
+    for (auto& [name, ms] : timer->collect()) timings.push_back({name, ms});
     prevViewProj = cameraView.proj * cameraView.view;
     lastFrameTime = timeSeconds;
     ++framesRendered;
@@ -515,45 +542,60 @@ struct Renderer::Impl : EffectContext {
 
   // ---- live changes ---------------------------------------------------------------------
 
+  // Drops the compiled graph (its passes may refer to pipelines about to be replaced); the
+  // next frame rebuilds it unless a change rebuilds it first.
+  void dropGraph() {
+    vkDeviceWaitIdle(ctx.device());
+    graph.reset();
+    graphDirty = true;
+  }
+
   void setEffectSettings(const std::string& name, const SettingValues& values) {
-    for (ActiveEffect& a : effects) {
+    for (size_t i = 0; i < effects.size(); ++i) {
+      ActiveEffect& a = effects[i];
       if (a.info.name != name) continue;
-      recompiledByLastChange = a.settings.graphDiffers(values);
-      a.settings = values;
-      if (recompiledByLastChange) {
-        vkDeviceWaitIdle(ctx.device());
-        graph.reset();  // the effect may replace pipelines the old graph's passes refer to
-        a.effect->prepare(*this, a.settings);
-        updateSurfacePoints();
-        graphDirty = true;
+      const bool rebuild = a.settings.graphDiffers(values);
+      if (rebuild) {
+        dropGraph();
+        const SettingValues old = a.settings;
+        try {
+          a.effect->prepare(*this, values);
+        } catch (...) {
+          a.effect->prepare(*this, old);  // the previous settings worked
+          throw;
+        }
       }
+      a.settings = values;
+      if (i < settings.effects.size()) settings.effects[i].settings = values;
+      recompiledByLastChange = rebuild;
+      if (rebuild) updateSurfacePoints();
       return;
     }
     throw Error(ErrorKind::Usage, "", "effect '" + name + "' is not active in this renderer");
   }
 
   // Keeps the instances of effects that stay (their settings updated), creates new ones. On
-  // any error (unknown effect, a failing prepare or graph) the previous effects stay active.
+  // any error (unknown effect, a failing prepare or graph) the previous effects stay active
+  // with their previous settings.
   void setEffects(const std::vector<EffectConfig>& configs) {
     std::set<std::string> seen;
     for (const EffectConfig& c : configs)
       if (!seen.insert(c.name).second)
         throw Error(ErrorKind::Usage, "", "effect '" + c.name + "' listed twice");
-    vkDeviceWaitIdle(ctx.device());
-    graph.reset();
+    dropGraph();
     const std::vector<EffectConfig> oldConfigs = settings.effects;
     std::vector<ActiveEffect> previous = std::move(effects);
     effects.clear();
     auto restore = [&] {
       for (ActiveEffect& a : effects)
         for (size_t i = 0; i < oldConfigs.size(); ++i)
-          if (oldConfigs[i].name == a.info.name && !previous[i].effect) {
-            previous[i] = std::move(a);
-            previous[i].settings = oldConfigs[i].settings;
-          }
+          if (oldConfigs[i].name == a.info.name && !previous[i].effect) previous[i] = std::move(a);
       effects = std::move(previous);
       settings.effects = oldConfigs;
-      for (ActiveEffect& a : effects) a.effect->prepare(*this, a.settings);
+      for (size_t i = 0; i < effects.size(); ++i) {
+        effects[i].settings = oldConfigs[i].settings;
+        effects[i].effect->prepare(*this, effects[i].settings);
+      }
       buildGraph();
     };
     try {
@@ -565,9 +607,8 @@ struct Renderer::Impl : EffectContext {
           effects.push_back(createEffect(c));
           continue;
         }
-        const bool reprepare = it->settings.graphDiffers(c.settings);
+        if (it->settings.graphDiffers(c.settings)) it->effect->prepare(*this, c.settings);
         it->settings = c.settings;
-        if (reprepare) it->effect->prepare(*this, it->settings);
         effects.push_back(std::move(*it));
         it->effect.reset();
       }
@@ -584,52 +625,60 @@ struct Renderer::Impl : EffectContext {
   void setView(const std::string& view) {
     const std::string old = settings.view;
     settings.view = view;
-    vkDeviceWaitIdle(ctx.device());
+    dropGraph();
     rebuildOrUndo([&] { settings.view = old; });
     recompiledByLastChange = true;
   }
 
-  // Engine settings, size, view and effect list in one call (what a settings UI changes).
+  // Size-dependent state: the output image, the camera's aspect, motion history.
+  void resize() {
+    output = makeOutputImage(ctx, settings.width, settings.height);
+    cameraView = activeCamera(source.activeCameraNode >= 0 ? sceneGpu->pose() : source, aspect());
+    prevViewProj = cameraView.proj * cameraView.view;
+    for (TrackedView& v : views)
+      if (auto view = v.view.lock()) view->forgetHistory();
+  }
+
+  // Engine settings, size, view and effect list in one call (what a settings UI changes). On an
+  // error the renderer keeps its previous configuration.
   void applySettings(const RenderSettings& next) {
     validateSettings(next);
-    vkDeviceWaitIdle(ctx.device());
-    const bool resized = next.width != settings.width || next.height != settings.height;
-    const bool graphChange = resized || next.shadowMapSize != settings.shadowMapSize ||
-                             next.surfacePoints != settings.surfacePoints ||
-                             next.surfacePointSeed != settings.surfacePointSeed ||
-                             next.view != settings.view || next.floorPass != settings.floorPass;
-    const std::vector<EffectConfig> nextEffects = next.effects;
-    const bool effectsChange = [&] {
-      if (nextEffects.size() != settings.effects.size()) return true;
-      for (size_t i = 0; i < nextEffects.size(); ++i)
-        if (nextEffects[i].name != settings.effects[i].name ||
-            nextEffects[i].settings.toJson() != settings.effects[i].settings.toJson())
-          return true;
-      return false;
-    }();
     const RenderSettings old = settings;
-    settings = next;
-    settings.effects = old.effects;
-    if (resized) {
-      graph.reset();
-      output = makeOutputImage(ctx, settings.width, settings.height);
-      if (source.activeCameraNode >= 0)
-        cameraView = activeCamera(sceneGpu->pose(), aspect());
+    auto differs = [](const std::vector<EffectConfig>& a, const std::vector<EffectConfig>& b) {
+      if (a.size() != b.size()) return true;
+      for (size_t i = 0; i < a.size(); ++i)
+        if (a[i].name != b[i].name || a[i].settings.toJson() != b[i].settings.toJson()) return true;
+      return false;
+    };
+    const bool effectsChange = differs(next.effects, old.effects);
+    const bool resized = next.width != old.width || next.height != old.height;
+    const bool graphChange = resized || next.shadowMapSize != old.shadowMapSize ||
+                             next.surfacePoints != old.surfacePoints ||
+                             next.surfacePointSeed != old.surfacePointSeed ||
+                             next.view != old.view || next.floorPass != old.floorPass;
+    auto apply = [&](const RenderSettings& s) {
+      dropGraph();
+      const RenderSettings before = settings;
+      settings = s;
+      settings.effects = before.effects;  // setEffects() changes these
+      if (s.width != before.width || s.height != before.height) resize();
+      if (s.surfacePointSeed != before.surfacePointSeed) surfacePoints.reset();
+      pointsRequested = std::max(pointsRequested, settings.surfacePoints);
+      updateSurfacePoints();
+      updateLights();
+    };
+    try {
+      apply(next);
+      if (effectsChange)
+        setEffects(next.effects);  // rebuilds the graph
       else
-        cameraView = activeCamera(source, aspect());
-      prevViewProj = cameraView.proj * cameraView.view;
-    }
-    if (next.surfacePointSeed != old.surfacePointSeed) surfacePoints.reset();
-    pointsRequested = std::max(pointsRequested, settings.surfacePoints);
-    updateSurfacePoints();
-    if (next.shadowMapSize != old.shadowMapSize || resized) updateLights();
-    recompiledByLastChange = graphChange || effectsChange;
-    if (effectsChange) {
-      setEffects(nextEffects);  // rebuilds the graph
-    } else if (graphChange || graphDirty) {
-      graph.reset();
+        buildGraph();
+    } catch (...) {
+      apply(old);
       buildGraph();
+      throw;
     }
+    recompiledByLastChange = graphChange || effectsChange;
   }
 
   FrameGraph::TextureState stateOf(const std::string& name) {

@@ -342,12 +342,11 @@ uint64_t SceneGpu::triangleCount() const {
   return n;
 }
 
-void SceneGpu::setTime(double seconds, bool firstFrame) {
+void SceneGpu::setTime(double seconds) {
   pose_.animate(seconds);
   for (size_t i = 0; i < instanceNodes_.size(); ++i) {
     GpuInstance& inst = instances_[i];
     const glm::mat4& world = pose_.nodes[instanceNodes_[i]].world;
-    inst.prevModel = firstFrame ? world : inst.model;  // no motion before the first frame
     inst.model = world;
     inst.normalMatrix = glm::mat4(cofactor3(world));
   }
@@ -355,10 +354,22 @@ void SceneGpu::setTime(double seconds, bool firstFrame) {
   updateDeformations();
 }
 
+// The previous model matrix is the one the last rendered frame used (none before the first
+// frame: no motion), like the camera's previous view-projection in the renderer.
 void SceneGpu::beginFrame() {
+  const bool first = rendered_.size() != instances_.size();
+  for (size_t i = 0; i < instances_.size(); ++i) {
+    const glm::mat4 prev = first ? instances_[i].model : rendered_[i];
+    if (prev != instances_[i].prevModel) {
+      instances_[i].prevModel = prev;
+      instancesDirty_ = true;
+    }
+  }
   if (instancesDirty_ && !instances_.empty())
     instanceBuffer_.write(instances_.data(), instances_.size() * sizeof(GpuInstance));
   instancesDirty_ = false;
+  rendered_.resize(instances_.size());
+  for (size_t i = 0; i < instances_.size(); ++i) rendered_[i] = instances_[i].model;
   viewSlotsUsed_ = 0;
 }
 

@@ -41,10 +41,11 @@ class SceneGpu final : public GpuScene {
   // pass), which declareRead() makes passes read.
   void setVertices(BufferHandle h) { vertices_ = h; }
   BufferHandle currentVertices() const { return vertices_; }
-  // Start of a frame: uploads changed instance matrices, recycles the per-view uniform slots.
+  // Start of a frame: previous model matrices = the last rendered frame's, uploads changed
+  // instance matrices, recycles the per-view uniform slots.
   void beginFrame();
-  // Poses the scene at `seconds`; returns false when nothing was animated.
-  void setTime(double seconds, bool firstFrame);
+  // Poses the scene at `seconds` (instance matrices, joints, morphed rest vertices).
+  void setTime(double seconds);
   const Scene& pose() const { return pose_; }
   const Scene& source() const { return scene_; }
 
@@ -90,6 +91,7 @@ class SceneGpu final : public GpuScene {
   std::vector<SceneDrawItem> draws_;
   std::vector<int> instanceNodes_;  // node of each GpuInstance
   std::vector<GpuInstance> instances_;
+  std::vector<glm::mat4> rendered_;  // model matrices of the last rendered frame
   bool instancesDirty_ = true;
   std::vector<Deformed> deformed_;
   std::vector<SurfacePointsPass::InstanceRef> instanceRefs_;
