@@ -329,7 +329,7 @@ TEST_F(EngineServicesTest, CubeFacesSeeTheirOwnWalls) {
     double sum = 0.0;
     for (int y = 14; y < 18; ++y)
       for (int x = 14; x < 18; ++x)
-        sum += d.pixels[(size_t((f / 3) * 32 + y) * 96 + (f % 3) * 32 + x) * 4];
+        sum += d.pixels[(size_t((f / 3) * 32 + y) * 96 + size_t((f % 3) * 32 + x)) * 4];
     const float depth = float(sum / 16.0);
     // perspectiveReverseZ: depth = near (far - z) / ((far - near) z).
     const float z = znear * zfar / (depth * (zfar - znear) + znear);

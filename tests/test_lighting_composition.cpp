@@ -170,7 +170,7 @@ TEST_F(LightingCompositionTest, AfterLightingEffectsRunInDependencyOrderWhatever
     ASSERT_NE(first, f.passes.end());
     ASSERT_NE(second, f.passes.end());
     EXPECT_LT(first - f.passes.begin(), second - f.passes.begin()) << order[0];
-    EXPECT_EQ(f.lit.pixels[1], 1.0f) << "tonemap reads the last writer's lit";
+    EXPECT_EQ(f.lit.pixels[1], 1.0f) << "the blackboard's lit is the last writer's";
   }
 }
 

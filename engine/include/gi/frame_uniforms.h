@@ -21,6 +21,7 @@ struct FrameUniforms {
   glm::vec4 options;          // PCF radius in texels, 0, 0, 0
 };
 
-static_assert(sizeof(FrameUniforms) == 6 * 64 + 17 * 16, "std140 mirror of common.glsl");
+static_assert(sizeof(FrameUniforms) == 6 * sizeof(glm::mat4) + 17 * sizeof(glm::vec4),
+              "std140 mirror of common.glsl");
 
 }  // namespace gi

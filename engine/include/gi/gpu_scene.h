@@ -36,8 +36,8 @@ struct GpuMaterial {
   glm::vec4 emission;   // rgb radiance
   glm::vec4 params;     // roughness, metallic, base-colour texture index (-1 none), 0
 };
-static_assert(sizeof(GpuInstance) == 3 * 64 + 16);
-static_assert(sizeof(GpuMaterial) == 3 * 16);
+static_assert(sizeof(GpuInstance) == 3 * sizeof(glm::mat4) + sizeof(glm::uvec4));
+static_assert(sizeof(GpuMaterial) == 3 * sizeof(glm::vec4));
 
 // One indexed draw of one mesh instance (vertexOffset already points at deformed copies).
 struct SceneDrawItem {

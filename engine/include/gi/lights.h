@@ -52,7 +52,7 @@ struct LightInfo {
   uint32_t index = 0;                      // its record in "lights"
 };
 
-static_assert(sizeof(GpuLight) == 5 * 16);
-static_assert(sizeof(GpuShadowView) == 64 + 2 * 16);
+static_assert(sizeof(GpuLight) == 5 * sizeof(glm::vec4));
+static_assert(sizeof(GpuShadowView) == sizeof(glm::mat4) + 2 * sizeof(glm::vec4));
 
 }  // namespace gi

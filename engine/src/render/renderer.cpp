@@ -589,7 +589,10 @@ struct Renderer::Impl : EffectContext {
     auto restore = [&] {
       for (ActiveEffect& a : effects)
         for (size_t i = 0; i < oldConfigs.size(); ++i)
-          if (oldConfigs[i].name == a.info.name && !previous[i].effect) previous[i] = std::move(a);
+          if (oldConfigs[i].name == a.info.name && !previous[i].effect) {
+            previous[i] = std::move(a);
+            break;
+          }
       effects = std::move(previous);
       settings.effects = oldConfigs;
       for (size_t i = 0; i < effects.size(); ++i) {

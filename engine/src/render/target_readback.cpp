@@ -59,7 +59,7 @@ ImageRGBA32F texelsToFloat(const std::vector<uint8_t>& raw, const FrameGraph::Te
         std::memcpy(o, &raw[i * 16], 16);
         break;
       case VK_FORMAT_R16G16B16A16_SFLOAT:
-        for (int c = 0; c < 4; ++c) o[c] = half(i * 8 + c * 2);
+        for (size_t c = 0; c < 4; ++c) o[c] = half(i * 8 + c * 2);
         break;
       case VK_FORMAT_R16G16_SFLOAT:
         o[0] = half(i * 4);
