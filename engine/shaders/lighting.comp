@@ -27,6 +27,10 @@ layout(set = 0, binding = 11) uniform sampler2D ambientTexture;   // linear, any
 layout(set = 0, binding = 12) uniform sampler2D indirectTexture;  // linear, any size
 // Equirect environment map (kind 2; a 1x1 dummy otherwise).
 layout(set = 0, binding = 13) uniform sampler2D environmentMap;
+// Which optional inputs an effect published (bit 0 ao, 1 ambient, 2 indirect). The others are
+// the graph's neutral stand-ins (ao 1, ambient alpha 0, indirect 0: the values the renderer
+// declares), so they are not fetched at all: three fetches of ~20 cost ~10% of the pass.
+layout(push_constant) uniform Inputs { uint present; } inputs;
 
 const float PI = 3.14159265358979;
 
@@ -81,14 +85,16 @@ void main() {
     vec3 brdf = diffuseColor / PI + f0 * spec;
     color += brdf * incident * ndl * visibility;
   }
-  vec4 ambient = optionalInput(ambientTexture, p, size, uv);
+  vec4 ambient = (inputs.present & 2u) != 0u ? optionalInput(ambientTexture, p, size, uv) : vec4(0.0);
   if (ambient.a > 0.5) {
     color += max(ambient.rgb, vec3(0.0));
   } else {
     vec3 nWorld = mat3(frame.invView) * n;
-    float ao = clamp(optionalInput(aoTexture, p, size, uv).r, 0.0, 1.0);
+    float ao = (inputs.present & 1u) != 0u ? clamp(optionalInput(aoTexture, p, size, uv).r, 0.0, 1.0)
+                                           : 1.0;
     color += diffuseColor * environmentIrradianceOverPi(frame, nWorld) * ao;
   }
-  color += max(optionalInput(indirectTexture, p, size, uv).rgb, vec3(0.0));
+  if ((inputs.present & 4u) != 0u)
+    color += max(optionalInput(indirectTexture, p, size, uv).rgb, vec3(0.0));
   imageStore(outLit, p, vec4(color, 1.0));
 }

@@ -42,12 +42,14 @@ class LightingPass final : public Effect {
                                        {10, tex},
                                        {11, tex},
                                        {12, tex},
-                                       {13, tex}});
+                                       {13, tex}},
+                                      sizeof(uint32_t));  // which optional inputs exist
   }
   void addPasses(FrameGraph& graph, EffectContext& ctx, const SettingValues&) override {
     struct Io {
       TextureHandle gbuffer[5], shadowMaps, ao, ambient, indirect, environment, lit;
       BufferHandle lights, shadowViews;
+      uint32_t present = 0;  // bit 0 ao, 1 ambient, 2 indirect published (not the fallback)
     };
     auto io = std::make_shared<Io>();
     Blackboard& bb = graph.blackboard();
@@ -63,6 +65,8 @@ class LightingPass final : public Effect {
           io->ao = b.readOptional(res::kAO);
           io->ambient = b.readOptional(res::kAmbient);
           io->indirect = b.readOptional(res::kIndirect);
+          io->present = (b.isFallback(io->ao) ? 0u : 1u) | (b.isFallback(io->ambient) ? 0u : 2u) |
+                        (b.isFallback(io->indirect) ? 0u : 4u);
           io->environment = b.read(bb.texture(res::kEnvironmentMap));
           io->lit = b.write(b.create(res::kLit, TextureDesc{VK_FORMAT_R16G16B16A16_SFLOAT}),
                             TextureUsage::StorageWrite);
@@ -81,6 +85,8 @@ class LightingPass final : public Effect {
               .sampled(12, pc.view(io->indirect), linear)
               .sampled(13, pc.view(io->environment), s_.scene.linearRepeat());
           pc.descriptors().bind(pc.cmd(), pipeline_, w);
+          vkCmdPushConstants(pc.cmd(), pipeline_.layout(), VK_SHADER_STAGE_ALL, 0,
+                             sizeof io->present, &io->present);
           const VkExtent2D e = pc.extent(io->lit);
           vkCmdDispatch(pc.cmd(), screenGroups(e.width, kScreenGroupX),
                         screenGroups(e.height, kScreenGroupY), 1);
