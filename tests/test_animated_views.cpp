@@ -51,6 +51,20 @@ int nodeWith(const Scene& s, bool light) {
   return -1;
 }
 
+// A 2-second looping clip sliding `node` (given TRS first) from `from` at 0 s to `to` at 1 s.
+void addSlideClip(Scene& s, int node, const glm::vec3& from, const glm::vec3& to) {
+  toTRS(s.nodes[node]);
+  AnimationClip clip;
+  AnimationSampler sampler;
+  sampler.times = {0.0f, 1.0f};
+  sampler.components = 3;
+  sampler.values = {from.x, from.y, from.z, to.x, to.y, to.z};
+  clip.samplers.push_back(sampler);
+  clip.channels.push_back({0, node, AnimationPath::Translation});
+  clip.duration = 2.0f;
+  s.animations.push_back(clip);
+}
+
 // A clip on `node`: rotation keys (x, y, z, w) at the given times.
 void addRotationClip(Scene& s, int node, const std::vector<float>& times,
                      const std::vector<glm::quat>& keys) {
@@ -136,16 +150,7 @@ TEST_F(AnimatedViewTest, MovingCameraFollowsItsNodeAndWritesMotionVectors) {
   Scene scene = boxScene();
   const int cam = nodeWith(scene, false);
   ASSERT_GE(cam, 0);
-  toTRS(scene.nodes[cam]);
-  AnimationClip clip;
-  AnimationSampler sampler;
-  sampler.times = {0.0f, 1.0f};
-  sampler.components = 3;
-  sampler.values = {0, 5, 0, 0.5f, 5, 0};  // slides 0.5 along +x
-  clip.samplers.push_back(sampler);
-  clip.channels.push_back({0, cam, AnimationPath::Translation});
-  clip.duration = 2.0f;
-  scene.animations.push_back(clip);
+  addSlideClip(scene, cam, {0, 5, 0}, {0.5f, 5, 0});  // slides 0.5 along +x
   scene.animate(0.0);
 
   RenderSettings rs;
@@ -192,16 +197,7 @@ TEST_F(AnimatedViewTest, ObjectMotionIsAgainstTheLastRenderedFrame) {
   for (size_t i = 0; i < scene.nodes.size(); ++i)
     if (!scene.nodes[i].meshes.empty() && scene.nodes[i].world[3].y > 0.5f) box = int(i);
   ASSERT_GE(box, 0);
-  toTRS(scene.nodes[box]);
-  AnimationClip clip;
-  AnimationSampler sampler;
-  sampler.times = {0.0f, 1.0f};
-  sampler.components = 3;
-  sampler.values = {0, 1, 0, 1.0f, 1, 0};  // slides 1 along +x
-  clip.samplers.push_back(sampler);
-  clip.channels.push_back({0, box, AnimationPath::Translation});
-  clip.duration = 2.0f;
-  scene.animations.push_back(clip);
+  addSlideClip(scene, box, {0, 1, 0}, {1.0f, 1, 0});  // slides 1 along +x
   RenderSettings rs;
   rs.width = 80;
   rs.height = 60;
