@@ -14,7 +14,6 @@ layout(push_constant) uniform Push {
   mat4 model;
   mat3 normalMatrix;
   uint instance;
-  uint material;
 } pc;
 
 // Few varyings: on llvmpipe the per-triangle set-up cost grows with them, and for small

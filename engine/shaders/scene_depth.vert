@@ -7,7 +7,7 @@
 
 layout(location = 0) in vec3 inPosition;
 
-layout(set = 0, binding = 1) uniform View { DrawView drawView; };
+layout(set = 0, binding = 0) uniform View { DrawView drawView; };
 // The instance's model matrix as a push constant (DrawPush in scene_gpu.cpp): a per-vertex
 // read of the instance buffer costs one load per lane on llvmpipe.
 layout(push_constant) uniform Push { mat4 model; } pc;

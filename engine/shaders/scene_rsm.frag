@@ -7,7 +7,7 @@
 #include "material.glsl"
 #include "scene_view.glsl"
 
-layout(set = 0, binding = 1) uniform View { DrawView drawView; };
+layout(set = 0, binding = 0) uniform View { DrawView drawView; };
 layout(set = 0, binding = 3) uniform sampler2D baseColorTexture;
 
 layout(location = 0) in vec3 inWorldPos;

@@ -8,13 +8,12 @@ layout(location = 0) in vec3 inPosition;
 layout(location = 1) in vec3 inNormal;
 layout(location = 2) in vec2 inUV;
 
-layout(set = 0, binding = 1) uniform View { DrawView drawView; };
+layout(set = 0, binding = 0) uniform View { DrawView drawView; };
 // Per draw, as gbuffer.vert (DrawPush in scene_gpu.cpp).
 layout(push_constant) uniform Push {
   mat4 model;
   mat3 normalMatrix;
   uint instance;
-  uint material;
 } pc;
 
 layout(location = 0) out vec3 outWorldPos;

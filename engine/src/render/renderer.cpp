@@ -68,6 +68,22 @@ Image makeNoShadowsImage(Context& ctx) {
   return img;
 }
 
+// The camera part of a view's uniforms: matrices, viewport, position, depth range.
+void setCamera(FrameUniforms& f, const CameraView& c, VkExtent2D extent,
+               const glm::mat4& prevViewProj) {
+  f.view = c.view;
+  f.proj = c.proj;
+  f.viewProj = c.proj * c.view;
+  f.invView = glm::inverse(c.view);
+  f.invProj = glm::inverse(c.proj);
+  f.prevViewProj = prevViewProj;
+  const float w = float(std::max(extent.width, 1u)), h = float(std::max(extent.height, 1u));
+  f.viewport = glm::vec4(w, h, 1.0f / w, 1.0f / h);
+  f.cameraPos = glm::vec4(c.position, 1.0f);
+  f.params.z = c.znear;
+  f.params.w = c.zfar;
+}
+
 // An extra view's uniforms: the main view's frame-wide values with this view's camera.
 class ViewUniformsImpl final : public ViewUniforms {
  public:
@@ -79,24 +95,15 @@ class ViewUniformsImpl final : public ViewUniforms {
   }
   VkBuffer buffer() const override { return buffer_.handle(); }
   const FrameUniforms& current() const override { return data_; }
-  // Called by the renderer before each frame.
-  void refresh(const FrameUniforms& main, const glm::mat4& prevViewProj) {
+  // Called by the renderer before each frame; motion is against the last refreshed camera.
+  void refresh(const FrameUniforms& main) {
+    const glm::mat4 viewProj = camera_.proj * camera_.view;
     data_ = main;
-    data_.view = camera_.view;
-    data_.proj = camera_.proj;
-    data_.viewProj = camera_.proj * camera_.view;
-    data_.invView = glm::inverse(camera_.view);
-    data_.invProj = glm::inverse(camera_.proj);
-    data_.prevViewProj = seen_ ? prevViewProj : data_.viewProj;
-    const float w = float(std::max(extent_.width, 1u)), h = float(std::max(extent_.height, 1u));
-    data_.viewport = glm::vec4(w, h, 1.0f / w, 1.0f / h);
-    data_.cameraPos = glm::vec4(camera_.position, 1.0f);
-    data_.params.z = camera_.znear;
-    data_.params.w = camera_.zfar;
+    gi::setCamera(data_, camera_, extent_, seen_ ? prevViewProj_ : viewProj);
     buffer_.write(&data_, sizeof data_);
+    prevViewProj_ = viewProj;
     seen_ = true;
   }
-  glm::mat4 viewProj() const { return camera_.proj * camera_.view; }
   void forgetHistory() { seen_ = false; }  // no motion into the next frame (resize)
 
  private:
@@ -104,6 +111,7 @@ class ViewUniformsImpl final : public ViewUniforms {
   CameraView camera_;
   VkExtent2D extent_{1, 1};
   FrameUniforms data_{};
+  glm::mat4 prevViewProj_{1.0f};
   bool seen_ = false;
 };
 
@@ -114,10 +122,6 @@ struct Renderer::Impl : EffectContext {
     std::unique_ptr<Effect> effect;
     EffectInfo info;
     SettingValues settings;
-  };
-  struct TrackedView {
-    std::weak_ptr<ViewUniformsImpl> view;
-    glm::mat4 prevViewProj{1.0f};
   };
 
   Context& ctx;
@@ -137,7 +141,7 @@ struct Renderer::Impl : EffectContext {
   glm::mat4 prevViewProj{1.0f};  // the camera of the previous frame (motion vectors)
   double timeSeconds = 0.0, lastFrameTime = 0.0;
   uint64_t framesRendered = 0;
-  std::vector<TrackedView> views;
+  std::vector<std::weak_ptr<ViewUniformsImpl>> views;  // extra views, refreshed per frame
   std::unique_ptr<EngineState> state;
 
   // Built-in passes, in frame order around the effects.
@@ -231,7 +235,7 @@ struct Renderer::Impl : EffectContext {
   GpuScene& scene() override { return *sceneGpu; }
   std::shared_ptr<ViewUniforms> createView() override {
     auto v = std::make_shared<ViewUniformsImpl>(ctx);
-    views.push_back({v, glm::mat4(1.0f)});
+    views.push_back(v);
     return v;
   }
   const CameraView& camera() override { return cameraView; }
@@ -456,16 +460,6 @@ struct Renderer::Impl : EffectContext {
   // The main view's uniforms of the coming frame (frameData, uploaded).
   void updateFrameUniforms() {
     FrameUniforms f{};
-    const CameraView& c = cameraView;
-    f.view = c.view;
-    f.proj = c.proj;
-    f.viewProj = c.proj * c.view;
-    f.invView = glm::inverse(c.view);
-    f.invProj = glm::inverse(c.proj);
-    f.prevViewProj = prevViewProj;
-    f.viewport =
-        glm::vec4(settings.width, settings.height, 1.0f / settings.width, 1.0f / settings.height);
-    f.cameraPos = glm::vec4(c.position, 1.0f);
     const Environment& e = source.environment;
     const bool constant = e.kind == Environment::Kind::Constant;
     const bool map = e.kind == Environment::Kind::Map && e.mapWidth > 0 && e.mapHeight > 0 &&
@@ -475,7 +469,8 @@ struct Renderer::Impl : EffectContext {
     f.skyZenith = glm::vec4(e.zenithColor, std::max(e.intensity, 0.0f) * scale);
     f.skyHorizon = glm::vec4(e.horizonColor, kind);
     f.skyGround = glm::vec4(constant ? e.constantColor : e.groundColor, 0.0f);
-    f.params = glm::vec4(settings.exposure, float(lightSetup.lights.size()), c.znear, c.zfar);
+    f.params = glm::vec4(settings.exposure, float(lightSetup.lights.size()), 0.0f, 0.0f);
+    setCamera(f, cameraView, {settings.width, settings.height}, prevViewProj);
     const SH9& sh = environment->irradiance();
     for (int i = 0; i < 9; ++i) f.irradianceSH[i] = glm::vec4(sh[i] * scale, 0.0f);
     f.time = glm::vec4(float(timeSeconds), float(framesRendered),
@@ -488,14 +483,8 @@ struct Renderer::Impl : EffectContext {
   // Extra views: frame-wide values from the main view, their own camera (after the effects'
   // update() hooks moved them).
   void updateViews() {
-    views.erase(std::remove_if(views.begin(), views.end(),
-                               [](const TrackedView& v) { return v.view.expired(); }),
-                views.end());
-    for (TrackedView& v : views) {
-      auto view = v.view.lock();
-      view->refresh(frameData, v.prevViewProj);
-      v.prevViewProj = view->viewProj();
-    }
+    std::erase_if(views, [](const std::weak_ptr<ViewUniformsImpl>& v) { return v.expired(); });
+    for (const auto& v : views) v.lock()->refresh(frameData);
   }
 
   // Ends `c`, submits it and waits for it to complete.
@@ -638,8 +627,8 @@ struct Renderer::Impl : EffectContext {
     output = makeOutputImage(ctx, settings.width, settings.height);
     cameraView = activeCamera(source.activeCameraNode >= 0 ? sceneGpu->pose() : source, aspect());
     prevViewProj = cameraView.proj * cameraView.view;
-    for (TrackedView& v : views)
-      if (auto view = v.view.lock()) view->forgetHistory();
+    for (const auto& v : views)
+      if (auto view = v.lock()) view->forgetHistory();
   }
 
   // Engine settings, size, view and effect list in one call (what a settings UI changes). On an

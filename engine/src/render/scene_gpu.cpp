@@ -33,9 +33,9 @@ constexpr VkDeviceSize kViewSlotBytes = 256;
 struct DrawPush {
   glm::mat4 model;
   glm::vec4 normalMatrix[3];
-  uint32_t instance, material;
+  uint32_t instance;
 };
-static_assert(sizeof(DrawPush) == 120 && sizeof(DrawPush) <= 128, "guaranteed push range");
+static_assert(sizeof(DrawPush) == 116 && sizeof(DrawPush) <= 128, "guaranteed push range");
 
 // material.glsl's uniform block, one 256-byte slot per material (the largest offset alignment
 // Vulkan allows), bound with the material's descriptor set.
@@ -308,6 +308,8 @@ void SceneGpu::createPipelines() {
   GraphicsDesc g;
   g.vertex = loadSpirv("gbuffer.vert");
   g.fragment = loadSpirv("gbuffer.frag");
+  // Shared set layout of the scene draws: 0 the view's uniforms (FrameUniforms or DrawView),
+  // 1 instances, 2 the material's uniform slot, 3 its base-colour texture (depth: 0 only).
   g.bindings = {{0, ubo}, {1, ssbo}, {2, ubo}, {3, tex}};
   g.pushConstantBytes = sizeof(DrawPush);
   g.vertexLayout.stride = sizeof(Vertex);
@@ -319,7 +321,7 @@ void SceneGpu::createPipelines() {
   GraphicsDesc d;
   d.vertex = loadSpirv("scene_depth.vert");
   d.fragment = loadSpirv("scene_depth.frag");
-  d.bindings = {{0, ssbo}, {1, ubo}};
+  d.bindings = {{0, ubo}};
   d.pushConstantBytes = sizeof(glm::mat4);
   d.vertexLayout.stride = sizeof(Vertex);
   d.vertexLayout.attributes = {fullVertex[0]};
@@ -329,7 +331,7 @@ void SceneGpu::createPipelines() {
   GraphicsDesc r = g;
   r.vertex = loadSpirv("scene_rsm.vert");
   r.fragment = loadSpirv("scene_rsm.frag");
-  r.bindings = {{0, ssbo}, {1, ubo}, {2, ubo}, {3, tex}};
+  r.bindings = {{0, ubo}, {1, ssbo}, {2, ubo}, {3, tex}};
   r.colorFormats = sceneColorFormats(SceneOutputs::ReflectiveShadowMap);
   rsmPipeline_ = Pipeline::graphics(ctx_, r);
 }
@@ -539,10 +541,9 @@ void SceneGpu::bindMaterial(PassContext& pc, const Pipeline& p, uint32_t materia
                             VkBuffer uniforms, VkDeviceSize offset, VkDeviceSize range) {
   const Material& m = materials_[material];
   const bool textured = m.baseColorTexture >= 0 && m.baseColorTexture < int(textures_.size());
-  const bool gbuffer = &p == &gbufferPipeline_;
   DescriptorWriter w;
-  w.buffer(gbuffer ? 0 : 1, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms, offset, range)
-      .buffer(gbuffer ? 1 : 0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, instanceBuffer_.handle())
+  w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms, offset, range)
+      .buffer(1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, instanceBuffer_.handle())
       .buffer(2, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, materialUniforms_.handle(),
               material * kMaterialSlotBytes, sizeof(MaterialUniforms))
       .sampled(3, textured ? textures_[m.baseColorTexture].view() : whiteTexture_.view(),
@@ -557,7 +558,6 @@ void SceneGpu::pushDraw(VkCommandBuffer cmd, const Pipeline& p, const SceneDrawI
   push.model = inst.model;
   for (int c = 0; c < 3; ++c) push.normalMatrix[c] = inst.normalMatrix[c];
   push.instance = d.instance;
-  push.material = d.material;
   vkCmdPushConstants(cmd, p.layout(), VK_SHADER_STAGE_ALL, 0,
                      modelOnly ? uint32_t(sizeof(glm::mat4)) : uint32_t(sizeof push), &push);
 }
@@ -605,8 +605,7 @@ void SceneGpu::drawDepth(PassContext& pc, const SceneTargets& t, std::span<const
     const VkDescriptorBufferInfo slot = viewSlot(v, nullptr, t.extent);
     setViewport(c, v, t.extent);
     DescriptorWriter w;
-    w.buffer(0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, instanceBuffer_.handle())
-        .buffer(1, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, slot.buffer, slot.offset, slot.range);
+    w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, slot.buffer, slot.offset, slot.range);
     pc.descriptors().bind(c, depthPipeline_, w);
     for (const SceneDrawItem& d : draws_) {
       pushDraw(c, depthPipeline_, d, true);
