@@ -61,6 +61,12 @@ vk::Pipeline computePipeline(vk::Context& ctx, const std::string& source, const 
                                bindings, pushBytes);
 }
 
+// The pipeline of fillSource(image): one storage image, FillPush as push constants.
+vk::Pipeline fillPipeline(vk::Context& ctx, const std::string& image, const std::string& name) {
+  return computePipeline(ctx, fillSource(image), name, {{0, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE}},
+                         sizeof(FillPush));
+}
+
 // Fills a storage view of `extent` (depth = layers or slices) with the FillPush pattern.
 void fill(PassContext& pc, const vk::Pipeline& p, VkImageView view, VkExtent3D extent,
           FillPush push) {
@@ -113,8 +119,7 @@ void run(vk::Context& ctx, FrameGraph& g) {
 TEST_F(FrameGraphLayersTest, PerLayerWritesThenWholeArrayRead) {
   constexpr uint32_t kSize = 32, kLayers = 4;
   FrameGraph g(ctx(), {kSize, kSize});
-  vk::Pipeline fill2D = computePipeline(ctx(), fillSource("image2D"), "fill2d.comp",
-                                        {{0, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE}}, 16);
+  vk::Pipeline fill2D = fillPipeline(ctx(), "image2D", "fill2d.comp");
   vk::Pipeline gather = computePipeline(
       ctx(),
       "#version 450\nlayout(local_size_x = 4, local_size_y = 4, local_size_z = 1) in;\n"
@@ -232,8 +237,7 @@ std::string downsampleSource(bool storageSource) {
 TEST_F(FrameGraphLayersTest, MipChainPassPerMip) {
   constexpr uint32_t kSize = 32;
   FrameGraph g(ctx(), {kSize, kSize});
-  vk::Pipeline fill2D = computePipeline(ctx(), fillSource("image2D"), "fill2d.comp",
-                                        {{0, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE}}, 16);
+  vk::Pipeline fill2D = fillPipeline(ctx(), "image2D", "fill2d.comp");
   vk::Pipeline down = computePipeline(
       ctx(), downsampleSource(false), "down.comp",
       {{0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER}, {1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE}}, 0);
@@ -284,8 +288,7 @@ TEST_F(FrameGraphLayersTest, MipChainPassPerMip) {
 TEST_F(FrameGraphLayersTest, MipChainInOnePassWithInternalBarriers) {
   constexpr uint32_t kSize = 32;
   FrameGraph g(ctx(), {kSize, kSize});
-  vk::Pipeline fill2D = computePipeline(ctx(), fillSource("image2D"), "fill2d.comp",
-                                        {{0, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE}}, 16);
+  vk::Pipeline fill2D = fillPipeline(ctx(), "image2D", "fill2d.comp");
   vk::Pipeline down = computePipeline(
       ctx(), downsampleSource(true), "down_storage.comp",
       {{0, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE}, {1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE}}, 0);
@@ -328,10 +331,8 @@ TEST_F(FrameGraphLayersTest, MipChainInOnePassWithInternalBarriers) {
 // and a 3-D texture, written and read back exactly.
 TEST_F(FrameGraphLayersTest, CubeAndVolumeTextures) {
   FrameGraph g(ctx(), {16, 16});
-  vk::Pipeline fillArray = computePipeline(ctx(), fillSource("image2DArray"), "fill_array.comp",
-                                           {{0, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE}}, 16);
-  vk::Pipeline fill3D = computePipeline(ctx(), fillSource("image3D"), "fill3d.comp",
-                                        {{0, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE}}, 16);
+  vk::Pipeline fillArray = fillPipeline(ctx(), "image2DArray", "fill_array.comp");
+  vk::Pipeline fill3D = fillPipeline(ctx(), "image3D", "fill3d.comp");
   vk::Pipeline lookup = computePipeline(
       ctx(),
       "#version 450\nlayout(local_size_x = 1) in;\n"
@@ -407,8 +408,7 @@ TEST_F(FrameGraphLayersTest, CubeAndVolumeTextures) {
 TEST_F(FrameGraphLayersTest, ArrayAndCubeAliasMemory) {
   constexpr uint32_t kSize = 16;
   FrameGraph g(ctx(), {kSize, kSize});
-  vk::Pipeline fillArray = computePipeline(ctx(), fillSource("image2DArray"), "fill_array.comp",
-                                           {{0, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE}}, 16);
+  vk::Pipeline fillArray = fillPipeline(ctx(), "image2DArray", "fill_array.comp");
   vk::Buffer arrayOut(ctx(), kSize * kSize * 2 * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
   vk::Buffer cubeOut(ctx(), kSize * kSize * 6 * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
   TextureHandle arr, cube;
@@ -531,8 +531,7 @@ TEST_F(FrameGraphLayersTest, PartialWritesKeepEarlierProducers) {
 // after a resize, which recreates it cleared to zero.
 TEST_F(FrameGraphLayersTest, PersistentHistoryAcrossFramesAndResize) {
   FrameGraph g(ctx(), {16, 16});
-  vk::Pipeline fill2D = computePipeline(ctx(), fillSource("image2D"), "fill2d.comp",
-                                        {{0, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE}}, 16);
+  vk::Pipeline fill2D = fillPipeline(ctx(), "image2D", "fill2d.comp");
   vk::Buffer out(ctx(), 16 * 16 * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
   TextureDesc desc{kR32};  // output-relative
   float frameValue = 0;
@@ -611,8 +610,7 @@ TEST_F(FrameGraphLayersTest, PersistentHistoryAcrossFramesAndResize) {
 TEST_F(FrameGraphLayersTest, OptionalReadsFallBackToNeutralTexture) {
   FrameGraph g(ctx(), {16, 16});
   g.declareFallback("ao", kR32, VkClearColorValue{{1.0f, 0, 0, 0}});
-  vk::Pipeline fill2D = computePipeline(ctx(), fillSource("image2D"), "fill2d.comp",
-                                        {{0, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE}}, 16);
+  vk::Pipeline fill2D = fillPipeline(ctx(), "image2D", "fill2d.comp");
   vk::Pipeline sample = computePipeline(
       ctx(),
       "#version 450\nlayout(local_size_x = 1) in;\n"

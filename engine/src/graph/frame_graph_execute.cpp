@@ -41,47 +41,29 @@ struct SubNeed {
 // Persistent and fallback images start cleared (zero, or the fallback's value): recorded at the
 // start of the frame, then treated as a write.
 void FrameGraph::clearOwned(VkCommandBuffer cmd) {
-  std::vector<Owned*> owned;
-  for (auto& [name, o] : persistent_)
-    if (o->needsClear) owned.push_back(o.get());
-  for (auto& [name, o] : fallbacks_)
-    if (o->needsClear) owned.push_back(o.get());
-  if (owned.empty()) return;
-  std::vector<VkImageMemoryBarrier2> barriers;
-  for (Owned* o : owned) {
-    VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
-    b.srcStageMask = VK_PIPELINE_STAGE_2_NONE;
-    b.dstStageMask = VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT;
-    b.dstAccessMask = VK_ACCESS_2_TRANSFER_WRITE_BIT;
-    b.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-    b.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
-    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-    b.image = o->image;
-    b.subresourceRange = {graph_detail::aspectOf(o->dims.format), 0, VK_REMAINING_MIP_LEVELS, 0,
-                          VK_REMAINING_ARRAY_LAYERS};
-    barriers.push_back(b);
-  }
-  VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-  dep.imageMemoryBarrierCount = uint32_t(barriers.size());
-  dep.pImageMemoryBarriers = barriers.data();
-  vkCmdPipelineBarrier2(cmd, &dep);
   const SyncState cleared{VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
                           VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT};
-  for (size_t i = 0; i < owned.size(); ++i) {
-    Owned* o = owned[i];
-    const VkImageSubresourceRange& range = barriers[i].subresourceRange;
-    if (vk::isDepthFormat(o->dims.format)) {
+  auto clear = [&](Owned& o) {
+    if (!o.needsClear) return;
+    const VkImageAspectFlags aspect = graph_detail::aspectOf(o.dims.format);
+    vk::imageBarrier(cmd, o.image, aspect, VK_IMAGE_LAYOUT_UNDEFINED,
+                     VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_NONE, 0,
+                     VK_PIPELINE_STAGE_2_ALL_TRANSFER_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
+    const VkImageSubresourceRange range{aspect, 0, VK_REMAINING_MIP_LEVELS, 0,
+                                        VK_REMAINING_ARRAY_LAYERS};
+    if (vk::isDepthFormat(o.dims.format)) {
       VkClearDepthStencilValue zero{};
-      vkCmdClearDepthStencilImage(cmd, o->image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &zero, 1,
+      vkCmdClearDepthStencilImage(cmd, o.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &zero, 1,
                                   &range);
     } else {
-      vkCmdClearColorImage(cmd, o->image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &o->clear, 1,
-                           &range);
+      vkCmdClearColorImage(cmd, o.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &o.clear, 1, &range);
     }
-    for (SubState& s : o->subs) s = {cleared, cleared, {}};
-    o->needsClear = false;
-    o->written = false;
-  }
+    for (SubState& s : o.subs) s = {cleared, cleared, {}};
+    o.needsClear = false;
+    o.written = false;
+  };
+  for (auto& [name, o] : persistent_) clear(*o);
+  for (auto& [name, o] : fallbacks_) clear(*o);
 }
 
 void FrameGraph::execute(VkCommandBuffer cmd, vk::DescriptorArena& descriptors, vk::GpuTimer* timer,

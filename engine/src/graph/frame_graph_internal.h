@@ -164,7 +164,6 @@ struct FrameGraph::Pass {
 // An image the graph owns beyond one compile: a persistent (history) or fallback texture.
 struct FrameGraph::Owned {
   vk::Context* ctx = nullptr;
-  TextureDesc desc;
   graph_detail::TextureDims dims;
   VkImage image = VK_NULL_HANDLE;
   vk::Allocation allocation;
