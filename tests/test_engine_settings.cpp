@@ -20,18 +20,7 @@
 namespace gi {
 namespace {
 
-void expectError(const std::function<void()>& f, ErrorKind kind,
-                 const std::vector<std::string>& fragments) {
-  try {
-    f();
-    ADD_FAILURE() << "expected an error";
-  } catch (const Error& e) {
-    EXPECT_EQ(e.kind(), kind) << e.what();
-    for (const std::string& frag : fragments)
-      EXPECT_NE(std::string(e.what()).find(frag), std::string::npos)
-          << "'" << frag << "' missing from: " << e.what();
-  }
-}
+using test::expectError;
 
 TEST(EngineSettings, DefaultsAreRenderSettingsDefaults) {
   const std::vector<SettingDesc> descs = engineSettingDescs();

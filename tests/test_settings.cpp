@@ -12,6 +12,7 @@
 #include "gi/effect_registry.h"
 #include "gi/errors.h"
 #include "gi/settings.h"
+#include "test_support.h"
 
 namespace gi {
 namespace {
@@ -36,19 +37,7 @@ SettingValues fresh() {
   return SettingValues("fx", allTypes());
 }
 
-// Each bad input must fail with the expected kind and a message containing all the fragments.
-void expectError(const std::function<void()>& f, ErrorKind kind,
-                 const std::vector<std::string>& fragments) {
-  try {
-    f();
-    ADD_FAILURE() << "expected an error";
-  } catch (const Error& e) {
-    EXPECT_EQ(e.kind(), kind) << e.what();
-    for (const std::string& frag : fragments)
-      EXPECT_NE(std::string(e.what()).find(frag), std::string::npos)
-          << "'" << frag << "' missing from: " << e.what();
-  }
-}
+using test::expectError;
 
 using Vec = std::array<double, 3>;
 

@@ -10,7 +10,7 @@
 //   #define GI_ENVIRONMENT_BINDING_SAMPLING 6  // storage buffer: EnvironmentGpu::samplingBuffer()
 //
 // Sampling buffer (std430; W x H = the map's size; offsets count floats into data[]):
-//   uvec4 header   W, H, kind (0 sky, 1 constant, 2 map: as FrameUniforms.skyHorizon.w), 0
+//   uvec4 header   W, H, kind (EnvironmentGpu::kind(), as FrameUniforms.skyHorizon.w), 0
 //   vec4  scale    intensity (>= 0), 0, 0, 0
 //   data[0 .. H]                  marginal CDF over rows: [0] = 0, [H] = 1
 //   data[M .. M + H(W+1))         M = H+1: row y's CDF over columns at M + y(W+1), [W] = 1

@@ -47,4 +47,17 @@ std::string TempDir::path(const std::string& name) const {
   return (std::filesystem::path(dir_) / name).string();
 }
 
+void expectError(const std::function<void()>& f, ErrorKind kind,
+                 const std::vector<std::string>& fragments) {
+  try {
+    f();
+    ADD_FAILURE() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), kind) << e.what();
+    for (const std::string& frag : fragments)
+      EXPECT_NE(std::string(e.what()).find(frag), std::string::npos)
+          << "'" << frag << "' missing from: " << e.what();
+  }
+}
+
 }  // namespace gi::test

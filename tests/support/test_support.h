@@ -1,9 +1,13 @@
 // Helpers shared by the tests: asset paths (skipping when optional assets are absent).
 #pragma once
 
+#include <functional>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
+
+#include "gi/errors.h"
 
 namespace gi::test {
 
@@ -13,6 +17,10 @@ std::string sharedAsset(const std::string& relative);
 std::string assimpModel(const std::string& relative);
 // Path to a built executable in build/bin.
 std::string binPath(const std::string& name);
+
+// `f` must throw a gi::Error of `kind` whose message contains every fragment.
+void expectError(const std::function<void()>& f, ErrorKind kind,
+                 const std::vector<std::string>& fragments);
 
 // A fresh folder per test (named after the test and the process) for files written on the
 // fly; removed with everything in it when the object goes away.

@@ -13,18 +13,6 @@ namespace {
 
 constexpr VkDeviceSize kHeaderBytes = 32;  // uvec4 header + vec4 scale
 
-// Kind code shared with FrameUniforms.skyHorizon.w: 0 sky, 1 constant, 2 equirect map.
-uint32_t kindCode(Environment::Kind kind) {
-  switch (kind) {
-    case Environment::Kind::Constant:
-      return 1;
-    case Environment::Kind::Map:
-      return 2;
-    default:
-      return 0;
-  }
-}
-
 }  // namespace
 
 EnvironmentGpu::Layout EnvironmentGpu::layout(uint32_t width, uint32_t height) {
@@ -48,10 +36,12 @@ EnvironmentGpu::EnvironmentGpu(vk::Context& ctx, const Environment& env) {
       w = env.mapWidth;
       h = env.mapHeight;
       rgb = &env.mapRGB;
+      kind_ = 2;
     } else {
       tabulated.assign(3, 0.0f);  // what environmentLookup returns for a broken map
     }
   } else {
+    kind_ = env.kind == Environment::Kind::Constant ? 1 : 0;
     w = kTabulatedWidth;
     h = kTabulatedHeight;
     tabulated = tabulateEnvironment(env, w, h);
@@ -90,7 +80,7 @@ EnvironmentGpu::EnvironmentGpu(vk::Context& ctx, const Environment& env) {
   for (int y = 0; y <= h; ++y) data[l.rowCos + size_t(y)] = sampler.rowCosTheta(y);
 
   std::vector<char> bytesOut(kHeaderBytes + data.size() * sizeof(float));
-  const uint32_t header[4] = {width_, height_, kindCode(env.kind), 0};
+  const uint32_t header[4] = {width_, height_, kind_, 0};
   const float scale[4] = {std::max(env.intensity, 0.0f), 0.0f, 0.0f, 0.0f};
   std::memcpy(bytesOut.data(), header, sizeof header);
   std::memcpy(bytesOut.data() + sizeof header, scale, sizeof scale);

@@ -27,6 +27,9 @@ class EnvironmentGpu {
   VkBuffer samplingBuffer() const { return sampling_.handle(); }
   VkDeviceSize samplingBytes() const { return sampling_.size(); }
   const SH9& irradiance() const { return irradiance_; }  // gi::irradianceSH(env)
+  // What shaders light with (FrameUniforms.skyHorizon.w): 0 the procedural sky (also a map whose
+  // texels do not match its size), 1 the constant colour, 2 the equirect map.
+  uint32_t kind() const { return kind_; }
   uint32_t width() const { return width_; }
   uint32_t height() const { return height_; }
 
@@ -40,7 +43,7 @@ class EnvironmentGpu {
   vk::Image map_;
   vk::Buffer sampling_;
   SH9 irradiance_{};
-  uint32_t width_ = 1, height_ = 1;
+  uint32_t width_ = 1, height_ = 1, kind_ = 0;
 };
 
 }  // namespace gi

@@ -462,9 +462,7 @@ struct Renderer::Impl : EffectContext {
     FrameUniforms f{};
     const Environment& e = source.environment;
     const bool constant = e.kind == Environment::Kind::Constant;
-    const bool map = e.kind == Environment::Kind::Map && e.mapWidth > 0 && e.mapHeight > 0 &&
-                     e.mapRGB.size() == size_t(e.mapWidth) * e.mapHeight * 3;
-    const float kind = constant ? 1.0f : map ? 2.0f : 0.0f;
+    const float kind = float(environment->kind());
     const float scale = std::max(settings.environmentIntensity, 0.0f);
     f.skyZenith = glm::vec4(e.zenithColor, std::max(e.intensity, 0.0f) * scale);
     f.skyHorizon = glm::vec4(e.horizonColor, kind);
