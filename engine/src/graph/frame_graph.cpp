@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <iterator>
 #include <set>
 #include <sstream>
 
@@ -328,6 +329,30 @@ void FrameGraph::resolveTextures() {
                           graph_detail::describeSubresource(a.sub) +
                           "' in two conflicting layouts");
       }
+  // Each pass's accesses combined per subresource, once, for execute() (layouts agree: above).
+  for (auto& p : passes_) {
+    p->textureNeeds.clear();
+    for (const Access& a : p->accesses) {
+      const Resource& r = *resources_[a.resource];
+      if (!r.texture) continue;
+      auto it = std::find_if(p->textureNeeds.begin(), p->textureNeeds.end(),
+                             [&](const auto& e) { return e.first == a.resource; });
+      if (it == p->textureNeeds.end()) {
+        p->textureNeeds.emplace_back(a.resource,
+                                     std::vector<graph_detail::SubNeed>(r.dims.subresources()));
+        it = std::prev(p->textureNeeds.end());
+      }
+      const SyncState n = required(a.textureUsage, vk::isDepthFormat(r.dims.format));
+      for (uint32_t m = a.range.mip; m < a.range.mip + a.range.mipCount; ++m)
+        for (uint32_t l = a.range.layer; l < a.range.layer + a.range.layerCount; ++l) {
+          graph_detail::SubNeed& x = it->second[m * r.dims.layers + l];
+          x.sync.layout = n.layout;
+          x.sync.stage |= n.stage;
+          x.sync.access |= n.access;
+          (a.write ? x.write : x.read) = true;
+        }
+    }
+  }
 }
 
 // Links this graph's persistent textures to their images, (re)creating those whose shape

@@ -1,6 +1,5 @@
 // Frame graph: recording a frame (per-subresource barriers, clears of persistent and fallback
 // images) and what a pass sees of its resources (PassContext).
-#include <unordered_map>
 
 #include "frame_graph_internal.h"
 #include "gi/vk/gpu_timer.h"
@@ -31,11 +30,6 @@ void afterBarrier(SyncState& state, SyncState& lastWrite, SyncState& visible, co
 }
 
 // What one pass needs of one subresource: all its accesses there, combined.
-struct SubNeed {
-  SyncState sync;
-  bool read = false, write = false;
-};
-
 }  // namespace
 
 // Persistent and fallback images start cleared (zero, or the fallback's value): recorded at the
@@ -93,37 +87,10 @@ void FrameGraph::execute(VkCommandBuffer cmd, vk::DescriptorArena& descriptors, 
     if (p->culled) continue;
     std::vector<VkImageMemoryBarrier2> imageBarriers;
     std::vector<VkBufferMemoryBarrier2> bufferBarriers;
-    // Textures: combine the pass's accesses per subresource first, so that coinciding ranges
-    // share one barrier and different ranges of one image get their own.
-    std::vector<uint32_t> images;
-    std::unordered_map<uint32_t, std::vector<SubNeed>> needs;
-    for (const Access& a : p->accesses) {
-      Resource& r = *resources_[a.resource];
-      if (!r.texture) continue;
-      std::vector<SubNeed>& subs = needs[a.resource];
-      if (subs.empty()) {
-        subs.resize(r.dims.subresources());
-        images.push_back(a.resource);
-      }
-      const SyncState n = required(a.textureUsage, vk::isDepthFormat(r.dims.format));
-      for (uint32_t m = a.range.mip; m < a.range.mip + a.range.mipCount; ++m)
-        for (uint32_t l = a.range.layer; l < a.range.layer + a.range.layerCount; ++l) {
-          SubNeed& x = subs[m * r.dims.layers + l];
-          if ((x.read || x.write) && x.sync.layout != n.layout)
-            throw Error(ErrorKind::Usage, "",
-                        "frame graph: pass '" + p->name + "' uses '" + r.name +
-                            graph_detail::describeSubresource(Subresource::one(m, l)) +
-                            "' in two conflicting layouts");
-          x.sync.layout = n.layout;
-          x.sync.stage |= n.stage;
-          x.sync.access |= n.access;
-          (a.write ? x.write : x.read) = true;
-        }
-    }
-    for (uint32_t id : images) {
+    // Textures: the pass's needs per subresource (combined by compile()).
+    for (const auto& [id, subs] : p->textureNeeds) {
       Resource& r = *resources_[id];
       Slot* slot = slotOf(r);
-      const std::vector<SubNeed>& subs = needs[id];
       std::vector<SubBarrier> barriers(subs.size());
       VkPipelineStageFlags2 used = VK_PIPELINE_STAGE_2_NONE;
       for (size_t i = 0; i < subs.size(); ++i) {

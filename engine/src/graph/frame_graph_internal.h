@@ -141,6 +141,12 @@ struct SubState {
   SyncState state, lastWrite, visible;
 };
 
+// What one pass needs of one subresource: its accesses combined (one layout, stages, accesses).
+struct SubNeed {
+  SyncState sync;
+  bool read = false, write = false;
+};
+
 }  // namespace graph_detail
 
 struct FrameGraph::Access {
@@ -156,6 +162,9 @@ struct FrameGraph::Access {
 struct FrameGraph::Pass {
   std::string name;
   std::vector<Access> accesses;
+  // Resolved by compile(): per texture the pass uses, its combined need of every subresource
+  // (indexed mip * layers + layer), so coinciding ranges share one barrier in execute().
+  std::vector<std::pair<uint32_t, std::vector<graph_detail::SubNeed>>> textureNeeds;
   bool sideEffect = false;
   bool culled = false;
   PassExecute execute;
