@@ -206,6 +206,13 @@ struct CameraView {
 
 // Reverse-Z perspective projection (Vulkan clip space, depth 1 at near, 0 at far).
 glm::mat4 perspectiveReverseZ(float yfov, float aspect, float znear, float zfar);
+// Reverse-Z orthographic projection (Vulkan clip space): depth 1 at znear, 0 at zfar.
+glm::mat4 orthoReverseZ(float left, float right, float bottom, float top, float znear, float zfar);
+// Guard: `v` normalised, or `fallback` when it is zero or not finite.
+glm::vec3 safeNormalize(const glm::vec3& v, const glm::vec3& fallback);
+// The view looking from `eye` along the unit `forward`, +y up (+z when forward is nearly
+// vertical): the convention of shadow views and GpuScene's views.
+glm::mat4 lookAlong(const glm::vec3& eye, const glm::vec3& forward);
 CameraView cameraFromNode(const Scene& scene, int node, float aspect);
 CameraView cameraFramingBounds(const glm::vec3& bmin, const glm::vec3& bmax, float aspect);
 CameraView activeCamera(const Scene& scene, float aspect);

@@ -11,19 +11,6 @@
 namespace gi {
 namespace {
 
-// Reverse-Z orthographic projection (Vulkan clip space): depth 1 at znear, 0 at zfar.
-glm::mat4 orthoReverseZ(float l, float r, float b, float t, float znear, float zfar) {
-  glm::mat4 flip(1.0f);
-  flip[2][2] = -1.0f;
-  flip[3][2] = 1.0f;  // z' = w - z
-  return flip * glm::orthoRH_ZO(l, r, b, t, znear, zfar);
-}
-
-glm::vec3 safeDir(const glm::vec3& v) {
-  const float len = glm::length(v);
-  return len > 1e-12f && std::isfinite(len) ? v / len : glm::vec3(0, -1, 0);
-}
-
 // Plans the shadow map of one light: its views (1, or 6 cube faces in a 3x2 atlas) fitted to
 // the scene bounds. Returns false when the light cannot see the scene (nothing to render).
 bool addShadowMap(const Light& l, const glm::mat4& world, uint32_t lightIndex,
@@ -31,16 +18,13 @@ bool addShadowMap(const Light& l, const glm::mat4& world, uint32_t lightIndex,
                   uint32_t res, std::vector<GpuShadowView>& out, std::vector<ShadowMap>& maps) {
   const glm::mat4 invView = glm::inverse(camera.view);
   const glm::vec3 pos = glm::vec3(world * glm::vec4(0, 0, 0, 1));
-  const glm::vec3 dir = safeDir(glm::vec3(world * glm::vec4(0, 0, -1, 0)));
+  const glm::vec3 dir = safeNormalize(glm::vec3(world * glm::vec4(0, 0, -1, 0)), {0, -1, 0});
   std::array<glm::vec3, 8> corners;
   for (int i = 0; i < 8; ++i)
     corners[i] =
         glm::vec3(i & 1 ? bmax.x : bmin.x, i & 2 ? bmax.y : bmin.y, i & 4 ? bmax.z : bmin.z);
   ShadowMap map;
   map.light = lightIndex;
-  auto upFor = [](const glm::vec3& d) {
-    return std::abs(d.y) > 0.99f ? glm::vec3(0, 0, 1) : glm::vec3(0, 1, 0);
-  };
   auto addView = [&](const glm::mat4& viewProj, const glm::vec4& params, glm::uvec2 offset) {
     map.views.push_back({viewProj, VkRect2D{{int32_t(offset.x), int32_t(offset.y)}, {res, res}}});
     out.push_back({viewProj * invView, params, glm::vec4(offset.x, offset.y, res, 0.0f)});
@@ -49,7 +33,7 @@ bool addShadowMap(const Light& l, const glm::mat4& world, uint32_t lightIndex,
     // Orthographic, fitted to the light-space bounds of the scene's box.
     const glm::vec3 centre = 0.5f * (bmin + bmax);
     const float radius = std::max(0.5f * glm::length(bmax - bmin), 1e-3f);
-    const glm::mat4 view = glm::lookAt(centre - dir * (2.0f * radius), centre, upFor(dir));
+    const glm::mat4 view = lookAlong(centre - dir * (2.0f * radius), dir);
     glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
     for (const glm::vec3& c : corners) {
       const glm::vec3 v = glm::vec3(view * glm::vec4(c, 1.0f));
@@ -76,7 +60,7 @@ bool addShadowMap(const Light& l, const glm::mat4& world, uint32_t lightIndex,
     if (l.type == LightType::Spot) {
       const float fov =
           std::min(2.0f * l.outerConeAngle + glm::radians(2.0f), glm::radians(170.0f));
-      const glm::mat4 view = glm::lookAt(pos, pos + dir, upFor(dir));
+      const glm::mat4 view = lookAlong(pos, dir);
       map.width = map.height = res;
       addView(perspectiveReverseZ(fov, 1.0f, znear, zfar) * view,
               glm::vec4(1.0f, znear, zfar, 2.0f * std::tan(0.5f * fov) / float(res)), {0, 0});
@@ -88,8 +72,8 @@ bool addShadowMap(const Light& l, const glm::mat4& world, uint32_t lightIndex,
       map.width = 3 * res;
       map.height = 2 * res;
       for (uint32_t f = 0; f < 6; ++f)
-        addView(proj * glm::lookAt(pos, pos + axes[f], upFor(axes[f])),
-                glm::vec4(1.0f, znear, zfar, 2.0f / float(res)), {(f % 3) * res, (f / 3) * res});
+        addView(proj * lookAlong(pos, axes[f]), glm::vec4(1.0f, znear, zfar, 2.0f / float(res)),
+                {(f % 3) * res, (f / 3) * res});
     }
   }
   maps.push_back(std::move(map));

@@ -46,23 +46,6 @@ constexpr VkDeviceSize kMaterialSlotBytes = 256;
 constexpr size_t kViewSlotsPerChunk = 256;
 static_assert(sizeof(DrawViewUniforms) <= kViewSlotBytes);
 
-glm::vec3 safeDirection(const glm::vec3& v, const glm::vec3& fallback) {
-  const float len = glm::length(v);
-  return len > 1e-20f && std::isfinite(len) ? v / len : fallback;
-}
-
-glm::vec3 upFor(const glm::vec3& d) {
-  return std::abs(d.y) > 0.99f ? glm::vec3(0, 0, 1) : glm::vec3(0, 1, 0);
-}
-
-// Reverse-Z orthographic projection (Vulkan clip space): depth 1 at znear, 0 at zfar.
-glm::mat4 orthoReverseZ(float l, float r, float b, float t, float znear, float zfar) {
-  glm::mat4 flip(1.0f);
-  flip[2][2] = -1.0f;
-  flip[3][2] = 1.0f;  // z' = w - z
-  return flip * glm::orthoRH_ZO(l, r, b, t, znear, zfar);
-}
-
 Image makeTexture(Context& ctx, VkFormat format, uint32_t w, uint32_t h, const void* pixels,
                   size_t bytes) {
   ImageDesc desc;
@@ -90,9 +73,9 @@ SceneView SceneView::fromCamera(const CameraView& camera) {
 
 SceneView SceneView::perspective(const glm::vec3& eye, const glm::vec3& forward, float yfov,
                                  float aspect, float znear, float zfar) {
-  const glm::vec3 f = safeDirection(forward, glm::vec3(0, 0, -1));
+  const glm::vec3 f = safeNormalize(forward, glm::vec3(0, 0, -1));
   SceneView v;
-  v.view = glm::lookAt(eye, eye + f, upFor(f));
+  v.view = lookAlong(eye, f);
   v.proj = perspectiveReverseZ(yfov, aspect, znear, zfar);
   v.znear = znear;
   v.zfar = zfar;
@@ -101,10 +84,10 @@ SceneView SceneView::perspective(const glm::vec3& eye, const glm::vec3& forward,
 
 SceneView SceneView::orthographic(const glm::vec3& eye, const glm::vec3& forward, float halfWidth,
                                   float halfHeight, float znear, float zfar) {
-  const glm::vec3 f = safeDirection(forward, glm::vec3(0, 0, -1));
+  const glm::vec3 f = safeNormalize(forward, glm::vec3(0, 0, -1));
   SceneView v;
   v.projection = Projection::Orthographic;
-  v.view = glm::lookAt(eye, eye + f, upFor(f));
+  v.view = lookAlong(eye, f);
   v.proj = orthoReverseZ(-halfWidth, halfWidth, -halfHeight, halfHeight, znear, zfar);
   v.znear = znear;
   v.zfar = zfar;
@@ -113,10 +96,10 @@ SceneView SceneView::orthographic(const glm::vec3& eye, const glm::vec3& forward
 
 SceneView SceneView::paraboloid(const glm::vec3& center, const glm::vec3& axis, float znear,
                                 float zfar) {
-  const glm::vec3 f = safeDirection(axis, glm::vec3(0, -1, 0));
+  const glm::vec3 f = safeNormalize(axis, glm::vec3(0, -1, 0));
   SceneView v;
   v.projection = Projection::Paraboloid;
-  v.view = glm::lookAt(center, center + f, upFor(f));
+  v.view = lookAlong(center, f);
   v.znear = znear;
   v.zfar = zfar;
   return v;

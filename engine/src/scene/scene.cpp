@@ -78,6 +78,23 @@ glm::mat4 perspectiveReverseZ(float yfov, float aspect, float znear, float zfar)
   return p;
 }
 
+glm::mat4 orthoReverseZ(float left, float right, float bottom, float top, float znear, float zfar) {
+  glm::mat4 flip(1.0f);
+  flip[2][2] = -1.0f;
+  flip[3][2] = 1.0f;  // z' = w - z
+  return flip * glm::orthoRH_ZO(left, right, bottom, top, znear, zfar);
+}
+
+glm::vec3 safeNormalize(const glm::vec3& v, const glm::vec3& fallback) {
+  const float len = glm::length(v);
+  return len > 1e-12f && std::isfinite(len) ? v / len : fallback;
+}
+
+glm::mat4 lookAlong(const glm::vec3& eye, const glm::vec3& forward) {
+  const glm::vec3 up = std::abs(forward.y) > 0.99f ? glm::vec3(0, 0, 1) : glm::vec3(0, 1, 0);
+  return glm::lookAt(eye, eye + forward, up);
+}
+
 CameraView cameraFromNode(const Scene& scene, int nodeIndex, float aspect) {
   const Node& node = scene.nodes.at(nodeIndex);
   const Camera& cam = scene.cameras.at(node.camera);
