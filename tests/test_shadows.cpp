@@ -28,8 +28,9 @@ std::string lightJson(const std::string& type) {
   return R"({"type": "point", "position": [-1.0, 2.5, 0.3], "intensity": 20})";
 }
 
-// Plane y = 0 (5 x 5), a 0.5 box floating at y = 1, camera straight above, dim constant sky.
-Scene boxScene(const std::string& light) {
+// Plane y = 0 (5 x 5), a 0.5 box floating at y = 1, camera straight above, dim constant sky,
+// and the given JSON light objects (comma-separated).
+Scene boxSceneWithLights(const std::string& lights) {
   const std::string dir = test::makeTempDir("shadow-scene");
   const std::string path = dir + "/scene.json";
   std::ofstream(path) << R"({
@@ -37,10 +38,14 @@ Scene boxScene(const std::string& light) {
       {"primitive": "plane", "size": 5, "material": {"base_color": [0.8, 0.8, 0.8]}},
       {"primitive": "box", "size": 0.5, "translation": [0, 1, 0]}],
     "camera": {"position": [0, 5, 0], "target": [0, 0, 0], "up": [0, 0, -1], "yfov_deg": 60},
-    "lights": [)" + lightJson(light) +
+    "lights": [)" + lights +
                              R"(],
     "environment": {"type": "constant", "color": [1, 1, 1], "intensity": 0.02}})";
   return loadScene(path);
+}
+
+Scene boxScene(const std::string& light) {
+  return boxSceneWithLights(lightJson(light));
 }
 
 bool rayHitsBox(const glm::vec3& o, const glm::vec3& d, float tMax) {
@@ -203,15 +208,7 @@ TEST_F(ShadowGraphTest, MoreThanFourShadowedLights) {
               std::to_string(-0.4f * std::sin(a)) +
               R"(], "outer_cone_deg": 50, "inner_cone_deg": 40, "intensity": 8})";
   }
-  const std::string dir = test::makeTempDir("six-lights");
-  const std::string path = dir + "/scene.json";
-  std::ofstream(path) << R"({
-    "models": [
-      {"primitive": "plane", "size": 5, "material": {"base_color": [0.8, 0.8, 0.8]}},
-      {"primitive": "box", "size": 0.5, "translation": [0, 1, 0]}],
-    "camera": {"position": [0, 5, 0], "target": [0, 0, 0], "up": [0, 0, -1], "yfov_deg": 60},
-    "lights": [)" + lights + R"(]})";
-  Scene scene = loadScene(path);
+  Scene scene = boxSceneWithLights(lights);
   RenderSettings rs;
   rs.width = 80;
   rs.height = 60;
