@@ -115,18 +115,7 @@ TEST(EffectConfig, PrecedenceDefaultsPresetSceneCommandLine) {
   EXPECT_TRUE(resolveEffects(scene, &preset, cli, reg).empty());
 }
 
-// Each bad input must fail with the expected kind and a message containing all the fragments.
-void expectError(const std::function<void()>& f, ErrorKind kind,
-                 std::vector<std::string> fragments) {
-  try {
-    f();
-    ADD_FAILURE() << "expected an error";
-  } catch (const Error& e) {
-    EXPECT_EQ(e.kind(), kind) << e.what();
-    for (const std::string& frag : fragments)
-      EXPECT_NE(std::string(e.what()).find(frag), std::string::npos) << e.what();
-  }
-}
+using test::expectError;
 
 TEST(EffectConfig, BadPresetsAndSettingsNameFileKeyAndRange) {
   EffectRegistry reg = testRegistry();
