@@ -7,8 +7,24 @@
 // is the engine's SH9 irradiance x albedo x ambient visibility ("ao"), unless an effect supplies
 // its replacement ("ambient", alpha 1: directional occlusion); "indirect" is added. All three
 // optional inputs default to neutral 1x1 textures (ao 1, ambient alpha 0, indirect 0).
-// Workgroup 32x16 (see kGroupX/Y in passes/lighting_pass.cpp): llvmpipe pays per workgroup.
+// Workgroup 32x16 (kScreenGroupX/Y in passes/builtin_passes.h): llvmpipe pays per workgroup.
 layout(local_size_x = 32, local_size_y = 16) in;
+
+// What this frame needs, fixed when the pipeline is built (LightingPass::Variant): llvmpipe runs
+// every branch of an `if` for every pixel, so code for absent light types, inputs and
+// environment kinds is removed here rather than skipped at run time.
+layout(constant_id = 0) const int kLightTypes = 7;   // bit mask: 1 directional, 2 point, 4 spot
+layout(constant_id = 1) const int kShadowTypes = 7;  // the same for shadowed lights
+layout(constant_id = 2) const int kPcfRadius = 1;    // engine.pcf_radius
+// Optional inputs: 0 the neutral fallback (not read), 1 full resolution (one texelFetch),
+// 2 another size (bilinear).
+layout(constant_id = 3) const int kAoInput = 0;
+layout(constant_id = 4) const int kAmbientInput = 0;
+layout(constant_id = 5) const int kIndirectInput = 0;
+layout(constant_id = 6) const int kEnvironmentKind = 0;  // 0 sky, 1 constant, 2 equirect map
+#define GI_LIGHT_TYPES kLightTypes
+#define GI_SHADOW_TYPES kShadowTypes
+#define GI_PCF_RADIUS kPcfRadius
 
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 layout(set = 0, binding = 1) uniform sampler2D gDepth;
@@ -27,20 +43,11 @@ layout(set = 0, binding = 11) uniform sampler2D ambientTexture;   // linear, any
 layout(set = 0, binding = 12) uniform sampler2D indirectTexture;  // linear, any size
 // Equirect environment map (kind 2; a 1x1 dummy otherwise).
 layout(set = 0, binding = 13) uniform sampler2D environmentMap;
-// Which optional inputs an effect published (bit 0 ao, 1 ambient, 2 indirect). The others are
-// the graph's neutral stand-ins (ao 1, ambient alpha 0, indirect 0: the values the renderer
-// declares), so they are not fetched at all: three fetches of ~20 cost ~10% of the pass.
-layout(push_constant) uniform Inputs { uint present; } inputs;
 
 const float PI = 3.14159265358979;
 
-// An optional input at pixel `p`: one fetch for the neutral 1x1 stand-in and for a
-// full-resolution input (on llvmpipe the cost goes with the fetch count), bilinear otherwise.
-vec4 optionalInput(sampler2D t, ivec2 p, ivec2 size, vec2 uv) {
-  ivec2 s = textureSize(t, 0);
-  if (s == ivec2(1)) return texelFetch(t, ivec2(0), 0);
-  if (s == size) return texelFetch(t, p, 0);
-  return textureLod(t, uv, 0.0);
+vec4 optionalInput(sampler2D t, int mode, ivec2 p, vec2 uv) {
+  return mode == 1 ? texelFetch(t, p, 0) : textureLod(t, uv, 0.0);
 }
 
 void main() {
@@ -53,9 +60,13 @@ void main() {
   if (isSky(depth)) {
     vec3 viewDirWorld = safeNormalize(
         mat3(frame.invView) * viewPositionFromDepth(frame.invProj, uv, 0.5), vec3(0, 0, -1));
-    vec3 sky = frame.skyHorizon.w > 1.5
-                   ? textureLod(environmentMap, equirectUV(viewDirWorld), 0.0).rgb * frame.skyZenith.w
-                   : environmentRadiance(frame, viewDirWorld);
+    vec3 sky;
+    if (kEnvironmentKind == 2)
+      sky = textureLod(environmentMap, equirectUV(viewDirWorld), 0.0).rgb * frame.skyZenith.w;
+    else if (kEnvironmentKind == 1)
+      sky = frame.skyGround.rgb * frame.skyZenith.w;
+    else
+      sky = environmentRadiance(frame, viewDirWorld);
     imageStore(outLit, p, vec4(sky, 1.0));
     return;
   }
@@ -85,16 +96,15 @@ void main() {
     vec3 brdf = diffuseColor / PI + f0 * spec;
     color += brdf * incident * ndl * visibility;
   }
-  vec4 ambient = (inputs.present & 2u) != 0u ? optionalInput(ambientTexture, p, size, uv) : vec4(0.0);
+  vec4 ambient = kAmbientInput != 0 ? optionalInput(ambientTexture, kAmbientInput, p, uv) : vec4(0.0);
   if (ambient.a > 0.5) {
     color += max(ambient.rgb, vec3(0.0));
   } else {
     vec3 nWorld = mat3(frame.invView) * n;
-    float ao = (inputs.present & 1u) != 0u ? clamp(optionalInput(aoTexture, p, size, uv).r, 0.0, 1.0)
-                                           : 1.0;
+    float ao = kAoInput != 0 ? clamp(optionalInput(aoTexture, kAoInput, p, uv).r, 0.0, 1.0) : 1.0;
     color += diffuseColor * environmentIrradianceOverPi(frame, nWorld) * ao;
   }
-  if ((inputs.present & 4u) != 0u)
-    color += max(optionalInput(indirectTexture, p, size, uv).rgb, vec3(0.0));
+  if (kIndirectInput != 0)
+    color += max(optionalInput(indirectTexture, kIndirectInput, p, uv).rgb, vec3(0.0));
   imageStore(outLit, p, vec4(color, 1.0));
 }

@@ -2,11 +2,30 @@
 // gi/lights.h). Include after common.glsl, with the FrameUniforms block named `frame` declared,
 // and after defining the set and bindings of the three resources:
 //   #define GI_LIGHTS_SET 0
-//   #define GI_LIGHTS_BINDING 6        // buffer "lights"
-//   #define GI_SHADOW_VIEWS_BINDING 7  // buffer "shadow_views"
+//   #define GI_LIGHTS_BINDING 6        // uniform buffer "lights"
+//   #define GI_SHADOW_VIEWS_BINDING 7  // uniform buffer "shadow_views"
 //   #define GI_SHADOW_MAPS_BINDING 8   // texture "shadow_maps" (sampler2DArray, nearest)
+// Both tables are uniform buffers, not storage buffers: llvmpipe loads a storage buffer lane by
+// lane even at a uniform index (a 96-byte shadow view per pixel cost ~13 ms at 640x480), a
+// uniform buffer once. Hence the fixed maxima (gi::kMaxLights, gi::kMaxShadowViews).
+// Optional, to drop code the scene does not need (e.g. from specialization constants):
+//   GI_LIGHT_TYPES   bit mask of the light types present: 1 directional, 2 point, 4 spot
+//   GI_SHADOW_TYPES  bit mask of the types of shadowed lights (0: no shadow code at all)
+//   GI_PCF_RADIUS    PCF radius in texels (default: frame.options.x, at run time)
 #ifndef GI_LIGHTS_GLSL
 #define GI_LIGHTS_GLSL
+
+#define GI_MAX_LIGHTS 128        // gi::kMaxLights
+#define GI_MAX_SHADOW_VIEWS 160  // gi::kMaxShadowViews (16 KiB: every device's UBO limit)
+#ifndef GI_LIGHT_TYPES
+#define GI_LIGHT_TYPES 7
+#endif
+#ifndef GI_SHADOW_TYPES
+#define GI_SHADOW_TYPES 7
+#endif
+#ifndef GI_PCF_RADIUS
+#define GI_PCF_RADIUS clamp(int(frame.options.x), 0, 3)
+#endif
 
 struct Light {
   vec4 positionRange;   // view-space position, range (0: infinite)
@@ -25,15 +44,15 @@ struct ShadowView {
 };
 // * world size of one texel: orthographic: params.w; perspective: params.w * light-space depth.
 
-layout(set = GI_LIGHTS_SET, binding = GI_LIGHTS_BINDING, std430) readonly buffer Lights {
-  Light lights[];
+layout(set = GI_LIGHTS_SET, binding = GI_LIGHTS_BINDING, std140) uniform Lights {
+  Light lights[GI_MAX_LIGHTS];
 };
-layout(set = GI_LIGHTS_SET, binding = GI_SHADOW_VIEWS_BINDING, std430) readonly buffer ShadowViews {
-  ShadowView shadowViews[];
+layout(set = GI_LIGHTS_SET, binding = GI_SHADOW_VIEWS_BINDING, std140) uniform ShadowViews {
+  ShadowView shadowViews[GI_MAX_SHADOW_VIEWS];
 };
 layout(set = GI_LIGHTS_SET, binding = GI_SHADOW_MAPS_BINDING) uniform sampler2DArray shadowMaps;
 
-int lightCount() { return int(frame.params.y); }
+int lightCount() { return GI_LIGHT_TYPES == 0 ? 0 : min(int(frame.params.y), GI_MAX_LIGHTS); }
 
 // Guard: squared light distance is clamped so a light on the surface stays finite.
 const float kMinLightDistance2 = 1e-4;
@@ -41,8 +60,8 @@ const float kMinLightDistance2 = 1e-4;
 // Radiance arriving at view-space `pos` from light `light` without shadowing (irradiance
 // normal to the light for a directional light), and the unit direction `l` toward the light.
 vec3 lightIncident(Light light, vec3 pos, out vec3 l) {
-  int type = int(light.directionType.w);
-  if (type == 0) {
+  int type = GI_LIGHT_TYPES == 1 ? 0 : int(light.directionType.w);
+  if ((GI_LIGHT_TYPES & 1) != 0 && type == 0) {
     l = safeNormalize(-light.directionType.xyz, vec3(0, 1, 0));
     return light.radiance.rgb;
   }
@@ -55,7 +74,7 @@ vec3 lightIncident(Light light, vec3 pos, out vec3 l) {
     float r = d2 / (range * range);
     attenuation *= clamp(1.0 - r * r, 0.0, 1.0);
   }
-  if (type == 2) {
+  if ((GI_LIGHT_TYPES & 4) != 0 && type == 2) {
     float cd = dot(safeNormalize(light.directionType.xyz, vec3(0, -1, 0)), -l);
     attenuation *= smoothstep(light.cone.y, max(light.cone.x, light.cone.y + 1e-4), cd);
   }
@@ -66,17 +85,17 @@ vec3 lightIncident(Light light, vec3 pos, out vec3 l) {
 // `ndl` sets the slope-scaled part of the bias.
 float shadowFactor(Light light, vec3 pos, float ndl) {
   int first = int(light.shadow.x);
-  if (first < 0) return 1.0;
+  if (GI_SHADOW_TYPES == 0 || first < 0) return 1.0;
   // Directional and spot lights read their one view with the light's (uniform) index, which
   // llvmpipe loads once for all lanes; only a point light's face differs per pixel.
   ShadowView sv;
-  if (int(light.directionType.w) == 1) {  // point: the cube face of the major axis
+  if ((GI_SHADOW_TYPES & 2) != 0 && int(light.directionType.w) == 1) {  // point: major-axis face
     vec3 d = mat3(frame.invView) * (pos - light.positionRange.xyz);
     vec3 a = abs(d);
     int axis = a.x >= a.y && a.x >= a.z ? 0 : (a.y >= a.z ? 1 : 2);
-    sv = shadowViews[first + 2 * axis + (d[axis] < 0.0 ? 1 : 0)];
+    sv = shadowViews[min(first + 2 * axis + (d[axis] < 0.0 ? 1 : 0), GI_MAX_SHADOW_VIEWS - 1)];
   } else {
-    sv = shadowViews[first];
+    sv = shadowViews[min(first, GI_MAX_SHADOW_VIEWS - 1)];
   }
   vec4 clip = sv.viewToClip * vec4(pos, 1.0);
   if (clip.w <= 0.0) return 1.0;
@@ -99,7 +118,7 @@ float shadowFactor(Light light, vec3 pos, float ndl) {
   int layer = int(light.shadow.w);
   ivec2 lo = ivec2(sv.tile.xy), size = ivec2(sv.tile.z), hi = lo + size - 1;
   ivec2 center = lo + clamp(ivec2(uv * vec2(size)), ivec2(0), size - 1);
-  int k = clamp(int(frame.options.x), 0, 3);
+  int k = GI_PCF_RADIUS;
   float lit = 0.0;
   for (int dy = -k; dy <= k; ++dy)
     for (int dx = -k; dx <= k; ++dx)

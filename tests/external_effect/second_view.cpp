@@ -61,8 +61,8 @@ class SecondViewEffect : public gi::Effect {
           {{0, ubo},
            {1, tex},
            {2, tex},
-           {3, ssbo},
-           {4, ssbo},
+           {3, ubo},
+           {4, ubo},
            {5, tex},
            {6, tex},
            {7, ssbo},
@@ -180,8 +180,8 @@ class SecondViewEffect : public gi::Effect {
           w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame)
               .sampled(1, pc.view(io->depth), nearest)
               .sampled(2, pc.view(io->normal), nearest)
-              .buffer(3, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, pc.buffer(io->lights))
-              .buffer(4, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, pc.buffer(io->shadowViews))
+              .buffer(3, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, pc.buffer(io->lights))
+              .buffer(4, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, pc.buffer(io->shadowViews))
               .sampled(5, pc.view(io->shadowMaps), nearest)
               .sampled(6, pc.view(io->environment), nearest)
               .buffer(7, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, pc.buffer(io->sampling))

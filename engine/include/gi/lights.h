@@ -1,8 +1,9 @@
 // Lights and shadow maps as the engine publishes them to effects: the GPU records (lights.glsl
 // reads them), the world-space description of the current pose, and the frame-graph names.
 //
-// Blackboard (every frame): buffer "lights" (GpuLight per light, camera view space, count in
-// FrameUniforms.params.y), buffer "shadow_views" (GpuShadowView), texture "shadow_maps" (D32
+// Blackboard (every frame): uniform buffer "lights" (GpuLight per light, camera view space, count
+// in FrameUniforms.params.y; kMaxLights records), uniform buffer "shadow_views" (GpuShadowView,
+// kMaxShadowViews records), texture "shadow_maps" (D32
 // reverse-Z 2-D array, one layer per shadowed light; a 1x1 one-layer array cleared to "no
 // occluder" when no light casts shadows). lights.glsl: Light, ShadowView, shadowFactor().
 #pragma once
@@ -21,7 +22,13 @@ inline constexpr const char* kShadowViews = "shadow_views";
 inline constexpr const char* kShadowMaps = "shadow_maps";
 }  // namespace resources
 
-// std430 mirror of `Light` in lights.glsl.
+// Sizes of the two uniform buffers (lights.glsl's GI_MAX_LIGHTS and GI_MAX_SHADOW_VIEWS): uniform,
+// not storage, buffers because llvmpipe loads storage buffers lane by lane. 160 views of 96 bytes
+// fit the 16 KiB every Vulkan device offers; a point light takes six views, any other one.
+inline constexpr uint32_t kMaxLights = 128;
+inline constexpr uint32_t kMaxShadowViews = 160;
+
+// std140 (= std430 here: vec4 members only) mirror of `Light` in lights.glsl.
 struct GpuLight {
   glm::vec4 positionRange;  // camera view-space position, range (0: infinite)
   glm::vec4

@@ -267,13 +267,22 @@ struct Renderer::Impl : EffectContext {
     sceneGpu->bounds(lo, hi);
     LightSetup next =
         planLights(source, sceneGpu->pose().nodes, cameraView, lo, hi, settings.shadowMapSize);
-    if (!lightBuffer || !next.sameLayout(lightSetup)) {
-      lightBuffer = Buffer(ctx, std::max<size_t>(next.lights.size(), 1) * sizeof(GpuLight),
-                           VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true);
-      shadowViewBuffer = Buffer(ctx, std::max<size_t>(next.views.size(), 1) * sizeof(GpuShadowView),
-                                VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true);
-      graphDirty = true;
+    if (next.lights.size() > kMaxLights)
+      throw Error(ErrorKind::Unsupported, "",
+                  std::to_string(next.lights.size()) + " lights exceed the engine's " +
+                      std::to_string(kMaxLights));
+    if (next.views.size() > kMaxShadowViews)
+      throw Error(ErrorKind::Unsupported, "",
+                  std::to_string(next.views.size()) + " shadow views exceed the engine's " +
+                      std::to_string(kMaxShadowViews) +
+                      " (a point light takes six, any other light one: cast fewer shadows)");
+    if (!lightBuffer) {  // full size: the shaders declare fixed-size uniform arrays
+      lightBuffer =
+          Buffer(ctx, kMaxLights * sizeof(GpuLight), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true);
+      shadowViewBuffer = Buffer(ctx, kMaxShadowViews * sizeof(GpuShadowView),
+                                VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true);
     }
+    if (!next.sameLayout(lightSetup)) graphDirty = true;
     const VkPhysicalDeviceLimits& limits = ctx.properties().limits;
     if (next.layerWidth() > limits.maxImageDimension2D ||
         next.layerHeight() > limits.maxImageDimension2D)

@@ -36,7 +36,8 @@ void Pipeline::createLayout(const std::vector<Binding>& bindings, uint32_t pushC
 }
 
 Pipeline Pipeline::compute(Context& ctx, const std::vector<uint32_t>& spirv,
-                           const std::vector<Binding>& bindings, uint32_t pushConstantBytes) {
+                           const std::vector<Binding>& bindings, uint32_t pushConstantBytes,
+                           const std::vector<uint32_t>& specialization) {
   Pipeline p;
   p.ctx_ = &ctx;
   p.bindPoint_ = VK_PIPELINE_BIND_POINT_COMPUTE;
@@ -47,6 +48,12 @@ Pipeline Pipeline::compute(Context& ctx, const std::vector<uint32_t>& spirv,
   info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
   info.stage.module = module;
   info.stage.pName = "main";
+  std::vector<VkSpecializationMapEntry> entries;
+  for (uint32_t i = 0; i < specialization.size(); ++i)
+    entries.push_back({i, i * uint32_t(sizeof(uint32_t)), sizeof(uint32_t)});
+  const VkSpecializationInfo spec{uint32_t(entries.size()), entries.data(),
+                                  specialization.size() * sizeof(uint32_t), specialization.data()};
+  if (!specialization.empty()) info.stage.pSpecializationInfo = &spec;
   info.layout = p.layout_;
   VkResult r =
       vkCreateComputePipelines(ctx.device(), ctx.pipelineCache(), 1, &info, nullptr, &p.pipeline_);

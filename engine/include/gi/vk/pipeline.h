@@ -51,8 +51,12 @@ struct GraphicsDesc {
 class Pipeline {
  public:
   Pipeline() = default;
+  // `specialization[i]` is the 32-bit value of the shader's `layout(constant_id = i)` constant:
+  // the driver folds the branches it decides before compiling (on llvmpipe an `if` costs its
+  // whole body even when no pixel takes it, so settings known at build time belong there).
   static Pipeline compute(Context& ctx, const std::vector<uint32_t>& spirv,
-                          const std::vector<Binding>& bindings, uint32_t pushConstantBytes = 0);
+                          const std::vector<Binding>& bindings, uint32_t pushConstantBytes = 0,
+                          const std::vector<uint32_t>& specialization = {});
   static Pipeline graphics(Context& ctx, const GraphicsDesc& desc);
   ~Pipeline() { reset(); }
   Pipeline(Pipeline&& o) noexcept { *this = std::move(o); }

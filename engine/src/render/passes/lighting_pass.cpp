@@ -1,6 +1,10 @@
 // "lighting": composes the lit image from the G-buffer, the lights and shadow maps, the
 // environment and the optional inputs effects publish (ao, ambient, indirect; neutral when
 // absent: the fallbacks are declared once, in the renderer's buildGraph()).
+#include <algorithm>
+#include <array>
+#include <map>
+
 #include "gi/vk/pipeline.h"
 #include "render/passes/builtin_passes.h"
 
@@ -23,35 +27,16 @@ class LightingPass final : public Effect {
   }
   std::vector<SettingDesc> settings() const override { return {}; }
   void prepare(EffectContext& ctx, const SettingValues&) override {
-    if (pipeline_.handle()) return;
     ctx.vulkan().requireWorkgroup(kScreenGroupX, kScreenGroupY, "lighting");
-    const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-               tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-               img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-    pipeline_ = vk::Pipeline::compute(ctx.vulkan(), vk::loadSpirv("lighting.comp"),
-                                      {{0, ubo},
-                                       {1, tex},
-                                       {2, tex},
-                                       {3, tex},
-                                       {4, tex},
-                                       {5, tex},
-                                       {6, ssbo},
-                                       {7, ssbo},
-                                       {8, tex},
-                                       {9, img},
-                                       {10, tex},
-                                       {11, tex},
-                                       {12, tex},
-                                       {13, tex}},
-                                      sizeof(uint32_t));  // which optional inputs exist
   }
   void addPasses(FrameGraph& graph, EffectContext& ctx, const SettingValues&) override {
     struct Io {
       TextureHandle gbuffer[5], shadowMaps, ao, ambient, indirect, environment, lit;
       BufferHandle lights, shadowViews;
-      uint32_t present = 0;  // bit 0 ao, 1 ambient, 2 indirect published (not the fallback)
+      bool fallback[3] = {true, true, true};  // ao, ambient, indirect: the neutral stand-in
     };
     auto io = std::make_shared<Io>();
+
     Blackboard& bb = graph.blackboard();
     const char* gbuffer[5] = {res::kDepth, res::kNormal, res::kAlbedo, res::kMaterial,
                               res::kEmission};
@@ -65,29 +50,37 @@ class LightingPass final : public Effect {
           io->ao = b.readOptional(res::kAO);
           io->ambient = b.readOptional(res::kAmbient);
           io->indirect = b.readOptional(res::kIndirect);
-          io->present = (b.isFallback(io->ao) ? 0u : 1u) | (b.isFallback(io->ambient) ? 0u : 2u) |
-                        (b.isFallback(io->indirect) ? 0u : 4u);
+          io->fallback[0] = b.isFallback(io->ao);
+          io->fallback[1] = b.isFallback(io->ambient);
+          io->fallback[2] = b.isFallback(io->indirect);
           io->environment = b.read(bb.texture(res::kEnvironmentMap));
           io->lit = b.write(b.create(res::kLit, TextureDesc{VK_FORMAT_R16G16B16A16_SFLOAT}),
                             TextureUsage::StorageWrite);
         },
         [this, io, frame = ctx.frameUniforms()](PassContext& pc) {
           const VkSampler nearest = s_.nearest, linear = s_.linear;
+          const VkExtent2D e = pc.extent(io->lit);
+          // An optional input is read once per pixel at the output's size, bilinearly otherwise.
+          auto inputMode = [&](bool isFallback, TextureHandle h) {
+            if (isFallback) return 0u;
+            const VkExtent2D i = pc.extent(h);
+            return i.width == e.width && i.height == e.height ? 1u : 2u;
+          };
+          const vk::Pipeline& pipeline =
+              variant({inputMode(io->fallback[0], io->ao), inputMode(io->fallback[1], io->ambient),
+                       inputMode(io->fallback[2], io->indirect)});
           vk::DescriptorWriter w;
           w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame);
           for (uint32_t i = 0; i < 5; ++i) w.sampled(1 + i, pc.view(io->gbuffer[i]), nearest);
-          w.buffer(6, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, pc.buffer(io->lights))
-              .buffer(7, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, pc.buffer(io->shadowViews))
+          w.buffer(6, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, pc.buffer(io->lights))
+              .buffer(7, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, pc.buffer(io->shadowViews))
               .sampled(8, pc.view(io->shadowMaps), nearest)
               .storageImage(9, pc.view(io->lit))
               .sampled(10, pc.view(io->ao), linear)
               .sampled(11, pc.view(io->ambient), linear)
               .sampled(12, pc.view(io->indirect), linear)
               .sampled(13, pc.view(io->environment), s_.scene.linearRepeat());
-          pc.descriptors().bind(pc.cmd(), pipeline_, w);
-          vkCmdPushConstants(pc.cmd(), pipeline_.layout(), VK_SHADER_STAGE_ALL, 0,
-                             sizeof io->present, &io->present);
-          const VkExtent2D e = pc.extent(io->lit);
+          pc.descriptors().bind(pc.cmd(), pipeline, w);
           vkCmdDispatch(pc.cmd(), screenGroups(e.width, kScreenGroupX),
                         screenGroups(e.height, kScreenGroupY), 1);
         });
@@ -95,8 +88,49 @@ class LightingPass final : public Effect {
   }
 
  private:
+  // The lighting.comp specialization constants of one configuration (constant_id order).
+  using Variant = std::array<uint32_t, 7>;
+
+  // The pipeline for this frame's lights, PCF radius, optional inputs (mode per input: 0
+  // fallback, 1 same size, 2 other size) and environment kind, built on first use: a scene
+  // needs one or two, and the disk pipeline cache keeps them between runs.
+  const vk::Pipeline& variant(const std::array<uint32_t, 3>& inputs) {
+    uint32_t types = 0, shadowTypes = 0;
+    for (const GpuLight& l : s_.lights.lights) {
+      const uint32_t bit = 1u << std::clamp(int(l.directionType.w), 0, 2);
+      types |= bit;
+      if (l.shadow.x >= 0.0f) shadowTypes |= bit;
+    }
+    const Variant key{
+        types,     shadowTypes,          std::min(s_.settings.pcfRadius, 3u), inputs[0], inputs[1],
+        inputs[2], s_.environment.kind()};
+    auto found = pipelines_.find(key);
+    if (found != pipelines_.end()) return found->second;
+    const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
+               tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+               img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+    return pipelines_
+        .emplace(key, vk::Pipeline::compute(s_.ctx, vk::loadSpirv("lighting.comp"),
+                                            {{0, ubo},
+                                             {1, tex},
+                                             {2, tex},
+                                             {3, tex},
+                                             {4, tex},
+                                             {5, tex},
+                                             {6, ubo},
+                                             {7, ubo},
+                                             {8, tex},
+                                             {9, img},
+                                             {10, tex},
+                                             {11, tex},
+                                             {12, tex},
+                                             {13, tex}},
+                                            0, {key.begin(), key.end()}))
+        .first->second;
+  }
+
   EngineState& s_;
-  vk::Pipeline pipeline_;
+  std::map<Variant, vk::Pipeline> pipelines_;
 };
 
 }  // namespace
