@@ -66,16 +66,20 @@ vec2 equirectUV(vec3 d) {
   return vec2(u < 0.0 ? u + 1.0 : u, acos(clamp(d.y, -1.0, 1.0)) * (1.0 / 3.14159265358979));
 }
 
-// Procedural sky radiance in world direction `dir` (or the constant environment). Shaders
-// without the map texture get its low-frequency (SH) approximation for kind 2; lighting.comp
-// samples the map itself.
-vec3 environmentRadiance(FrameUniforms f, vec3 dir) {
-  if (f.skyHorizon.w > 1.5) return environmentIrradianceOverPi(f, dir);
-  if (f.skyHorizon.w > 0.5) return f.skyGround.rgb * f.skyZenith.w;
+// The procedural sky (environment kind 0) in world direction `dir`.
+vec3 proceduralSkyRadiance(FrameUniforms f, vec3 dir) {
   float y = clamp(dir.y, -1.0, 1.0);
   vec3 c = y >= 0.0 ? mix(f.skyHorizon.rgb, f.skyZenith.rgb, sqrt(y))
                     : mix(f.skyHorizon.rgb, f.skyGround.rgb, sqrt(-y));
   return c * f.skyZenith.w;
+}
+
+// Environment radiance in world direction `dir`. Shaders without the map texture get its
+// low-frequency (SH) approximation for kind 2; lighting.comp samples the map itself.
+vec3 environmentRadiance(FrameUniforms f, vec3 dir) {
+  if (f.skyHorizon.w > 1.5) return environmentIrradianceOverPi(f, dir);
+  if (f.skyHorizon.w > 0.5) return f.skyGround.rgb * f.skyZenith.w;
+  return proceduralSkyRadiance(f, dir);
 }
 
 #endif

@@ -66,7 +66,7 @@ void main() {
     else if (kEnvironmentKind == 1)
       sky = frame.skyGround.rgb * frame.skyZenith.w;
     else
-      sky = environmentRadiance(frame, viewDirWorld);
+      sky = proceduralSkyRadiance(frame, viewDirWorld);
     imageStore(outLit, p, vec4(sky, 1.0));
     return;
   }
