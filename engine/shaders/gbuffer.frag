@@ -22,11 +22,14 @@ void main() {
   vec4 albedo = material.baseColor;
   if (material.params.z > 0.5) albedo *= texture(baseColorTexture, inUV);
 
-  // Geometric fallback when the interpolated normal is degenerate; facing the camera so
-  // double-sided surfaces shade from either side.
+  // The triangle's plane normal on the side the camera sees (the fallback when the interpolated
+  // normal is degenerate). The interpolated normal is turned to that side, so a double-sided
+  // surface shades from either side; it is not turned toward the viewer, which near a
+  // silhouette (where interpolated normals face slightly away) would point it into the object.
   vec3 faceN = safeNormalize(cross(dFdx(inViewPos), dFdy(inViewPos)), vec3(0, 0, 1));
+  if (dot(faceN, -inViewPos) < 0.0) faceN = -faceN;
   vec3 n = safeNormalize(inViewNormal, faceN);
-  if (dot(n, -inViewPos) < 0.0) n = -n;
+  if (dot(n, faceN) < 0.0) n = -n;
 
   outNormal = vec4(n, 1.0);
   outAlbedo = vec4(clamp(albedo.rgb, 0.0, 1.0), 1.0);

@@ -26,9 +26,11 @@ void main() {
 
   int type = int(v.lightPosType.w);
   vec3 towardLight = type == 0 ? -v.lightDirRange.xyz : v.lightPosType.xyz - inWorldPos;
+  // Double-sided like the G-buffer: the normal goes to the side of the triangle the light sees.
   vec3 faceN = safeNormalize(cross(dFdx(inWorldPos), dFdy(inWorldPos)), towardLight);
+  if (dot(faceN, towardLight) < 0.0) faceN = -faceN;
   vec3 n = safeNormalize(inWorldNormal, faceN);
-  if (dot(n, towardLight) < 0.0) n = -n;  // double-sided, like the G-buffer
+  if (dot(n, faceN) < 0.0) n = -n;
 
   vec3 flux;
   if (type == 0) {
