@@ -23,6 +23,11 @@ layout(set = 0, binding = 4, r16f) uniform writeonly image2D outAO;
 
 // Guard: taps at or behind the camera plane (clip.w below this) are untestable: open.
 const float kMinClipW = 1e-20;
+// Guard: the depth buffer gives view distances to a relative ~2^-23 only (float32 reverse-Z),
+// and the slide below rounds too: an occluder must lie at least this fraction of its distance
+// in front of a tap, or a flat face occludes itself in bands once the radius (and so the bias)
+// nears that resolution. Radii below it find no occluders at all (AO 1: unresolvable).
+const float kDepthResolution = 1e-6;
 // Guard: the texel-centre slide (below) is skipped when the tap's tangent-parallel plane passes
 // this close to the camera (|N.Q| below kSlideMinK x view distance): it would be ill-conditioned.
 const float kSlideMinK = 1e-4;
@@ -120,9 +125,12 @@ void main() {
     float slid = invW + dot(g, vec2(t) + 0.5 - pix) * invK;
     float iQ = (K < minK && slid > 0.0) ? slid : invW;  // tap, 1 / distance
 
-    // bias < zQ - zS < R, in inverse distances (both positive): no division needed.
+    // max(bias, resolution x zQ) < zQ - zS < R, in inverse distances (both positive; zQ x iS x
+    // iQ = iS): no division needed.
     float diff = iS - iQ, prod = iS * iQ;
-    occluded += (valid && diff > bias * prod && diff < R * prod) ? 1.0 : 0.0;
+    occluded += (valid && diff > max(bias * prod, kDepthResolution * iS) && diff < R * prod)
+                    ? 1.0
+                    : 0.0;
   }
   float ao = clamp(1.0 - ssao.params.z * occluded / float(count), 0.0, 1.0);
   imageStore(outAO, p, vec4(ao));

@@ -50,7 +50,7 @@ class SsaoEffect : public gi::Effect {
 
   std::vector<gi::SettingDesc> settings() const override {
     return {
-        {"radius", SettingType::Float, 0.5, 1e-4, 1e4,
+        {"radius", SettingType::Float, 0.5, 1e-6, 1e9,
          "world-space radius R of the sampled hemisphere (scale it with the scene)", false},
         {"samples", SettingType::Int, 16, 1, gi::ssao::kMaxSamples, "taps per pixel", false},
         {"bias", SettingType::Float, 0.025, 0.0, 0.5,
