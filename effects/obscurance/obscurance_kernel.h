@@ -15,7 +15,8 @@
 // Guard ("phantom open sample"): W = (N/n + eta) / (D/n + eta), i.e. eta n extra rays that are
 // open in both sums. It keeps D + eta > 0, W in [0, 1] (N <= D), gives W = 1 for a fully
 // occluded white neighbourhood (the limit a -> 1 at any O > 0: a white room has no dark
-// corners), and biases W by at most eta (1 - O) / (1 + eta) elsewhere (albedo 0: W = O + that).
+// corners), and biases W by eta (1 - W) / (D/n + eta) elsewhere: at most eta (1 - O) for
+// black occluders (D = n), growing only where D/n is small, i.e. where W -> 1 anyway.
 #pragma once
 
 #include <algorithm>
@@ -88,7 +89,8 @@ inline double membershipInverse(Membership m, double u) {
 }
 
 // n points in [0, 1]^dims (dims 2 or 3; unused coordinates 0.5) relaxed by Lloyd's algorithm
-// over a dense uniform candidate set: a Poisson-disc-like, blue-noise set (seed 001 §4.1).
+// over a dense uniform candidate set: a Poisson-disc-like, blue-noise set (seed 001 §4.1),
+// then with rank-stratified marginals (below).
 // Deterministic: std::mt19937 is fully specified, and the floats are built from its bits.
 inline std::vector<std::array<double, 3>> lloydPoints(int n, int dims) {
   std::mt19937 rng(kLloydSeed + uint32_t(n) * 7u + uint32_t(dims));
@@ -116,6 +118,20 @@ inline std::vector<std::array<double, 3>> lloydPoints(int n, int dims) {
     for (size_t s = 0; s < sites.size(); ++s)  // a site without candidates stays put
       if (sum[s][3] > 0.0)
         for (int d = 0; d < 3; ++d) sites[s][size_t(d)] = sum[s][size_t(d)] / sum[s][3];
+  }
+  // Marginals stratified by rank: coordinate d of the k-th smallest site becomes (k + 0.5) / n.
+  // Lloyd's centroids keep away from the cube's faces unevenly for small n (16 sites: mean
+  // xi_y 0.546 instead of 0.5, which made corner AO 0.014 too dark on average); ranks keep the
+  // relaxed arrangement and make every 1-D projection (elevation, distance) exactly stratified.
+  std::vector<size_t> order(sites.size());
+  for (int d = 0; d < dims; ++d) {
+    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+      return sites[a][size_t(d)] < sites[b][size_t(d)] ||
+             (sites[a][size_t(d)] == sites[b][size_t(d)] && a < b);
+    });
+    for (size_t k = 0; k < order.size(); ++k)
+      sites[order[k]][size_t(d)] = (double(k) + 0.5) / double(n);
   }
   return sites;
 }
