@@ -5,8 +5,10 @@
 // Obscurance / ambient transfer (seed 001 §4, eqs. 7-9): containment tests of precomputed
 // samples (cosine x mu' importance sampled, obscurance_kernel.h) against the depth buffer, with
 // the silhouette test 0 < z - z* < R and 4x4 interleaved rotations. Writes per pixel the sample
-// means of the numerator and denominator of eq. 9 (r = N / n, g = D / n); the filter pass
-// averages both over 4x4 pixels and divides (a ratio of sums, as weighted importance sampling).
+// means of the numerator and denominator of eq. 9 (N / n, D / n) and what the depth-aware
+// filter needs of the G-buffer (1 / view distance and its tangent-plane slopes), packed in one
+// RGBA32UI texel so that the filter fetches each neighbour once (notes/llvmpipe.md: ~1 ms per
+// full-screen fetch at 640x480); the filter averages the sums over 4x4 pixels and divides.
 // Settings that change code are specialization constants (notes/llvmpipe.md: a runtime `if`
 // runs both sides on llvmpipe; constant loops unroll, so the UBO taps are scalar loads).
 layout(local_size_x = 32, local_size_y = 16) in;
@@ -26,7 +28,7 @@ layout(set = 0, binding = 2) uniform sampler2D gDepth;
 layout(set = 0, binding = 3) uniform sampler2D gNormal;
 layout(set = 0, binding = 4) uniform sampler2D gAlbedo;
 layout(set = 0, binding = 5) uniform sampler2D gEmission;
-layout(set = 0, binding = 6, rg16f) uniform writeonly image2D outSums;
+layout(set = 0, binding = 6, rgba32ui) uniform writeonly uimage2D outSums;
 
 // Guard: test points at or behind the camera plane (clip.w below this) are untestable: open.
 const float kMinClipW = 1e-20;
@@ -51,8 +53,9 @@ void main() {
   float depth = texelFetch(gDepth, p, 0).r;
   vec4 normalTexel = texelFetch(gNormal, p, 0);
   // Guard: sky / far-plane pixels and pixels without geometry are open (O = W = 1).
+  // 1 / distance 0 marks them for the filter (nothing is averaged into or out of them).
   if (isSky(depth) || !(normalTexel.w > 0.5)) {
-    imageStore(outSums, p, vec4(1.0, 1.0, 0.0, 0.0));
+    imageStore(outSums, p, uvec4(packHalf2x16(vec2(1.0)), 0u, 0u, 0u));
     return;
   }
 
@@ -141,5 +144,17 @@ void main() {
     }
   }
   float invN = 1.0 / float(SAMPLES);
-  imageStore(outSums, p, vec4(nSum * invN, MODE == 0 ? 1.0 : dSum * invN, 0.0, 0.0));
+  vec2 sums = vec2(nSum * invN, MODE == 0 ? 1.0 : dSum * invN);
+
+  // For the filter: on the tangent plane N.X = N.P, 1/z along the pixel's view ray D (z = -1)
+  // is (N.D) / (N.P), so its slope per pixel is (1/z) (N.x dDx, N.y dDy) / (N.D).
+  float ic = 1.0 / dist;
+  vec3 D = vec3((ndc.x + p20) / p00, (ndc.y + p21) / p11, -1.0);
+  float nd = dot(N, D);
+  vec2 dD = 2.0 * frame.viewport.zw / vec2(p00, p11);
+  // Guard: a grazing normal (N.D near 0) predicts nothing: slope 0, so only neighbours at the
+  // centre's own distance are averaged.
+  vec2 slope = nd < -1e-4 * length(D) ? ic * N.xy * dD / nd : vec2(0.0);
+  slope = clamp(slope, vec2(-60000.0), vec2(60000.0));  // finite in 16 bits
+  imageStore(outSums, p, uvec4(packHalf2x16(sums), floatBitsToUint(ic), packHalf2x16(slope), 0u));
 }

@@ -28,9 +28,10 @@ namespace obs = gi::obscurance;
 using gi::SettingType;
 
 constexpr VkFormat kAOFormat = VK_FORMAT_R16_SFLOAT;
-constexpr VkFormat kSumsFormat = VK_FORMAT_R16G16_SFLOAT;  // N / n, D / n
-constexpr uint32_t kGroupX = 32, kGroupY = 16;             // 32x16: llvmpipe's fastest
-constexpr int kFilterRadius = 2;                           // [.5 1 1 1 .5]: the 4x4 box
+// half2(N / n, D / n), 1 / distance, half2 slopes: what the filter reads, one fetch per tap.
+constexpr VkFormat kSumsFormat = VK_FORMAT_R32G32B32A32_UINT;
+constexpr uint32_t kGroupX = 32, kGroupY = 16;  // 32x16: llvmpipe's fastest
+constexpr int kFilterRadius = 2;                // [.5 1 1 1 .5]: the 4x4 box
 
 uint32_t groupsOf(uint32_t n, uint32_t size) {
   return (n + size - 1) / size;
@@ -102,8 +103,7 @@ class ObscuranceEffect : public gi::Effect {
         obs::specialize(words(std::begin(obscurance_comp), std::end(obscurance_comp)),
                         {{0, s.integer("samples")}, {1, s.integer("points_per_ray")}, {2, mode}}),
         {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, tex}, {5, tex}, {6, img}});
-    const std::vector<gi::vk::Binding> filterBindings = {{0, ubo}, {1, ubo}, {2, tex},
-                                                         {3, tex}, {4, tex}, {5, img}};
+    const std::vector<gi::vk::Binding> filterBindings = {{0, ubo}, {1, ubo}, {2, tex}, {3, img}};
     const std::map<uint32_t, int32_t> filterSpec = {{0, mode}, {1, filter_ ? kFilterRadius : 0}};
     filterX_ = gi::vk::Pipeline::compute(
         vk,
@@ -161,8 +161,6 @@ class ObscuranceEffect : public gi::Effect {
     graph.addPass(
         "obscurance_filter",
         [&](gi::PassBuilder& b) {
-          io->depth = b.read(io->depth);
-          io->normal = b.read(io->normal);
           io->sums = b.read(io->sums);
           if (filter)
             io->half = b.write(b.create("obscurance_filter_x", gi::TextureDesc{kSumsFormat}),
@@ -177,10 +175,8 @@ class ObscuranceEffect : public gi::Effect {
             gi::vk::DescriptorWriter w;
             w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame)
                 .buffer(1, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms_.handle())
-                .sampled(2, pc.view(io->depth), nearest)
-                .sampled(3, pc.view(io->normal), nearest)
-                .sampled(4, in, nearest, inLayout)
-                .storageImage(5, out);
+                .sampled(2, in, nearest, inLayout)
+                .storageImage(3, out);
             dispatch(pc, p, w, groupsOf(e.width, kGroupX), groupsOf(e.height, kGroupY));
           };
           if (!filter) {
