@@ -1,0 +1,241 @@
+// Obscurance and the ambient transfer function (Umenhoffer, Toth, Szirmay-Kalos; seed 001):
+// containment tests of Lloyd-relaxed, cos x mu' importance-sampled points against the depth
+// buffer, the silhouette test, 4x4 interleaving and a depth-aware 4x4 box filter. Publishes
+// "ao": obscurance O (transfer off) or the ambient transfer W (eq. 6/9), which the lighting pass
+// multiplies into its environment term, i.e. L' = a W L^a (eq. 2). Estimator, guard and sample
+// set: obscurance_kernel.h; measurements: README.md.
+#include <algorithm>
+#include <array>
+#include <map>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "gi/effect.h"
+#include "gi/effect_registry.h"
+#include "gi/vk/pipeline.h"
+#include "gi/vk/resources.h"
+#include "obscurance.comp.h"         // const uint32_t obscurance_comp[]
+#include "obscurance_filter.comp.h"  // const uint32_t obscurance_filter_comp[]
+#include "obscurance_kernel.h"
+#include "obscurance_resolve.comp.h"  // const uint32_t obscurance_resolve_comp[]
+#include "spirv_specialize.h"
+
+namespace {
+
+namespace res = gi::resources;
+namespace obs = gi::obscurance;
+using gi::SettingType;
+
+constexpr VkFormat kAOFormat = VK_FORMAT_R16_SFLOAT;
+// half2(N / n, D / n), 1 / distance, half2 slopes: what the filter reads, one fetch per tap.
+constexpr VkFormat kSumsFormat = VK_FORMAT_R32G32B32A32_UINT;
+constexpr uint32_t kGroupX = 32, kGroupY = 16;  // 32x16: llvmpipe's fastest
+constexpr int kFilterRadius = 2;                // [.5 1 1 1 .5]: the 4x4 box
+
+uint32_t groupsOf(uint32_t n, uint32_t size) {
+  return (n + size - 1) / size;
+}
+
+std::vector<uint32_t> words(const uint32_t* begin, const uint32_t* end) {
+  return {begin, end};
+}
+
+class ObscuranceEffect : public gi::Effect {
+ public:
+  gi::EffectInfo info() const override {
+    gi::EffectInfo i;
+    i.name = "obscurance";
+    i.version = "1.0";
+    i.description =
+        "obscurance with a fuzzy membership and the ambient transfer function with "
+        "interreflections (seed 001)";
+    i.stage = gi::EffectStage::BeforeLighting;
+    i.reads = {res::kDepth, res::kNormal, res::kAlbedo, res::kEmission};
+    i.writes = {res::kAO};
+    i.debugView = res::kAO;
+    // It estimates obscurance (gi-reference --quantity obscurance --membership <membership>);
+    // AO is the closest ground truth an effect can declare today (equal for membership step).
+    i.estimates = gi::GroundTruth::AmbientOcclusion;
+    return i;
+  }
+
+  std::vector<gi::SettingDesc> settings() const override {
+    return {
+        {"radius", SettingType::Float, 0.5, 1e-4, 1e4,
+         "world-space radius R: the membership reaches 1 (fully open) at distance R", false},
+        gi::SettingDesc::enumeration(
+            "membership", obs::membershipNames(), int(obs::Membership::Sqrt),
+            "fuzzy membership mu(d / R) of an occluder at distance d: sqrt (Mendez et al.), "
+            "step (ambient occlusion), linear, smoothstep"),
+        {"samples", SettingType::Int, 16, 1, obs::kMaxSamples,
+         "rays per pixel (x 16 interleaved rotations after the filter)", true},
+        {"points_per_ray", SettingType::Int, 1, 1, 2,
+         "containment tests along each ray (seed 001: 1 or 2); 2 catches thin occluders", true},
+        gi::SettingDesc::enumeration(
+            "transfer", obs::transferNames(), int(obs::Transfer::Off),
+            "output: off = obscurance O; albedo = ambient transfer W (interreflections with the "
+            "occluders' albedo, eq. 9); emission = W with the occluders' radiance (emission + "
+            "albedo x ambient), clamped to 1",
+            true),
+        {"bias", SettingType::Float, 0.02, 0.0, 0.5,
+         "a test point must be this far behind the depth buffer's surface to count as inside, "
+         "as a fraction of R",
+         false},
+        {"filter", SettingType::Bool, 1, 0, 1,
+         "depth-aware 4x4 box filter of the interleaved estimate", true},
+        {"interleave", SettingType::Bool, 1, 0, 1,
+         "rotate the sample set in a 4x4 pixel pattern (16 rotations) for the filter to average",
+         false},
+    };
+  }
+
+  void prepare(gi::EffectContext& ctx, const gi::SettingValues& s) override {
+    gi::vk::Context& vk = ctx.vulkan();
+    vk.requireWorkgroup(kGroupX, kGroupY, "obscurance");
+    const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
+               tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+               img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+    const int mode = s.integer("transfer");
+    filter_ = s.flag("filter");
+    main_ = gi::vk::Pipeline::compute(
+        vk,
+        obs::specialize(words(std::begin(obscurance_comp), std::end(obscurance_comp)),
+                        {{0, s.integer("samples")}, {1, s.integer("points_per_ray")}, {2, mode}}),
+        {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, tex}, {5, tex}, {6, img}});
+    const std::vector<gi::vk::Binding> filterBindings = {{0, ubo}, {1, ubo}, {2, tex}, {3, img}};
+    const std::map<uint32_t, int32_t> filterSpec = {{0, mode}, {1, filter_ ? kFilterRadius : 0}};
+    filterX_ = gi::vk::Pipeline::compute(
+        vk,
+        obs::specialize(words(std::begin(obscurance_filter_comp), std::end(obscurance_filter_comp)),
+                        filterSpec),
+        filterBindings);
+    resolve_ = gi::vk::Pipeline::compute(vk,
+                                         obs::specialize(words(std::begin(obscurance_resolve_comp),
+                                                               std::end(obscurance_resolve_comp)),
+                                                         filterSpec),
+                                         filterBindings);
+    if (!uniforms_)
+      uniforms_ =
+          gi::vk::Buffer(vk, sizeof(obs::Uniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true);
+    uploaded_.reset();  // the sample count may have changed
+  }
+
+  void addPasses(gi::FrameGraph& graph, gi::EffectContext& ctx,
+                 const gi::SettingValues& settings) override {
+    struct Io {
+      gi::TextureHandle depth, normal, albedo, emission, sums, half, ao;
+    };
+    auto io = std::make_shared<Io>();
+    gi::Blackboard& bb = graph.blackboard();
+    const VkBuffer frame = ctx.frameUniforms();
+    const VkSampler nearest = ctx.nearestSampler();
+
+    graph.addPass(
+        "obscurance",
+        [&](gi::PassBuilder& b) {
+          io->depth = b.read(bb.texture(res::kDepth));
+          io->normal = b.read(bb.texture(res::kNormal));
+          io->albedo = b.read(bb.texture(res::kAlbedo));
+          io->emission = b.read(bb.texture(res::kEmission));
+          io->sums = b.write(b.create("obscurance_sums", gi::TextureDesc{kSumsFormat}),
+                             gi::TextureUsage::StorageWrite);
+        },
+        [this, io, values = &settings, frame, nearest](gi::PassContext& pc) {
+          upload(*values);
+          gi::vk::DescriptorWriter w;
+          w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame)
+              .buffer(1, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms_.handle())
+              .sampled(2, pc.view(io->depth), nearest)
+              .sampled(3, pc.view(io->normal), nearest)
+              .sampled(4, pc.view(io->albedo), nearest)
+              .sampled(5, pc.view(io->emission), nearest)
+              .storageImage(6, pc.view(io->sums));
+          const VkExtent2D e = pc.extent(io->sums);
+          dispatch(pc, main_, w, groupsOf(e.width, kGroupX), groupsOf(e.height, kGroupY));
+        });
+
+    // Filter along x into `half`, then along y with the division into "ao"; without the filter
+    // only the division (one dispatch).
+    const bool filter = settings.flag("filter");  // changesGraph: prepare() matched it
+    graph.addPass(
+        "obscurance_filter",
+        [&](gi::PassBuilder& b) {
+          io->sums = b.read(io->sums);
+          if (filter)
+            io->half = b.write(b.create("obscurance_filter_x", gi::TextureDesc{kSumsFormat}),
+                               gi::TextureUsage::StorageWrite);
+          io->ao = b.write(b.create(res::kAO, gi::TextureDesc{kAOFormat}),
+                           gi::TextureUsage::StorageWrite);
+        },
+        [this, io, frame, nearest, filter](gi::PassContext& pc) {
+          const VkExtent2D e = pc.extent(io->ao);
+          auto axis = [&](const gi::vk::Pipeline& p, VkImageView in, VkImageLayout inLayout,
+                          VkImageView out) {
+            gi::vk::DescriptorWriter w;
+            w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame)
+                .buffer(1, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms_.handle())
+                .sampled(2, in, nearest, inLayout)
+                .storageImage(3, out);
+            dispatch(pc, p, w, groupsOf(e.width, kGroupX), groupsOf(e.height, kGroupY));
+          };
+          if (!filter) {
+            axis(resolve_, pc.view(io->sums), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                 pc.view(io->ao));
+            return;
+          }
+          axis(filterX_, pc.view(io->sums), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+               pc.view(io->half));
+          // The graph orders passes, not dispatches inside one: the y dispatch reads what the
+          // x dispatch wrote (the image stays GENERAL, as storage images are).
+          imageBarrier(pc.cmd(), pc.image(io->half));
+          axis(resolve_, pc.view(io->half), VK_IMAGE_LAYOUT_GENERAL, pc.view(io->ao));
+        });
+    bb.put(res::kAO, io->ao);
+  }
+
+ private:
+  // Host-visible and written while recording (the renderer waits for each frame before it
+  // records the next). The sample set is rebuilt only when a setting it depends on changed.
+  void upload(const gi::SettingValues& s) {
+    const std::array<double, 5> key = {
+        s.number("radius"), s.number("bias"), double(s.integer("membership")),
+        double(s.integer("samples")), s.flag("interleave") ? 1.0 : 0.0};
+    if (key == uploaded_) return;
+    const obs::Uniforms u =
+        obs::makeUniforms(key[0], key[1], obs::Membership(int(key[2])), int(key[3]), key[4] != 0.0);
+    uniforms_.write(&u, sizeof u);
+    uploaded_ = key;
+  }
+
+  static void dispatch(gi::PassContext& pc, const gi::vk::Pipeline& p, gi::vk::DescriptorWriter& w,
+                       uint32_t x, uint32_t y) {
+    pc.descriptors().bind(pc.cmd(), p, w);
+    vkCmdDispatch(pc.cmd(), x, y, 1);
+  }
+
+  // Compute write -> compute sampled read of a storage image that stays in GENERAL.
+  static void imageBarrier(VkCommandBuffer cmd, VkImage image) {
+    VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
+    b.srcStageMask = b.dstStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+    b.srcAccessMask = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
+    b.dstAccessMask = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT;
+    b.oldLayout = b.newLayout = VK_IMAGE_LAYOUT_GENERAL;
+    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    b.image = image;
+    b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+    VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+    dep.imageMemoryBarrierCount = 1;
+    dep.pImageMemoryBarriers = &b;
+    vkCmdPipelineBarrier2(cmd, &dep);
+  }
+
+  gi::vk::Pipeline main_, filterX_, resolve_;
+  bool filter_ = true;
+  gi::vk::Buffer uniforms_;
+  std::optional<std::array<double, 5>> uploaded_;  // the settings uniforms_ holds
+};
+
+}  // namespace
+
+GI_EFFECT_MODULE(ObscuranceEffect)

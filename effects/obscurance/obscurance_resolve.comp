@@ -1,0 +1,7 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#include "common.glsl"
+// Filter along y and divide: sums -> "ao" (obscurance_filter.glsl).
+#define GI_AXIS ivec2(0, 1)
+#define GI_RESOLVE 1
+#include "obscurance_filter.glsl"
