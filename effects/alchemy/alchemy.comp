@@ -68,6 +68,10 @@ void main() {
 
   vec2 centre = vec2(q) + 0.5;
   float biasZ = beta * dist;
+  // The view ray (z = -1) through a texel's centre is affine in the texel: D(t) = ray0 + t dRay.
+  vec2 invP = 1.0 / vec2(p00, p11);
+  vec2 dRay = toNdc * invP;
+  vec2 ray0 = (0.5 * toNdc - 1.0 + vec2(p20, p21)) * invP;
   float sum = 0.0;
   for (int i = 0; i < kSamples; ++i) {
     // Constants after unrolling: the spiral tap on the unit disk.
@@ -76,27 +80,28 @@ void main() {
     vec2 tp = floor(centre + vec2(o.x * rot.x - o.y * rot.y, o.x * rot.y + o.y * rot.x));
     // Guard: taps outside the depth image count as unoccluded (clamped for the fetch).
     bool inside = tp.x >= 0.0 && tp.y >= 0.0 && tp.x < float(size.x) && tp.y < float(size.y);
-    ivec2 t = ivec2(clamp(tp, vec2(0.0), vec2(size - 1)));
-    float d = texelFetch(gDepth, t, 0).r;
-    float tdist = p32 / max(d + p22, 1e-30);
-    vec2 tndc = (vec2(t) + 0.5) * toNdc - 1.0;
-    vec3 v = vec3((tndc.x + p20) * tdist / p00, (tndc.y + p21) * tdist / p11, -tdist) - C;
-    float vv = dot(v, v);
+    vec2 t = clamp(tp, vec2(0.0), vec2(size - 1));
+    float d = texelFetch(gDepth, ivec2(t), 0).r;
+    // With it = 1 / (the tap's view distance) and P = D / it: w = it v = D - it C, so
+    //   max(0, v.n - beta z) / (v.v + epsilon) = it max(0, w.n - beta z it) / (w.w + epsilon it^2)
+    // and v.v < r^2 <=> w.w < r^2 it^2: one division per tap instead of three.
+    float it = (d + p22) * invP32;
+    vec3 w = vec3(ray0 + t * dRay, -1.0) - it * C;
+    float ww = dot(w, w), it2 = it * it;
     // epsilon: the denominator's guard (v = 0 gives 0 / epsilon; a tap adds at most
     // 1 / (2 sqrt(epsilon))). Sky taps and taps beyond r (eq. 9's Heaviside) count nothing.
-    float term = max(0.0, dot(v, N) - biasZ) / (vv + eps);
-    sum += (inside && !isSky(d) && vv < r2) ? term : 0.0;
+    float term = it * max(0.0, dot(w, N) - biasZ * it) / (ww + eps * it2);
+    sum += (inside && !isSky(d) && ww < r2 * it2) ? term : 0.0;
   }
   float base = max(0.0, 1.0 - params.a.z * sum);
   float ao = base > 0.0 ? min(pow(base, params.a.w), 1.0) : 0.0;  // NaN sum: 0, never NaN
 
   // Tangent-plane slopes of 1/z per pixel for the blur's edge stopping: on the plane N.X = K,
-  // 1/z = (N.D)/K with D the pixel's view ray (z = -1), so d(1/z)/dpixel = (1/z) N.xy dD / (N.D).
-  vec3 D = vec3((ndc.x + p20) / p00, (ndc.y + p21) / p11, -1.0);
+  // 1/z = (N.D)/K with D the pixel's view ray (z = -1), so d(1/z)/dpixel = (1/z) N.xy dRay / (N.D).
+  vec3 D = vec3((ndc + vec2(p20, p21)) * invP, -1.0);
   float nd = dot(N, D);
-  vec2 dD = toNdc / vec2(p00, p11);
   // Guard: a grazing plane (N.D near 0) predicts nothing: slope 0.
-  vec2 slope = nd < -1e-4 * length(D) ? ic * N.xy * dD / nd : vec2(0.0);
+  vec2 slope = nd < -1e-4 * length(D) ? ic * N.xy * dRay / nd : vec2(0.0);
 
   bool sky = isSky(depth) || !(normalTexel.w > 0.5);
   imageStore(outAO, p, sky ? vec4(1.0, 0.0, 0.0, 0.0) : vec4(ao, ic, slope));
