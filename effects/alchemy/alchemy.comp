@@ -13,8 +13,8 @@
 // Assumes a perspective projection (clip.w = view distance), as every engine camera has.
 layout(local_size_x = 32, local_size_y = 16) in;
 
-// Specialized at pipeline creation (spirv_specialize.h): the tap loop is unrolled and its
-// constants folded; the band offset is folded into the addressing.
+// Specialized at pipeline creation (spirv_specialize.h): a constant trip count and the band
+// offset folded into the addressing.
 layout(constant_id = 0) const int kSamples = 12;
 layout(constant_id = 1) const int kBand = 0;
 
@@ -23,12 +23,11 @@ layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 layout(set = 0, binding = 1) uniform AlchemyParams {
   vec4 a;  // radius r, bias beta, 2 sigma / s, contrast k
   vec4 b;  // epsilon, blur tolerance (world), r^2, 0
+  uvec4 taps[16];  // tap i: taps[i / 4][i % 4], packSnorm2x16 of its unit-disk offset
 } params;
 layout(set = 0, binding = 2) uniform sampler2D gDepth;
 layout(set = 0, binding = 3) uniform sampler2D gNormal;
 layout(set = 0, binding = 4, rgba32f) uniform writeonly image2D outAO;
-
-const float kGoldenAngle = 2.39996322972865332;  // gi::alchemy::kGoldenAngle
 
 void main() {
   ivec2 p = ivec2(gl_GlobalInvocationID.xy);
@@ -74,9 +73,7 @@ void main() {
   vec2 ray0 = (0.5 * toNdc - 1.0 + vec2(p20, p21)) * invP;
   float sum = 0.0;
   for (int i = 0; i < kSamples; ++i) {
-    // Constants after unrolling: the spiral tap on the unit disk.
-    float tr = (float(i) + 0.5) / float(kSamples), ta = float(i) * kGoldenAngle;
-    vec2 o = tr * vec2(cos(ta), sin(ta));
+    vec2 o = unpackSnorm2x16(params.taps[i >> 2][i & 3]);  // the spiral tap on the unit disk
     vec2 tp = floor(centre + vec2(o.x * rot.x - o.y * rot.y, o.x * rot.y + o.y * rot.x));
     // Guard: taps outside the depth image count as unoccluded (clamped for the fetch).
     bool inside = tp.x >= 0.0 && tp.y >= 0.0 && tp.x < float(size.x) && tp.y < float(size.y);

@@ -21,6 +21,7 @@ layout(constant_id = 0) const int kRadius = 4;  // 1..gi::alchemy::kMaxBlurRadiu
 layout(set = 0, binding = 0) uniform AlchemyParams {
   vec4 a;  // radius r, bias beta, 2 sigma / s, contrast k
   vec4 b;  // epsilon, blur tolerance (world), r^2, 0
+  uvec4 taps[16];
 } params;
 layout(set = 0, binding = 1) uniform sampler2D inAO;
 #ifdef ALCHEMY_BLUR_FINAL

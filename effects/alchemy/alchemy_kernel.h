@@ -50,20 +50,47 @@ struct Uniforms {
   float blurTolerance;  // absolute, world units (kBlurDepthTolerance x r)
   float radius2;        // r^2
   float pad;
+  uint32_t taps[kMaxSamples / 4][4];  // tap i at [i / 4][i % 4]: packTap(exactTapOffset(i, s))
 };
-static_assert(sizeof(Uniforms) == 32, "std140 layout");
+static_assert(sizeof(Uniforms) == 32 + kMaxSamples * 4, "std140 layout");
+
+// Unit-disk offset of tap i of s, before the pixel's rotation.
+inline glm::vec2 exactTapOffset(int i, int s) {
+  const double radius = (i + 0.5) / s, angle = i * kGoldenAngle;
+  return glm::vec2(float(radius * std::cos(angle)), float(radius * std::sin(angle)));
+}
+// One tap in 32 bits, GLSL's packSnorm2x16 (steps of 3e-5 of the disk radius): the shader reads
+// one uint per tap (a UBO value indexed by the tap counter is gathered lane by lane on llvmpipe;
+// sin and cos per tap measured 5x the cost of the rest of the tap).
+inline uint32_t packTap(glm::vec2 o) {
+  auto q = [](float v) {
+    return uint32_t(uint16_t(int16_t(std::lround(std::clamp(v, -1.0f, 1.0f) * 32767.0f))));
+  };
+  return q(o.x) | q(o.y) << 16;
+}
+// Exactly what alchemy.comp decodes (unpackSnorm2x16).
+inline glm::vec2 unpackTap(uint32_t p) {
+  auto u = [](uint32_t bits) { return std::max(float(int16_t(uint16_t(bits))) / 32767.0f, -1.0f); };
+  return {u(p & 0xffffu), u(p >> 16)};
+}
+// Tap i of s as the shader sees it.
+inline glm::vec2 tapOffset(int i, int s) {
+  return unpackTap(packTap(exactTapOffset(i, s)));
+}
 
 inline Uniforms makeUniforms(double radius, double bias, double intensity, double contrast,
                              double epsilon, int samples) {
   const int s = std::clamp(samples, 1, kMaxSamples);
-  return {float(radius),
-          float(bias),
-          float(2.0 * intensity / s),
-          float(contrast),
-          float(epsilon),
-          float(kBlurDepthTolerance * radius),
-          float(radius * radius),
-          0.0f};
+  Uniforms u{};
+  u.radius = float(radius);
+  u.bias = float(bias);
+  u.scale = float(2.0 * intensity / s);
+  u.contrast = float(contrast);
+  u.epsilon = float(epsilon);
+  u.blurTolerance = float(kBlurDepthTolerance * radius);
+  u.radius2 = float(radius * radius);
+  for (int i = 0; i < s; ++i) u.taps[i / 4][i % 4] = packTap(exactTapOffset(i, s));
+  return u;
 }
 
 // 4x4 Bayer rank of pixel (x, y), 0..15, computed the way the shader does (bit interleave of
@@ -71,14 +98,6 @@ inline Uniforms makeUniforms(double radius, double bias, double intensity, doubl
 inline int bayerRank(int x, int y) {
   const int b = (x ^ y) & 3;
   return ((b & 1) << 3) | ((y & 1) << 2) | ((b >> 1) << 1) | ((y >> 1) & 1);
-}
-
-// Unit-disk offset of tap i of s, before the pixel's rotation (alchemy.comp folds these
-// constants after specialization).
-inline glm::vec2 tapOffset(int i, int s) {
-  const float radius = (float(i) + 0.5f) / float(s);
-  const float angle = float(i) * float(kGoldenAngle);
-  return radius * glm::vec2(std::cos(angle), std::sin(angle));
 }
 
 // A depth/normal buffer as the CPU estimator reads it: reverse-Z depth (0 = sky), view-space
