@@ -136,7 +136,10 @@ class AlchemyEffect : public gi::Effect {
     const VkExtent2D big{e.width + 2 * uint32_t(band), e.height + 2 * uint32_t(band)};
     gi::CameraView camera = ctx.camera();
     const float sx = float(e.width) / float(big.width), sy = float(e.height) / float(big.height);
-    for (int c = 0; c < 4; ++c) camera.proj[c][0] *= sx, camera.proj[c][1] *= sy;
+    for (int c = 0; c < 4; ++c) {  // rows 0 and 1 of the (column-major) projection
+      camera.proj[c][0] *= sx;
+      camera.proj[c][1] *= sy;
+    }
     view_->setCamera(camera, big);
   }
 
