@@ -96,11 +96,6 @@ class AlchemyTest : public test::VulkanTest {
                     glm::vec4((x + 0.5f) / w * 2 - 1, (y + 0.5f) / h * 2 - 1, depthAt(x, y), 1.0f);
       return glm::vec3(glm::inverse(camera.view) * glm::vec4(glm::vec3(v) / v.w, 1.0f));
     }
-    double mean() const {
-      double s = 0.0;
-      for (size_t i = 0; i < ao.pixels.size(); i += 4) s += ao.pixels[i];
-      return s / double(ao.pixels.size() / 4);
-    }
   };
   RenderSettings settingsFor(const Scene& scene, const std::vector<std::string>& sets,
                              uint32_t w = kW, uint32_t h = kH) {
@@ -196,7 +191,7 @@ TEST_F(AlchemyTest, MonotoneInIntensityContrastAndEpsilon) {
   RenderSettings rs = settingsFor(scene, {"alchemy.blur_radius=0"});
   rs.view = "ao";
   Renderer r(ctx(), scene, rs, &registry);
-  auto sweep = [&](const char* key, std::vector<double> values, bool darker) {
+  auto sweep = [&](const char* key, const std::vector<double>& values, bool darker) {
     ImageRGBA32F prev;
     double prevMean = 0.0;
     for (double v : values) {
@@ -215,7 +210,7 @@ TEST_F(AlchemyTest, MonotoneInIntensityContrastAndEpsilon) {
           ASSERT_LE(darker ? d : -d, 1e-6f) << key << "=" << v << " pixel " << i / 4;
         }
       }
-      mean /= double(ao.pixels.size() / 4);
+      mean /= double(ao.pixels.size()) / 4.0;
       std::printf("%s = %g: mean AO %.4f\n", key, v, mean);
       if (!prev.pixels.empty()) {
         EXPECT_NE(mean, prevMean) << key << "=" << v;
