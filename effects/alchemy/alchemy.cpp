@@ -1,0 +1,288 @@
+// Alchemy screen-space ambient obscurance (McGuire, Osman, Bukowski, Hennessy 2011; seed 003):
+// the estimator of eq. 10 with spiral taps on the projected disk of the world radius r and 4x4
+// interleaved rotations (alchemy.comp, alchemy_kernel.h), a separable cross-bilateral filter
+// (alchemy_blur.glsl) and an optional guard band: the scene drawn again, through the engine's
+// GPU scene service, into a G-buffer `guard_band` pixels larger on each side, so that taps
+// leaving the screen still find occluders. Publishes "ao" (lighting multiplies the environment
+// term by it).
+#include <algorithm>
+#include <array>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "alchemy.comp.h"         // const uint32_t alchemy_comp[]
+#include "alchemy_blur_x.comp.h"  // const uint32_t alchemy_blur_x_comp[]
+#include "alchemy_blur_y.comp.h"  // const uint32_t alchemy_blur_y_comp[]
+#include "alchemy_kernel.h"
+#include "gi/effect.h"
+#include "gi/effect_registry.h"
+#include "gi/vk/pipeline.h"
+#include "gi/vk/resources.h"
+#include "spirv_specialize.h"
+
+namespace {
+
+namespace res = gi::resources;
+using gi::SettingType;
+
+// The estimator's packed output (AO, 1/z, plane slopes) and the x-filtered copy: RGBA32F, so
+// the filter reads one texel per tap. The final "ao" after the filter is R16F.
+constexpr VkFormat kPackedFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
+constexpr VkFormat kAOFormat = VK_FORMAT_R16_SFLOAT;
+// Workgroup size of the shaders (local_size_x/y there): 32x16 measured fastest on llvmpipe.
+constexpr uint32_t kGroupX = 32, kGroupY = 16;
+
+uint32_t groupsOf(uint32_t n, uint32_t size) {
+  return (n + size - 1) / size;
+}
+
+template <size_t N>
+std::span<const uint32_t> words(const uint32_t (&code)[N]) {
+  return {code, N};
+}
+
+class AlchemyEffect : public gi::Effect {
+ public:
+  gi::EffectInfo info() const override {
+    gi::EffectInfo i;
+    i.name = "alchemy";
+    i.version = "1.0";
+    i.description =
+        "Alchemy screen-space ambient obscurance (McGuire et al. 2011: eq. 10, spiral taps, "
+        "cross-bilateral filter, guard band)";
+    i.stage = gi::EffectStage::BeforeLighting;
+    i.reads = {res::kDepth, res::kNormal};
+    i.writes = {res::kAO};
+    i.debugView = res::kAO;
+    i.estimates = gi::GroundTruth::AmbientOcclusion;
+    return i;
+  }
+
+  std::vector<gi::SettingDesc> settings() const override {
+    using gi::alchemy::kMaxBlurRadius, gi::alchemy::kMaxGuardBand, gi::alchemy::kMaxSamples;
+    gi::SettingDesc epsilon{"epsilon",
+                            SettingType::Float,
+                            1e-4,
+                            1e-8,
+                            1.0,
+                            "epsilon, the guard of the denominator v.v + epsilon (world units "
+                            "squared): larger values lighten corners (light leaks)",
+                            false};
+    epsilon.logScale = true;
+    return {
+        {"radius", SettingType::Float, 0.5, 1e-4, 1e4,
+         "world-space radius r: taps lie on its projected disk, occluders farther than r count "
+         "nothing",
+         false},
+        {"samples", SettingType::Int, 12, 1, kMaxSamples,
+         "taps s per pixel (specialized: a change rebuilds the pipeline)", true},
+        {"bias", SettingType::Float, 1e-4, 0.0, 0.1,
+         "bias beta: the numerator is max(0, v.n - beta z), z the view distance (the paper's "
+         "z_C beta); removes self-occlusion from depth precision",
+         false},
+        {"intensity", SettingType::Float, 1.0, 0.0, 10.0,
+         "intensity sigma (world units, like u in eq. 8): A = max(0, 1 - (2 sigma / s) sum)^k; "
+         "higher is darker",
+         false},
+        {"contrast", SettingType::Float, 1.0, 0.1, 8.0,
+         "contrast k, the exponent of eq. 10: higher darkens the occluded parts more", false},
+        epsilon,
+        {"blur_radius", SettingType::Int, 4, 0, kMaxBlurRadius,
+         "cross-bilateral filter radius in pixels, two separable passes of 2 radius + 1 taps (0: "
+         "no filter; even radii cancel the 4x4 interleave pattern exactly)",
+         true},
+        {"guard_band", SettingType::Int, 0, 0, kMaxGuardBand,
+         "pixels drawn beyond each screen edge (the scene is drawn again into a larger G-buffer) "
+         "so that taps leaving the screen find occluders; 0: off, off-screen taps are unoccluded",
+         true},
+    };
+  }
+
+  void prepare(gi::EffectContext& ctx, const gi::SettingValues& s) override {
+    gi::vk::Context& vk = ctx.vulkan();
+    vk.requireWorkgroup(kGroupX, kGroupY, "alchemy");
+    const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
+               tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+               img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+    const int samples = s.integer("samples"), band = s.integer("guard_band"),
+              blur = s.integer("blur_radius");
+    ao_ = gi::vk::Pipeline::compute(
+        vk, gi::alchemy::specialize(words(alchemy_comp), {{0, samples}, {1, band}}, "alchemy.comp"),
+        {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, img}});
+    if (blur > 0) {
+      blurX_ = gi::vk::Pipeline::compute(
+          vk, gi::alchemy::specialize(words(alchemy_blur_x_comp), {{0, blur}}, "alchemy_blur_x"),
+          {{0, ubo}, {1, tex}, {2, img}});
+      blurY_ = gi::vk::Pipeline::compute(
+          vk, gi::alchemy::specialize(words(alchemy_blur_y_comp), {{0, blur}}, "alchemy_blur_y"),
+          {{0, ubo}, {1, tex}, {2, img}});
+    }
+    if (!uniforms_)
+      uniforms_ = gi::vk::Buffer(vk, sizeof(gi::alchemy::Uniforms),
+                                 VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true);
+    if (band > 0 && !view_) view_ = ctx.createView();
+  }
+
+  // The guard-band view: the main camera with its projection widened so that the band image's
+  // inner region is the main image pixel for pixel. NDC scale by W / (W + 2 band) (and H / (H +
+  // 2 band)) maps pixel x of the main view to pixel x + band of the larger one.
+  void update(gi::EffectContext& ctx, const gi::SettingValues& s) override {
+    const int band = s.integer("guard_band");
+    if (band <= 0 || !view_) return;
+    const VkExtent2D e = ctx.outputExtent();
+    const VkExtent2D big{e.width + 2 * uint32_t(band), e.height + 2 * uint32_t(band)};
+    gi::CameraView camera = ctx.camera();
+    const float sx = float(e.width) / float(big.width), sy = float(e.height) / float(big.height);
+    for (int c = 0; c < 4; ++c) {  // rows 0 and 1 of the (column-major) projection
+      camera.proj[c][0] *= sx;
+      camera.proj[c][1] *= sy;
+    }
+    view_->setCamera(camera, big);
+  }
+
+  void addPasses(gi::FrameGraph& graph, gi::EffectContext& ctx,
+                 const gi::SettingValues& settings) override {
+    struct Io {
+      gi::TextureHandle depth, normal, raw, half, ao;
+      std::vector<gi::TextureHandle> gbuffer;  // guard band: the larger G-buffer's colours
+    };
+    auto io = std::make_shared<Io>();
+    gi::Blackboard& bb = graph.blackboard();
+    const int blurRadius = settings.integer("blur_radius");  // changesGraph: fixed per graph
+    const int band = settings.integer("guard_band");         // changesGraph
+    const VkSampler nearest = ctx.nearestSampler();
+    VkBuffer frame = ctx.frameUniforms();
+
+    if (band > 0) {
+      // The scene again, into a G-buffer 2 band pixels larger, through the widened view.
+      const VkExtent2D e = ctx.outputExtent();
+      const uint32_t w = e.width + 2 * uint32_t(band), h = e.height + 2 * uint32_t(band);
+      gi::GpuScene& scene = ctx.scene();
+      frame = view_->buffer();
+      graph.addPass(
+          "alchemy_guard_band",
+          [&](gi::PassBuilder& b) {
+            scene.declareRead(b);
+            auto target = [&](const std::string& name, VkFormat f, gi::TextureUsage u) {
+              return b.write(
+                  b.create(name, gi::TextureDesc{f, gi::SizeClass::Absolute, 1.0f, w, h}), u);
+            };
+            io->depth = target("alchemy_band_depth", gi::kSceneDepthFormat,
+                               gi::TextureUsage::DepthAttachment);
+            const auto formats = gi::sceneColorFormats(gi::SceneOutputs::GBuffer);
+            for (size_t i = 0; i < formats.size(); ++i)
+              io->gbuffer.push_back(target("alchemy_band_g" + std::to_string(i), formats[i],
+                                           gi::TextureUsage::ColorAttachment));
+            io->normal = io->gbuffer[0];  // the normal comes first in sceneColorFormats
+          },
+          [io, &scene, view = frame](gi::PassContext& pc) {
+            gi::SceneTargets t{pc.view(io->depth), {}, pc.extent(io->depth)};
+            for (gi::TextureHandle g : io->gbuffer) t.colors.push_back(pc.view(g));
+            scene.drawGBuffer(pc, t, view);
+          });
+    }
+
+    // The renderer keeps `settings` alive for the graph's life and updates it in place, so
+    // uniform-only settings are read (and uploaded) when the pass is recorded, every frame.
+    graph.addPass(
+        "alchemy",
+        [&](gi::PassBuilder& b) {
+          io->depth = b.read(band > 0 ? io->depth : bb.texture(res::kDepth));
+          io->normal = b.read(band > 0 ? io->normal : bb.texture(res::kNormal));
+          io->raw = b.write(
+              b.create(blurRadius > 0 ? "alchemy_raw" : res::kAO, gi::TextureDesc{kPackedFormat}),
+              gi::TextureUsage::StorageWrite);
+        },
+        [this, io, values = &settings, frame, nearest](gi::PassContext& pc) {
+          upload(*values);
+          gi::vk::DescriptorWriter w;
+          w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame)
+              .buffer(1, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms_.handle())
+              .sampled(2, pc.view(io->depth), nearest)
+              .sampled(3, pc.view(io->normal), nearest)
+              .storageImage(4, pc.view(io->raw));
+          const VkExtent2D e = pc.extent(io->raw);
+          dispatch(pc, ao_, w, groupsOf(e.width, kGroupX), groupsOf(e.height, kGroupY));
+        });
+
+    io->ao = io->raw;
+    if (blurRadius > 0) {
+      // Separable: along x into `half`, then along y into "ao", two dispatches in one pass.
+      graph.addPass(
+          "alchemy_blur",
+          [&](gi::PassBuilder& b) {
+            io->raw = b.read(io->raw);
+            io->half = b.write(b.create("alchemy_blur_x", gi::TextureDesc{kPackedFormat}),
+                               gi::TextureUsage::StorageWrite);
+            io->ao = b.write(b.create(res::kAO, gi::TextureDesc{kAOFormat}),
+                             gi::TextureUsage::StorageWrite);
+          },
+          [this, io, nearest](gi::PassContext& pc) {
+            const VkExtent2D e = pc.extent(io->ao);
+            auto axis = [&](const gi::vk::Pipeline& p, VkImageView in, VkImageLayout inLayout,
+                            VkImageView out) {
+              gi::vk::DescriptorWriter w;
+              w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms_.handle())
+                  .sampled(1, in, nearest, inLayout)
+                  .storageImage(2, out);
+              dispatch(pc, p, w, groupsOf(e.width, kGroupX), groupsOf(e.height, kGroupY));
+            };
+            axis(blurX_, pc.view(io->raw), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                 pc.view(io->half));
+            // The graph orders passes, not dispatches inside one: the y dispatch reads what the
+            // x dispatch wrote (the image stays GENERAL, as storage images are).
+            imageBarrier(pc.cmd(), pc.image(io->half));
+            axis(blurY_, pc.view(io->half), VK_IMAGE_LAYOUT_GENERAL, pc.view(io->ao));
+          });
+    }
+    bb.put(res::kAO, io->ao);
+  }
+
+ private:
+  // Host-visible and written while recording: the renderer waits for each frame before it
+  // records the next, so the GPU is not reading it. Rewritten only when a setting changed.
+  void upload(const gi::SettingValues& s) {
+    const std::array<double, 6> key = {s.number("radius"),    s.number("bias"),
+                                       s.number("intensity"), s.number("contrast"),
+                                       s.number("epsilon"),   double(s.integer("samples"))};
+    if (key == uploaded_) return;
+    const gi::alchemy::Uniforms u =
+        gi::alchemy::makeUniforms(key[0], key[1], key[2], key[3], key[4], int(key[5]));
+    uniforms_.write(&u, sizeof u);
+    uploaded_ = key;
+  }
+
+  static void dispatch(gi::PassContext& pc, const gi::vk::Pipeline& p, gi::vk::DescriptorWriter& w,
+                       uint32_t x, uint32_t y) {
+    pc.descriptors().bind(pc.cmd(), p, w);
+    vkCmdDispatch(pc.cmd(), x, y, 1);
+  }
+
+  // Compute write -> compute sampled read of a storage image that stays in GENERAL.
+  static void imageBarrier(VkCommandBuffer cmd, VkImage image) {
+    VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
+    b.srcStageMask = b.dstStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+    b.srcAccessMask = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
+    b.dstAccessMask = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT;
+    b.oldLayout = b.newLayout = VK_IMAGE_LAYOUT_GENERAL;
+    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    b.image = image;
+    b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+    VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+    dep.imageMemoryBarrierCount = 1;
+    dep.pImageMemoryBarriers = &b;
+    vkCmdPipelineBarrier2(cmd, &dep);
+  }
+
+  gi::vk::Pipeline ao_, blurX_, blurY_;
+  gi::vk::Buffer uniforms_;
+  std::shared_ptr<gi::ViewUniforms> view_;         // the guard-band view (guard_band > 0)
+  std::optional<std::array<double, 6>> uploaded_;  // the settings uniforms_ holds
+};
+
+}  // namespace
+
+GI_EFFECT_MODULE(AlchemyEffect)

@@ -1,0 +1,402 @@
+// The Alchemy obscurance plugin (seed 003 eq. 10) against analytic cases: a plane is open, the
+// shader equals the same estimator evaluated on the CPU from the rendered depth and normals, AO
+// falls monotonically with intensity and contrast and rises with epsilon, epsilon keeps
+// zero-distance occluders finite, the cross-bilateral filter does not cross depth edges, the
+// guard band gives the edge pixels what a wider view sees, and nothing is NaN at grazing angles,
+// extreme clip planes or sky pixels.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "../effects/alchemy/alchemy_kernel.h"
+#include "gi/effect_config.h"
+#include "gi/renderer.h"
+#include "test_support.h"
+#include "vulkan_fixture.h"
+
+namespace gi {
+namespace {
+
+constexpr uint32_t kW = 160, kH = 120;
+
+// The analytic quad scenes of test_ssao.cpp (quads facing local +z, one camera).
+Mesh quad(float half) {
+  Mesh m;
+  m.name = "quad";
+  for (auto [x, y] : {std::pair{-1.f, -1.f}, {1.f, -1.f}, {1.f, 1.f}, {-1.f, 1.f}})
+    m.vertices.push_back({glm::vec3(x * half, y * half, 0), glm::vec3(0, 0, 1), glm::vec2(0)});
+  m.indices = {0, 1, 2, 0, 2, 3};
+  m.boundsMin = glm::vec3(-half, -half, 0);
+  m.boundsMax = glm::vec3(half, half, 0);
+  m.triangleAreas = {2 * half * half, 2 * half * half};
+  return m;
+}
+
+using Quads = std::vector<std::pair<glm::mat4, float>>;  // world transform, half size
+
+Scene quadScene(const Quads& quads, glm::vec3 eye, glm::vec3 target, float scale = 1.0f,
+                float znear = 0.05f, float zfar = 100.0f, float yfov = glm::radians(60.0f)) {
+  Scene s;
+  s.materials.push_back(Material{});
+  const glm::mat4 S = glm::scale(glm::mat4(1.0f), glm::vec3(scale));
+  for (const auto& [transform, half] : quads) {
+    s.meshes.push_back(quad(half));
+    int n = s.addNode("quad", S * transform);
+    s.nodes[n].meshes = {int(s.meshes.size()) - 1};
+  }
+  Camera cam;
+  cam.yfov = yfov;
+  cam.znear = znear * scale;
+  cam.zfar = zfar * scale;
+  s.cameras.push_back(cam);
+  int c = s.addNode("camera",
+                    glm::inverse(glm::lookAt(eye * scale, target * scale, glm::vec3(0, 1, 0))));
+  s.nodes[c].camera = 0;
+  s.activeCameraNode = c;
+  s.updateWorldTransforms();
+  return s;
+}
+
+const glm::mat4 kFloor = glm::rotate(glm::mat4(1.0f), glm::radians(-90.0f), glm::vec3(1, 0, 0));
+const glm::mat4 kWall = glm::rotate(glm::mat4(1.0f), glm::radians(90.0f), glm::vec3(0, 1, 0));
+
+// A floor (y = 0) and a wall (x = 0) meeting in a concave crease that runs across the image.
+Scene cornerScene(float scale = 1.0f, float yfov = glm::radians(60.0f)) {
+  return quadScene({{kFloor, 20.0f}, {kWall, 20.0f}}, glm::vec3(2.5f, 1.6f, 0.0f), glm::vec3(0.0f),
+                   scale, 0.05f, 100.0f, yfov);
+}
+
+bool finite(const ImageRGBA32F& img) {
+  for (float v : img.pixels)
+    if (!std::isfinite(v)) return false;
+  return true;
+}
+
+class AlchemyTest : public test::VulkanTest {
+ protected:
+  void SetUp() override {
+    VulkanTest::SetUp();
+    registry.scanDirectory(test::binPath("plugins"));
+    ASSERT_TRUE(registry.has("alchemy"))
+        << "alchemy plugin missing from " << test::binPath("plugins");
+  }
+  struct Result {
+    ImageRGBA32F ao, depth, normal;
+    CameraView camera;
+    int w = 0, h = 0;
+    float at(int x, int y) const { return ao.pixels[(size_t(y) * w + x) * 4]; }
+    float depthAt(int x, int y) const { return depth.pixels[(size_t(y) * w + x) * 4]; }
+    glm::vec3 worldAt(int x, int y) const {
+      glm::vec4 v = glm::inverse(camera.proj) *
+                    glm::vec4((x + 0.5f) / w * 2 - 1, (y + 0.5f) / h * 2 - 1, depthAt(x, y), 1.0f);
+      return glm::vec3(glm::inverse(camera.view) * glm::vec4(glm::vec3(v) / v.w, 1.0f));
+    }
+  };
+  RenderSettings settingsFor(const Scene& scene, const std::vector<std::string>& sets,
+                             uint32_t w = kW, uint32_t h = kH) {
+    EffectOverrides cli;
+    cli.effects = std::vector<std::string>{"alchemy"};
+    cli.sets = sets;
+    RenderSettings rs;
+    rs.width = w;
+    rs.height = h;
+    rs.effects = resolveEffects(scene, nullptr, cli, registry);
+    return rs;
+  }
+  static Result read(Renderer& r, uint32_t w, uint32_t h) {
+    return {r.readTarget("ao"),
+            r.readTarget("depth"),
+            r.readTarget("normal"),
+            r.camera(),
+            int(w),
+            int(h)};
+  }
+  Result render(const Scene& scene, const std::vector<std::string>& sets, uint32_t w = kW,
+                uint32_t h = kH) {
+    Renderer r(ctx(), scene, settingsFor(scene, sets, w, h), &registry);
+    r.renderFrame();
+    return read(r, w, h);
+  }
+  EffectRegistry registry;
+};
+
+TEST_F(AlchemyTest, PlaneGivesOne) {
+  // Facing the camera, and tilted 70 degrees away from it; unfiltered and filtered. Tolerance
+  // 0.01: the normals are stored in 16-bit floats, the bias (1e-4 x distance) absorbs the rest.
+  const glm::mat4 tilted = glm::rotate(glm::mat4(1.0f), glm::radians(-70.0f), glm::vec3(1, 0, 0));
+  for (const glm::mat4& m : {glm::mat4(1.0f), tilted}) {
+    Scene s = quadScene({{m, 1.5f}}, glm::vec3(0, 0, 5), glm::vec3(0));
+    for (const char* blur : {"alchemy.blur_radius=0", "alchemy.blur_radius=4"}) {
+      Result r = render(s, {"alchemy.radius=0.5", "alchemy.samples=16", blur});
+      ASSERT_TRUE(finite(r.ao));
+      int sky = 0, plane = 0;
+      for (int y = 0; y < r.h; ++y)
+        for (int x = 0; x < r.w; ++x) {
+          if (r.depthAt(x, y) <= 0.0f) {
+            ++sky;
+            ASSERT_EQ(r.at(x, y), 1.0f) << "sky pixel " << x << "," << y;
+          } else {
+            ++plane;
+            ASSERT_NEAR(r.at(x, y), 1.0f, 0.01f) << blur << " pixel " << x << "," << y;
+          }
+        }
+      EXPECT_GT(sky, 1000);
+      EXPECT_GT(plane, 1000);
+    }
+  }
+}
+
+TEST_F(AlchemyTest, MatchesTheEstimatorOnTheCpu) {
+  // gi::alchemy::estimate (eq. 10 with the same taps) on the rendered depth and normals, pixel
+  // by pixel, unfiltered. Differences: float rounding of a tap exactly on a texel border.
+  const int samples = 16;
+  Result r = render(cornerScene(), {"alchemy.samples=16", "alchemy.blur_radius=0",
+                                    "alchemy.intensity=0.5", "alchemy.contrast=1.5"});
+  ASSERT_TRUE(finite(r.ao));
+  std::vector<float> depth(size_t(r.w) * r.h);
+  std::vector<glm::vec3> normal(depth.size());
+  for (size_t i = 0; i < depth.size(); ++i) {
+    depth[i] = r.depth.pixels[i * 4];
+    normal[i] =
+        glm::vec3(r.normal.pixels[i * 4], r.normal.pixels[i * 4 + 1], r.normal.pixels[i * 4 + 2]);
+  }
+  const alchemy::DepthView in{depth.data(), normal.data(), r.w, r.h, r.camera.proj};
+  const alchemy::Uniforms u = alchemy::makeUniforms(0.5, 1e-4, 0.5, 1.5, 1e-4, samples);
+  double sumAbs = 0.0, minAO = 1.0;
+  int off = 0;
+  for (int y = 0; y < r.h; ++y)
+    for (int x = 0; x < r.w; ++x) {
+      const double e = std::abs(r.at(x, y) - alchemy::estimate(in, x, y, 0, u, samples));
+      sumAbs += e;
+      off += e > 1e-3;
+      minAO = std::min(minAO, double(r.at(x, y)));
+    }
+  const int n = r.w * r.h;
+  std::printf("CPU estimator: mean |diff| %.2g, %d of %d pixels differ by > 1e-3, min AO %.3f\n",
+              sumAbs / n, off, n, minAO);
+  EXPECT_LT(sumAbs / n, 1e-3);
+  EXPECT_LT(off, n / 100);
+  EXPECT_LT(minAO, 0.5) << "the crease must be occluded for the comparison to bite";
+}
+
+TEST_F(AlchemyTest, MonotoneInIntensityContrastAndEpsilon) {
+  // Documented directions: higher intensity sigma and higher contrast k darken (AO never
+  // rises), higher epsilon lightens. Uniform-only settings: one renderer, one depth buffer.
+  Scene scene = cornerScene();
+  RenderSettings rs = settingsFor(scene, {"alchemy.blur_radius=0"});
+  rs.view = "ao";
+  Renderer r(ctx(), scene, rs, &registry);
+  auto sweep = [&](const char* key, const std::vector<double>& values, bool darker) {
+    ImageRGBA32F prev;
+    double prevMean = 0.0;
+    for (double v : values) {
+      SettingValues s = rs.effects[0].settings;
+      s.set(key, v, "test");
+      r.setEffectSettings("alchemy", s);
+      EXPECT_FALSE(r.graphRecompiledByLastChange()) << key;
+      r.renderFrame();
+      const ImageRGBA32F ao = r.readTarget("ao");
+      ASSERT_TRUE(finite(ao)) << key << "=" << v;
+      double mean = 0.0;
+      for (size_t i = 0; i < ao.pixels.size(); i += 4) {
+        mean += ao.pixels[i];
+        if (!prev.pixels.empty()) {
+          const float d = ao.pixels[i] - prev.pixels[i];
+          ASSERT_LE(darker ? d : -d, 1e-6f) << key << "=" << v << " pixel " << i / 4;
+        }
+      }
+      mean /= double(ao.pixels.size()) / 4.0;
+      std::printf("%s = %g: mean AO %.4f\n", key, v, mean);
+      if (!prev.pixels.empty()) {
+        EXPECT_NE(mean, prevMean) << key << "=" << v;
+      }
+      prev = ao;
+      prevMean = mean;
+    }
+  };
+  sweep("intensity", {0.0, 0.25, 0.5, 1.0, 2.0, 4.0}, true);
+  sweep("contrast", {0.25, 0.5, 1.0, 2.0, 4.0}, true);
+  sweep("epsilon", {1e-8, 1e-4, 1e-2, 1e-1}, false);
+
+  SettingValues s = rs.effects[0].settings;
+  s.set("intensity", 0.0, "test");
+  r.setEffectSettings("alchemy", s);
+  r.renderFrame();
+  const ImageRGBA32F ao = r.readTarget("ao");
+  for (size_t i = 0; i < ao.pixels.size(); i += 4) ASSERT_EQ(ao.pixels[i], 1.0f) << "sigma = 0";
+}
+
+TEST_F(AlchemyTest, EpsilonKeepsZeroDistanceOccludersFinite) {
+  // The crease at a millimetre scale with epsilon at its minimum (1e-8): taps at distances of
+  // 1e-5..1e-4 from the crease and taps landing on their own pixel (v = 0: 0 / epsilon).
+  for (const char* eps : {"alchemy.epsilon=1e-8", "alchemy.epsilon=1e-4"}) {
+    Result r = render(cornerScene(1e-3f), {"alchemy.radius=5e-4", eps, "alchemy.blur_radius=0"});
+    ASSERT_TRUE(finite(r.ao)) << eps;
+    float lo = 1.0f;
+    for (int y = 0; y < r.h; ++y)
+      for (int x = 0; x < r.w; ++x) {
+        ASSERT_GE(r.at(x, y), 0.0f);
+        ASSERT_LE(r.at(x, y), 1.0f);
+        lo = std::min(lo, r.at(x, y));
+      }
+    std::printf("%s: darkest %.4f\n", eps, lo);
+    EXPECT_LT(lo, 0.5f) << eps << ": the crease must be occluded";
+  }
+  // Taps that all fall on the centre texel (the projected disk smaller than a pixel): v = 0 for
+  // every tap, so AO is exactly 1, not 0 / 0.
+  Result far = render(cornerScene(),
+                      {"alchemy.radius=1e-4", "alchemy.epsilon=1e-8", "alchemy.blur_radius=0"});
+  for (size_t i = 0; i < far.ao.pixels.size(); i += 4) ASSERT_EQ(far.ao.pixels[i], 1.0f);
+}
+
+TEST_F(AlchemyTest, FilterDoesNotCrossDepthEdges) {
+  // A wall at z = 0 and, 3 units (6 radii) in front of it, an open book (two quads meeting at
+  // 90 degrees, opening towards the camera): the pages are dark up to their silhouettes, the
+  // wall around them must stay at 1 (no occlusion from 3 units away: eq. 9's Heaviside; no
+  // filtering across the depth edge).
+  const glm::mat4 at = glm::translate(glm::mat4(1.0f), glm::vec3(0, 0, 3));
+  const glm::mat4 left = at *
+                         glm::rotate(glm::mat4(1.0f), glm::radians(-45.0f), glm::vec3(0, 1, 0)) *
+                         glm::translate(glm::mat4(1.0f), glm::vec3(0.2f, 0, 0));
+  const glm::mat4 right = at *
+                          glm::rotate(glm::mat4(1.0f), glm::radians(45.0f), glm::vec3(0, 1, 0)) *
+                          glm::translate(glm::mat4(1.0f), glm::vec3(-0.2f, 0, 0));
+  Scene s = quadScene({{glm::mat4(1.0f), 10.0f}, {left, 0.2f}, {right, 0.2f}}, glm::vec3(0, 0, 6),
+                      glm::vec3(0));
+  for (const char* blur :
+       {"alchemy.blur_radius=0", "alchemy.blur_radius=2", "alchemy.blur_radius=8"}) {
+    Result r = render(s, {"alchemy.samples=16", "alchemy.intensity=2", blur});
+    auto onWall = [&](int x, int y) { return std::abs(r.worldAt(x, y).z) < 1e-3f; };
+    auto nearOther = [&](int x, int y, bool wall) {  // a pixel of the other kind within 3 px
+      for (int j = -3; j <= 3; ++j)
+        for (int i = -3; i <= 3; ++i)
+          if (onWall(x + i, y + j) != wall) return true;
+      return false;
+    };
+    int wallNearEdge = 0, pageNearEdge = 0;
+    float darkestPage = 1.0f;
+    for (int y = 3; y < r.h - 3; ++y)
+      for (int x = 3; x < r.w - 3; ++x) {
+        const bool wall = onWall(x, y);
+        if (!nearOther(x, y, wall)) continue;
+        if (!wall) {
+          ++pageNearEdge;
+          darkestPage = std::min(darkestPage, r.at(x, y));
+          continue;
+        }
+        ++wallNearEdge;
+        ASSERT_GT(r.at(x, y), 0.99f) << blur << " wall pixel " << x << "," << y << " darkened";
+      }
+    std::printf("%s: darkest page pixel next to the wall %.3f\n", blur, darkestPage);
+    EXPECT_GT(wallNearEdge, 50) << blur;
+    ASSERT_GT(pageNearEdge, 50) << blur;
+    EXPECT_LT(darkestPage, 0.85f) << blur << ": the pages must be dark for the test to bite";
+  }
+}
+
+TEST_F(AlchemyTest, GuardBandSeesWhatAWiderViewSees) {
+  // The crease runs off the left and right screen edges. Reference: the same camera with a
+  // view `band` pixels larger on each side (yfov widened so the pixel pitch is the same),
+  // unguarded, cropped. With the guard band the 160x120 result must equal it; without, the
+  // edge pixels lose the occluders beyond the screen and are lighter.
+  const int band = 20;
+  const float yfov = glm::radians(60.0f);
+  const float wideFov = 2.0f * std::atan(std::tan(0.5f * yfov) * float(kH + 2 * band) / kH);
+  const std::vector<std::string> common = {"alchemy.samples=16", "alchemy.blur_radius=0"};
+  auto with = [&](std::vector<std::string> sets, const std::string& extra) {
+    sets.push_back(extra);
+    return sets;
+  };
+  Result wide = render(cornerScene(1.0f, wideFov), with(common, "alchemy.guard_band=0"),
+                       kW + 2 * band, kH + 2 * band);
+  Result plain = render(cornerScene(), with(common, "alchemy.guard_band=0"));
+  Result guarded = render(cornerScene(), with(common, "alchemy.guard_band=20"));
+  ASSERT_TRUE(finite(guarded.ao));
+  double plainDiff = 0.0, guardDiff = 0.0, guardAll = 0.0;
+  int edge = 0, guardOff = 0;
+  for (int y = 0; y < int(kH); ++y)
+    for (int x = 0; x < int(kW); ++x) {
+      const float ref = wide.at(x + band, y + band);
+      const double g = std::abs(guarded.at(x, y) - ref);
+      guardAll += g;
+      guardOff += g > 1e-2;
+      if (x >= 6 && x < int(kW) - 6) continue;  // edge columns
+      ++edge;
+      plainDiff += plain.at(x, y) - ref;  // signed: lighter is positive
+      guardDiff += g;
+    }
+  std::printf(
+      "edge columns (%d px): unguarded %.4f lighter on average, guarded |diff| %.5f; all "
+      "pixels guarded |diff| %.5f, %d > 1e-2\n",
+      edge, plainDiff / edge, guardDiff / edge, guardAll / (kW * kH), guardOff);
+  EXPECT_GT(plainDiff / edge, 0.01) << "off-screen occluders must be missed without the band";
+  EXPECT_LT(guardDiff / edge, 1e-3);
+  EXPECT_LT(guardAll / (kW * kH), 1e-3);
+  EXPECT_LT(guardOff, int(kW * kH) / 200);
+}
+
+TEST_F(AlchemyTest, NoNaNAtGrazingAnglesExtremeClipPlanesAndSky) {
+  // A camera skimming a huge floor, near 1e-4, far 1e5; the horizon leaves sky pixels above.
+  Scene grazing = quadScene({{kFloor, 1000.0f}}, glm::vec3(0, 0.01f, 0), glm::vec3(0, 0.01f, -10),
+                            1.0f, 1e-4f, 1e5f);
+  for (const char* radius : {"alchemy.radius=0.5", "alchemy.radius=1e-4", "alchemy.radius=1e4"})
+    for (const char* band : {"alchemy.guard_band=0", "alchemy.guard_band=8"}) {
+      Result r = render(grazing, {radius, band, "alchemy.epsilon=1e-8"});
+      EXPECT_TRUE(finite(r.ao)) << radius << " " << band;
+      double sum = 0.0;
+      int floorPixels = 0, sky = 0;
+      for (int y = 0; y < r.h; ++y)
+        for (int x = 0; x < r.w; ++x) {
+          ASSERT_GE(r.at(x, y), 0.0f);
+          ASSERT_LE(r.at(x, y), 1.0f);
+          if (r.depthAt(x, y) > 0.0f) {
+            sum += r.at(x, y), ++floorPixels;
+          } else {
+            ++sky;
+            ASSERT_EQ(r.at(x, y), 1.0f) << "sky pixel " << x << "," << y;
+          }
+        }
+      ASSERT_GT(floorPixels, 1000);
+      ASSERT_GT(sky, 1000);
+      std::printf("grazing floor, %s %s: mean AO %.4f\n", radius, band, sum / floorPixels);
+      EXPECT_GT(sum / floorPixels, 0.98) << radius << " " << band << ": a flat floor is open";
+    }
+  EXPECT_TRUE(finite(render(cornerScene(), {"alchemy.guard_band=4"}).ao));
+}
+
+TEST_F(AlchemyTest, PassesAndLiveSettings) {
+  Scene scene = cornerScene();  // no lights: no shadow pass
+  {
+    Renderer r(ctx(), scene, settingsFor(scene, {}), &registry);
+    r.renderFrame();
+    EXPECT_EQ(r.passNames(), (std::vector<std::string>{"gbuffer", "alchemy", "alchemy_blur",
+                                                       "lighting", "tonemap"}));
+  }
+  RenderSettings rs = settingsFor(scene, {"alchemy.blur_radius=0"});
+  rs.view = "ao";
+  Renderer r(ctx(), scene, rs, &registry);
+  r.renderFrame();
+  EXPECT_EQ(r.passNames(), (std::vector<std::string>{"gbuffer", "alchemy"}));
+  SettingValues values = rs.effects[0].settings;
+  values.set("samples", 4, "test");  // specialized: rebuilds
+  r.setEffectSettings("alchemy", values);
+  EXPECT_TRUE(r.graphRecompiledByLastChange());
+  r.renderFrame();
+  values.set("guard_band", 8, "test");
+  values.set("blur_radius", 2, "test");
+  r.setEffectSettings("alchemy", values);
+  EXPECT_TRUE(r.graphRecompiledByLastChange());
+  r.renderFrame();
+  // With the band the effect reads only its own G-buffer: the main one feeds nothing of "ao".
+  EXPECT_EQ(r.passNames(),
+            (std::vector<std::string>{"alchemy_guard_band", "alchemy", "alchemy_blur"}));
+  EXPECT_TRUE(finite(r.readTarget("ao")));
+}
+
+}  // namespace
+}  // namespace gi
