@@ -14,7 +14,6 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "../effects/obscurance/obscurance_kernel.h"
-#include "../effects/obscurance/spirv_specialize.h"
 #include "gi/effect_config.h"
 #include "gi/renderer.h"
 #include "test_support.h"
@@ -242,22 +241,6 @@ TEST(ObscuranceKernel, TransferGuardKeepsWFiniteAndInUnitRange) {
         EXPECT_LE(bias, obs::kTransferGuard);
       }
     }
-}
-
-TEST(ObscuranceKernel, SpecializeRewritesSpecConstantDefaults) {
-  // Header, OpDecorate %7 SpecId 3, OpSpecConstant %int %7 16.
-  std::vector<uint32_t> spirv = {
-      0x07230203u, 0x10000u,         0u, 8u, 0u, (4u << 16) | 71u, 7u, 1u,
-      3u,          (4u << 16) | 50u, 2u, 7u, 16u};
-  const std::vector<uint32_t> out = obs::specialize(spirv, {{3, 42}});
-  EXPECT_EQ(out[12], 42u);
-  spirv[12] = 42u;
-  EXPECT_EQ(out, spirv) << "nothing else changes";
-  test::expectError(
-      [&] {
-        obs::specialize(spirv, {{4, 1}});
-      },
-      ErrorKind::InvalidData, {"specialization constant 4"});
 }
 
 // ---- GPU ------------------------------------------------------------------------------------

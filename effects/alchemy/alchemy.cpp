@@ -9,7 +9,6 @@
 #include <array>
 #include <memory>
 #include <optional>
-#include <span>
 #include <string>
 #include <vector>
 
@@ -21,7 +20,6 @@
 #include "gi/effect_registry.h"
 #include "gi/vk/pipeline.h"
 #include "gi/vk/resources.h"
-#include "spirv_specialize.h"
 
 namespace {
 
@@ -40,8 +38,8 @@ uint32_t groupsOf(uint32_t n, uint32_t size) {
 }
 
 template <size_t N>
-std::span<const uint32_t> words(const uint32_t (&code)[N]) {
-  return {code, N};
+std::vector<uint32_t> words(const uint32_t (&code)[N]) {
+  return {code, code + N};
 }
 
 class AlchemyEffect : public gi::Effect {
@@ -109,16 +107,14 @@ class AlchemyEffect : public gi::Effect {
                img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
     const int samples = s.integer("samples"), band = s.integer("guard_band"),
               blur = s.integer("blur_radius");
-    ao_ = gi::vk::Pipeline::compute(
-        vk, gi::alchemy::specialize(words(alchemy_comp), {{0, samples}, {1, band}}, "alchemy.comp"),
-        {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, img}});
+    ao_ = gi::vk::Pipeline::compute(vk, words(alchemy_comp),
+                                    {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, img}}, 0,
+                                    {uint32_t(samples), uint32_t(band)});
     if (blur > 0) {
-      blurX_ = gi::vk::Pipeline::compute(
-          vk, gi::alchemy::specialize(words(alchemy_blur_x_comp), {{0, blur}}, "alchemy_blur_x"),
-          {{0, ubo}, {1, tex}, {2, img}});
-      blurY_ = gi::vk::Pipeline::compute(
-          vk, gi::alchemy::specialize(words(alchemy_blur_y_comp), {{0, blur}}, "alchemy_blur_y"),
-          {{0, ubo}, {1, tex}, {2, img}});
+      blurX_ = gi::vk::Pipeline::compute(vk, words(alchemy_blur_x_comp),
+                                         {{0, ubo}, {1, tex}, {2, img}}, 0, {uint32_t(blur)});
+      blurY_ = gi::vk::Pipeline::compute(vk, words(alchemy_blur_y_comp),
+                                         {{0, ubo}, {1, tex}, {2, img}}, 0, {uint32_t(blur)});
     }
     if (!uniforms_)
       uniforms_ = gi::vk::Buffer(vk, sizeof(gi::alchemy::Uniforms),

@@ -6,7 +6,6 @@
 // set: obscurance_kernel.h; measurements: README.md.
 #include <algorithm>
 #include <array>
-#include <map>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -19,7 +18,6 @@
 #include "obscurance_filter.comp.h"  // const uint32_t obscurance_filter_comp[]
 #include "obscurance_kernel.h"
 #include "obscurance_resolve.comp.h"  // const uint32_t obscurance_resolve_comp[]
-#include "spirv_specialize.h"
 
 namespace {
 
@@ -99,22 +97,18 @@ class ObscuranceEffect : public gi::Effect {
     const int mode = s.integer("transfer");
     filter_ = s.flag("filter");
     main_ = gi::vk::Pipeline::compute(
-        vk,
-        obs::specialize(words(std::begin(obscurance_comp), std::end(obscurance_comp)),
-                        {{0, s.integer("samples")}, {1, s.integer("points_per_ray")}, {2, mode}}),
-        {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, tex}, {5, tex}, {6, img}});
+        vk, words(std::begin(obscurance_comp), std::end(obscurance_comp)),
+        {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, tex}, {5, tex}, {6, img}}, 0,
+        {uint32_t(s.integer("samples")), uint32_t(s.integer("points_per_ray")), uint32_t(mode)});
     const std::vector<gi::vk::Binding> filterBindings = {{0, ubo}, {1, ubo}, {2, tex}, {3, img}};
-    const std::map<uint32_t, int32_t> filterSpec = {{0, mode}, {1, filter_ ? kFilterRadius : 0}};
+    const std::vector<uint32_t> filterSpec = {uint32_t(mode),
+                                              uint32_t(filter_ ? kFilterRadius : 0)};
     filterX_ = gi::vk::Pipeline::compute(
-        vk,
-        obs::specialize(words(std::begin(obscurance_filter_comp), std::end(obscurance_filter_comp)),
-                        filterSpec),
-        filterBindings);
-    resolve_ = gi::vk::Pipeline::compute(vk,
-                                         obs::specialize(words(std::begin(obscurance_resolve_comp),
-                                                               std::end(obscurance_resolve_comp)),
-                                                         filterSpec),
-                                         filterBindings);
+        vk, words(std::begin(obscurance_filter_comp), std::end(obscurance_filter_comp)),
+        filterBindings, 0, filterSpec);
+    resolve_ = gi::vk::Pipeline::compute(
+        vk, words(std::begin(obscurance_resolve_comp), std::end(obscurance_resolve_comp)),
+        filterBindings, 0, filterSpec);
     if (!uniforms_)
       uniforms_ =
           gi::vk::Buffer(vk, sizeof(obs::Uniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true);
