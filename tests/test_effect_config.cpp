@@ -115,6 +115,34 @@ TEST(EffectConfig, PrecedenceDefaultsPresetSceneCommandLine) {
   EXPECT_TRUE(resolveEffects(scene, &preset, cli, reg).empty());
 }
 
+TEST(EffectConfig, WorldLengthDefaultsFollowABareModelsSize) {
+  // The real plugins' radii are world lengths: a model loaded without a scene file (the
+  // 2CylinderEngine glTF, hundreds of units across) scales their defaults by its size; the
+  // built-in room and scene files keep them; preset, scene and --set values are not scaled.
+  EffectRegistry reg;
+  reg.scanDirectory(test::binPath("plugins"));
+  EffectOverrides cli;
+  cli.effects = std::vector<std::string>{"ssao"};
+  const Scene room = loadScene("default");
+  EXPECT_EQ(room.lengthScale, 1.0f);
+  EXPECT_DOUBLE_EQ(resolveEffects(room, nullptr, cli, reg)[0].settings.number("radius"), 0.5);
+
+  const Scene model =
+      loadScene(test::assimpModel("glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb"));
+  glm::vec3 lo, hi;
+  model.worldBounds(lo, hi);
+  const float scale = glm::length(hi - lo) / kReferenceSceneDiagonal;
+  EXPECT_FLOAT_EQ(model.lengthScale, scale);
+  ASSERT_GT(scale, 10.0f) << "the engine model is hundreds of units across";
+  EXPECT_NEAR(resolveEffects(model, nullptr, cli, reg)[0].settings.number("radius"), 0.5 * scale,
+              1e-6 * scale);
+  cli.sets = {"ssao.radius=0.25"};
+  EXPECT_DOUBLE_EQ(resolveEffects(model, nullptr, cli, reg)[0].settings.number("radius"), 0.25);
+  // Only Float settings marked as lengths scale: the tap count does not.
+  EXPECT_EQ(resolveEffects(model, nullptr, cli, reg)[0].settings.integer("samples"),
+            reg.defaultSettings("ssao").integer("samples"));
+}
+
 using test::expectError;
 
 TEST(EffectConfig, BadPresetsAndSettingsNameFileKeyAndRange) {

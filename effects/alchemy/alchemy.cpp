@@ -71,10 +71,9 @@ class AlchemyEffect : public gi::Effect {
                             false};
     epsilon.logScale = true;
     return {
-        {"radius", SettingType::Float, 0.5, 1e-4, 1e4,
-         "world-space radius r: taps lie on its projected disk, occluders farther than r count "
-         "nothing",
-         false},
+        gi::SettingDesc::length("radius", 0.5, 1e-6, 1e9,
+                                "world-space radius r: taps lie on its projected disk, occluders "
+                                "farther than r count nothing"),
         {"samples", SettingType::Int, 12, 1, kMaxSamples,
          "taps s per pixel (specialized: a change rebuilds the pipeline)", true},
         {"bias", SettingType::Float, 1e-4, 0.0, 0.1,

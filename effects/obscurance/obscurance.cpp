@@ -60,8 +60,9 @@ class ObscuranceEffect : public gi::Effect {
 
   std::vector<gi::SettingDesc> settings() const override {
     return {
-        {"radius", SettingType::Float, 0.5, 1e-4, 1e4,
-         "world-space radius R: the membership reaches 1 (fully open) at distance R", false},
+        gi::SettingDesc::length(
+            "radius", 0.5, 1e-6, 1e9,
+            "world-space radius R: the membership reaches 1 (fully open) at distance R"),
         gi::SettingDesc::enumeration(
             "membership", obs::membershipNames(), int(obs::Membership::Sqrt),
             "fuzzy membership mu(d / R) of an occluder at distance d: sqrt (Mendez et al.), "

@@ -53,6 +53,10 @@ struct Texture {
   std::vector<uint8_t> rgba8;  // width*height*4, sRGB-encoded colour
 };
 
+// The size effects' world-length defaults are chosen for: the bounding-box diagonal of the
+// built-in room (2 units across). Scene::lengthScale compares a bare model with it.
+inline constexpr float kReferenceSceneDiagonal = 3.4641016f;  // 2 sqrt(3)
+
 struct Material {
   std::string name;
   glm::vec4 baseColor{0.8f, 0.8f, 0.8f, 1.0f};  // linear
@@ -181,6 +185,10 @@ struct Scene {
   Environment environment;
   std::vector<EffectRequest> effects;
   std::vector<std::string> warnings;  // things sanitised while loading (e.g. recomputed normals)
+  // Multiplies the defaults of effects' world-length settings (SettingDesc::worldLength): 1 for
+  // scene files and the built-in room; a model loaded without a scene file gets its bounding-box
+  // diagonal / kReferenceSceneDiagonal.
+  float lengthScale = 1.0f;
 
   // Recompute Node::world from Node::local down the hierarchy.
   void updateWorldTransforms();

@@ -28,9 +28,15 @@ struct SettingDesc {
   std::array<double, 3> defaultVector{};  // Vec3/Color default (min/max apply per component)
   double step = 0.0;                      // UI hint: widget step (0: type default)
   bool logScale = false;                  // UI hint: logarithmic slider (needs min > 0)
+  // A length in world units (Float): for a model loaded without a scene file its default is
+  // scaled by the model's size (Scene::lengthScale), so an AO radius fits a bunny or a city.
+  bool worldLength = false;
 
   static SettingDesc enumeration(std::string name, std::vector<std::string> options,
                                  int defaultIndex, std::string help, bool changesGraph = false);
+  // A Float length in world units (worldLength set).
+  static SettingDesc length(std::string name, double def, double min, double max, std::string help,
+                            bool changesGraph = false);
   static SettingDesc vec3(std::string name, std::array<double, 3> def, double min, double max,
                           std::string help, bool changesGraph = false);
   static SettingDesc color(std::string name, std::array<double, 3> def, std::string help,

@@ -175,6 +175,15 @@ std::vector<std::string> splitEffectList(const std::string& text) {
   return out;
 }
 
+// World-length defaults follow the scene's size (Scene::lengthScale), clamped to their range.
+static void scaleWorldLengths(SettingValues& values, float lengthScale) {
+  if (lengthScale == 1.0f) return;
+  for (const SettingDesc& d : values.descs())
+    if (d.worldLength && d.type == SettingType::Float)
+      values.set(d.name, std::clamp(d.defaultValue * lengthScale, d.minValue, d.maxValue),
+                 "the model's size");
+}
+
 std::vector<EffectConfig> resolveEffects(const Scene& scene, const Preset* preset,
                                          const EffectOverrides& cli,
                                          const EffectRegistry& registry) {
@@ -201,6 +210,7 @@ std::vector<EffectConfig> resolveEffects(const Scene& scene, const Preset* prese
     } catch (const Error& e) {
       throw Error(e.kind(), cli.effects ? "--effects" : scene.sourcePath, e.what());
     }
+    scaleWorldLengths(configs.back().settings, scene.lengthScale);
   }
   if (preset) validatePreset(*preset, registry);
   // The engine's entries, checked here too so a caller that skips resolveEngineSettings

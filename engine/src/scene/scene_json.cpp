@@ -733,10 +733,16 @@ Scene loadScene(const std::string& pathOrDefault) {
     throw Error(ErrorKind::FileNotFound, pathOrDefault, "file does not exist");
   const std::string ext = detail::lowerExtension(pathOrDefault);
   if (ext == ".json") return loadSceneJson(pathOrDefault);
-  if (ext == ".obj" || ext == ".ply") return loadMeshFile(pathOrDefault);
-  if (ext == ".gltf" || ext == ".glb") {
-    Scene s = loadGltf(pathOrDefault);
-    addDefaultCameraAndLight(s);  // a bare model file, like .obj/.ply
+  if (ext == ".obj" || ext == ".ply" || ext == ".gltf" || ext == ".glb") {
+    Scene s =
+        ext == ".obj" || ext == ".ply" ? loadMeshFile(pathOrDefault) : loadGltf(pathOrDefault);
+    addDefaultCameraAndLight(s);  // a bare model file: framed, lit, effects sized to it
+    glm::vec3 lo, hi;
+    s.worldBounds(lo, hi);
+    const float diagonal = glm::length(hi - lo);
+    // Guard: an empty, degenerate or non-finite model keeps the defaults as they are.
+    if (std::isfinite(diagonal) && diagonal > 0.0f)
+      s.lengthScale = diagonal / kReferenceSceneDiagonal;
     return s;
   }
   throw Error(ErrorKind::Unsupported, pathOrDefault,
