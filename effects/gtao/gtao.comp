@@ -51,6 +51,14 @@ float arc(float h, float n, float cosN, float sinN) {
   return 0.25 * (cosN + 2.0 * h * sinN - cos(2.0 * h - n));
 }
 
+// Int_0^h (cos(theta), sin(theta)) cos(theta - n) sin(theta) dtheta: the V and T components
+// of the cosine-weighted directions on one side of V up to its horizon h (bent normals; the
+// other side is the same with n -> -n and the T component negated).
+vec2 bentArc(float h, float cosN, float sinN) {
+  float c = cos(h), s = sin(h), c3 = c * c * c, s3 = s * s * s;
+  return vec2(cosN * (1.0 - c3) + sinN * s3, cosN * s3 + sinN * (2.0 - 3.0 * c + c3)) / 3.0;
+}
+
 void main() {
   ivec2 p = ivec2(gl_GlobalInvocationID.xy);
   ivec2 size = ivec2(frame.viewport.xy);
@@ -105,12 +113,20 @@ void main() {
     float n = abs(nt) + abs(nv) > 1e-12 ? clamp(atan(nt, nv), -kHalfPi, kHalfPi) : 0.0;
     float cosN = cos(n), sinN = sin(n);
 
-    float horizonCos[2];
+    // Horizons are elevations above the tangent line of the slice (the normal's hemisphere
+    // edge), in the slice frame: x along that line, y along the normal. For samples in the
+    // slice plane this is the usual horizon angle from V; depth texels are sampled at their
+    // centres, off the slice by up to half a texel, and measuring their height along the
+    // normal (instead of their angle to V) keeps a plane's own samples exactly on the tangent
+    // line at any viewing angle: a plane never occludes itself.
+    vec3 tangentLine = T * cosN - V * sinN;  // towards +T
+    // Guard: projLen -> 0 (a normal nearly perpendicular to the slice) only makes the slice's
+    // weight vanish; 1e-6 keeps the scale finite.
+    float invProjLen = 1.0 / max(projLen, 1e-6);
+    float elevation[2];
     for (int side = 0; side < 2; ++side) {
       float sgn = side == 0 ? 1.0 : -1.0;
-      // The tangent plane's horizon on this side: cos(n + pi/2) for +T, cos(n - pi/2) for -T.
-      float low = -sgn * sinN;
-      float hc = low;
+      float hc = 1.0;  // cos of the highest elevation so far; 1 = the tangent plane
       for (int step = 0; step < kSteps; ++step) {
         float s = (float(step) + noise.y) / float(kSteps);
         // Guard: the first sample is at least one pixel out, never the centre texel itself
@@ -120,33 +136,39 @@ void main() {
         bool inside = pix.x >= 0.0 && pix.y >= 0.0 && pix.x < sizeF.x && pix.y < sizeF.y;
         float sd = texelFetch(gDepth, clamp(t, ivec2(0), size - 1), 0).r;
         vec3 delta = viewPosition(vec2(t), sd, proj4, off, p32) - P;
-        float len2 = dot(delta, delta);
-        // Guard: a zero distance has no direction (inversesqrt of 1e-30 stays finite).
-        float len = sqrt(len2);
-        float c = dot(delta, V) * inversesqrt(max(len2, 1e-30));
+        float len = length(delta);
+        float x = sgn * dot(delta, tangentLine), y = dot(delta, N) * invProjLen;
+        // Guard: a zero offset has no direction (inversesqrt of 1e-30 stays finite).
+        float ce = x * inversesqrt(max(x * x + y * y, 1e-30));
         // Falloff: full weight up to R (1 - falloff), none beyond R; the reference counts
         // occluders within R exactly (falloff 0 is its hard cut-off).
         float w = clamp((R - len) * gtao.params.y, 0.0, 1.0);
         // Guard: off-screen and sky samples (depth 0: a point at infinity, len may overflow to
-        // inf and c be NaN) are not occluders; selects never propagate the unselected NaN.
-        bool valid = inside && !isSky(sd) && w > 0.0;
-        float cw = valid ? mix(low, c, w) : low;
+        // inf and ce be NaN) and samples below the tangent plane are not occluders; selects
+        // never propagate the unselected NaN.
+        // Guard: depth reconstruction leaves a plane's own samples within ~1e-4 x len of it:
+        // heights below 1e-3 x len (0.06 degrees) count as on the plane, not above it.
+        bool valid = inside && !isSky(sd) && w > 0.0 && y > 1e-3 * len;
+        float cw = valid ? mix(1.0, ce, w) : 1.0;
         // Thickness heuristic (Jimenez et al. 2016, sec. 4.3): a sample below the horizon pulls
         // it down by the blend factor (0: the plain maximum).
-        hc = cw > hc ? cw : mix(hc, cw, gtao.params.z);
+        hc = cw < hc ? cw : mix(hc, cw, gtao.params.z);
       }
-      // Guard: acos needs [-1, 1]; the horizon never drops below the tangent plane.
-      horizonCos[side] = clamp(max(hc, low), -1.0, 1.0);
+      // Guard: acos needs [-1, 1].
+      elevation[side] = acos(clamp(hc, -1.0, 1.0));
     }
-    float h1 = acos(horizonCos[0]);   // towards +T, in [0, n + pi/2]
-    float h0 = -acos(horizonCos[1]);  // towards -T, in [n - pi/2, 0]
+    // Horizon angles from V; clamped at V (an occluder on one side cannot hide the other side).
+    float h1 = max(n + kHalfPi - elevation[0], 0.0);  // towards +T, in [0, n + pi/2]
+    float h0 = min(n - kHalfPi + elevation[1], 0.0);  // towards -T, in [n - pi/2, 0]
     float v = projLen * (arc(h0, n, cosN, sinN) + arc(h1, n, cosN, sinN));
     visible += v;
     // Unoccluded: horizons at n -+ pi/2, arc sum = cos n + n sin n.
     unoccluded += projLen * (cosN + n * sinN);
     if (kBentNormals) {
-      float b = 0.5 * (h0 + h1);  // the visible arc's middle direction
-      bent += v * (V * cos(b) + T * sin(b));
+      // The cosine-weighted mean visible direction of the slice, in closed form (exactly N
+      // for an open hemisphere): the (V, T) components on each side of V.
+      vec2 bp = bentArc(h1, cosN, sinN), bm = bentArc(-h0, cosN, -sinN);
+      bent += projLen * (V * (bp.x + bm.x) + T * (bp.y - bm.y));
     }
   }
   // Ratio estimator: the slice sum over the same sum without occluders, so a plane gives

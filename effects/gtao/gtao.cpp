@@ -132,6 +132,13 @@ class GtaoEffect : public gi::Effect {
                multiBounce = settings.flag("multi_bounce");
     const VkBuffer frame = ctx.frameUniforms();
     const VkSampler nearest = ctx.nearestSampler();
+    // Persistent, not transient: no pass of the graph may read the bent normal, and the graph
+    // aliases a transient whose last use is the pass that wrote it with later transients (its
+    // aliasing barrier then reports a write-after-write hazard); a persistent texture is never
+    // aliased and stays readable after the frame.
+    const gi::TextureHandle bentTexture =
+        bentNormals ? graph.persistentTexture(kBentNormal, gi::TextureDesc{kBentFormat})
+                    : gi::TextureHandle{};
 
     graph.addPass(
         "gtao",
@@ -142,9 +149,7 @@ class GtaoEffect : public gi::Effect {
           io->raw =
               b.write(b.create(blurRadius > 0 ? "gtao_raw" : res::kAO, gi::TextureDesc{kAOFormat}),
                       gi::TextureUsage::StorageWrite);
-          if (bentNormals)
-            io->bent = b.write(b.create(kBentNormal, gi::TextureDesc{kBentFormat}),
-                               gi::TextureUsage::StorageWrite);
+          if (bentNormals) io->bent = b.write(bentTexture, gi::TextureUsage::StorageWrite);
         },
         [this, io, values = &settings, frame, nearest, multiBounce,
          bentNormals](gi::PassContext& pc) {
@@ -178,8 +183,7 @@ class GtaoEffect : public gi::Effect {
           },
           [this, io, values = &settings, frame, nearest](gi::PassContext& pc) {
             const VkExtent2D e = pc.extent(io->ao);
-            const float tolerance =
-                float(gi::gtao::kBlurDepthTolerance * values->number("radius"));
+            const float tolerance = float(gi::gtao::kBlurDepthTolerance * values->number("radius"));
             auto axis = [&](VkImageView in, VkImageLayout inLayout, VkImageView out, int dx) {
               gi::vk::DescriptorWriter w;
               w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame)
@@ -188,8 +192,8 @@ class GtaoEffect : public gi::Effect {
                   .sampled(3, in, nearest, inLayout)
                   .storageImage(4, out);
               const BlurPush push{{dx, 1 - dx}, tolerance};
-              dispatch(pc, blur_, w, groupsOf(e.width, kGroupX), groupsOf(e.height, kGroupY),
-                       &push, sizeof push);
+              dispatch(pc, blur_, w, groupsOf(e.width, kGroupX), groupsOf(e.height, kGroupY), &push,
+                       sizeof push);
             };
             axis(pc.view(io->raw), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, pc.view(io->half), 1);
             // The graph orders passes, not dispatches inside one: the y dispatch reads what the

@@ -84,7 +84,16 @@ void main() {
     float lenT = length(tangent);
     // Guard: an edge-on surface (the tangent plane is the slice plane: no line) takes t = 0.
     float sinT = lenT > 1e-6 ? clamp(tangent.z / lenT, -1.0, 1.0) : 0.0;
-    float t = asin(sinT);
+    float t = asin(sinT), cosT = cos(t);
+    // Samples are measured in the slice frame: x along the tangent line, y along the normal
+    // (scaled by 1 / |normal projected into the slice|): their elevation is t + atan(y, x).
+    // Depth texels are sampled at their centres, off the slice by up to half a texel; measured
+    // this way a plane's own samples stay exactly on the tangent line at any viewing angle.
+    vec3 tangentLine = tangent / max(lenT, 1e-6);
+    float nAxis = dot(N, safeNormalize(cross(Pn, Dn), vec3(0.0, 1.0, 0.0)));
+    // Guard: a normal nearly perpendicular to the slice keeps a finite scale.
+    float invProjLen = inversesqrt(max(1.0 - nAxis * nAxis, 1e-12));
+    // Guard: the biased horizon is clamped to 90 degrees (sin stays monotone).
     float sinH = sin(min(t + bias, kHalfPi));
     float ao = 0.0;
     for (int step = 0; step < kSteps; ++step) {
@@ -97,11 +106,18 @@ void main() {
       float sd = texelFetch(gDepth, clamp(q, ivec2(0), size - 1), 0).r;
       vec3 delta = viewPosition(vec2(q), sd, proj4, off, p32) - P;
       float r2 = dot(delta, delta);
-      // Guard: zero distance (no elevation): inversesqrt of at least 1e-30 stays finite.
-      float sinE = delta.z * inversesqrt(max(r2, 1e-30));
-      // Guard: off-screen and sky samples (a point at infinity: r2 may be inf, sinE NaN) and
-      // samples beyond R are ignored; selects never propagate the unselected NaN.
-      bool valid = inside && !isSky(sd) && r2 < R * R;
+      float x = dot(delta, tangentLine), y = dot(delta, N) * invProjLen;
+      // Guard: a zero offset has no elevation (inversesqrt of 1e-30 stays finite).
+      float invLen = inversesqrt(max(x * x + y * y, 1e-30));
+      // sin and cos of t + atan(y, x); past the vertical the elevation is clamped to 90 deg.
+      float sinE = (sinT * x + cosT * y) * invLen, cosE = (cosT * x - sinT * y) * invLen;
+      sinE = cosE < 0.0 ? 1.0 : sinE;
+      // Guard: off-screen and sky samples (a point at infinity: r2 may be inf, sinE NaN),
+      // samples below the tangent plane and samples beyond R are ignored; selects never
+      // propagate the unselected NaN.
+      // Guard: depth reconstruction leaves a plane's own samples within ~1e-4 x r of it:
+      // heights below 1e-3 x r (0.06 degrees) count as on the plane, not above it.
+      bool valid = inside && !isSky(sd) && y > 1e-3 * sqrt(r2) && r2 < R * R;
       float gain = valid ? max(sinE - sinH, 0.0) * (1.0 - r2 * invR2) : 0.0;
       ao += gain;
       sinH = valid ? max(sinH, sinE) : sinH;

@@ -55,8 +55,7 @@ class HbaoEffect : public gi::Effect {
          false},
         {"directions", SettingType::Int, 6, 1, gi::hbao::kMaxDirections,
          "screen directions per pixel (rotated per pixel by the 4x4 interleave)", true},
-        {"steps", SettingType::Int, 4, 1, gi::hbao::kMaxSteps, "depth samples per direction",
-         true},
+        {"steps", SettingType::Int, 4, 1, gi::hbao::kMaxSteps, "depth samples per direction", true},
         {"angle_bias", SettingType::Float, 10.0, 0.0, 60.0,
          "degrees added to the tangent angle: horizons below it do not occlude (hides "
          "tessellation and depth-precision self-occlusion)",
@@ -144,8 +143,7 @@ class HbaoEffect : public gi::Effect {
           },
           [this, io, values = &settings, frame, nearest](gi::PassContext& pc) {
             const VkExtent2D e = pc.extent(io->ao);
-            const float tolerance =
-                float(gi::hbao::kBlurDepthTolerance * values->number("radius"));
+            const float tolerance = float(gi::hbao::kBlurDepthTolerance * values->number("radius"));
             auto axis = [&](VkImageView in, VkImageLayout inLayout, VkImageView out, int dx) {
               gi::vk::DescriptorWriter w;
               w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame)
@@ -154,8 +152,8 @@ class HbaoEffect : public gi::Effect {
                   .sampled(3, in, nearest, inLayout)
                   .storageImage(4, out);
               const BlurPush push{{dx, 1 - dx}, tolerance};
-              dispatch(pc, blur_, w, groupsOf(e.width, kGroupX), groupsOf(e.height, kGroupY),
-                       &push, sizeof push);
+              dispatch(pc, blur_, w, groupsOf(e.width, kGroupX), groupsOf(e.height, kGroupY), &push,
+                       sizeof push);
             };
             axis(pc.view(io->raw), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, pc.view(io->half), 1);
             // The graph orders passes, not dispatches inside one: the y dispatch reads what the

@@ -23,9 +23,9 @@ inline constexpr float kBlurDepthTolerance = 0.25f;  // fraction of the radius
 
 // std140 mirror of the `HbaoParams` uniform block in hbao.comp.
 struct Uniforms {
-  float radius;     // R, world units
-  float invRadius2; // 1 / R^2 (W(r) = 1 - r^2 / R^2)
-  float angleBias;  // radians
+  float radius;      // R, world units
+  float invRadius2;  // 1 / R^2 (W(r) = 1 - r^2 / R^2)
+  float angleBias;   // radians
   float pad;
   float noise[16][4];  // per 4x4 phase: direction rotation and step jitter in [0, 1), 0, 0
 };

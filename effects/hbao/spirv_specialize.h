@@ -35,8 +35,8 @@ inline std::vector<uint32_t> specialize(std::vector<uint32_t> code,
       if (pass == 1 && (op == kOpSpecConstantTrue || op == kOpSpecConstantFalse) && words == 3) {
         auto it = idOf.find(code[i + 2]);
         if (it != idOf.end() && values.count(it->second))
-          code[i] = (words << 16) |
-                    (values.at(it->second) ? kOpSpecConstantTrue : kOpSpecConstantFalse);
+          code[i] =
+              (words << 16) | (values.at(it->second) ? kOpSpecConstantTrue : kOpSpecConstantFalse);
       }
       if (pass == 1 && op == kOpSpecConstant && words == 4) {  // 32-bit scalar
         auto it = idOf.find(code[i + 2]);
