@@ -36,13 +36,14 @@ layout(set = 0, binding = 6, rgba16f) uniform writeonly image2D outBent;  // 1x1
 const float kPi = 3.14159265358979;
 const float kHalfPi = 1.57079632679490;
 
-// View-space position of texel t's centre from its reverse-Z depth d.
+// View-space position of texel t's centre from its reverse-Z depth d; proj4 = (1 / P00,
+// 1 / P11, P22, 0) (multiplications: llvmpipe divides slowly).
 vec3 viewPosition(vec2 t, float d, vec4 proj4, vec2 off, float p32) {
   vec2 ndc = (t + 0.5) * 2.0 * frame.viewport.zw - 1.0;
   // Guard: depth + P22 <= 0 (sky, or the far plane of an infinite projection) would divide by
   // zero; such samples are rejected by the caller.
   float dist = p32 / max(d + proj4.z, 1e-30);
-  return vec3((ndc + off) * dist / proj4.xy, -dist);
+  return vec3((ndc + off) * proj4.xy * dist, -dist);
 }
 
 // Integral of cos(theta - n) |sin(theta)| from 0 to h (Jimenez et al. 2016, eq. 10): the
@@ -75,7 +76,7 @@ void main() {
   float p00 = abs(proj[0][0]) > 1e-30 ? proj[0][0] : 1e-30;
   float p11 = abs(proj[1][1]) > 1e-30 ? proj[1][1] : 1e-30;
   float p32 = abs(proj[3][2]) > 1e-30 ? proj[3][2] : 1e-30;
-  vec4 proj4 = vec4(p00, p11, proj[2][2], 0.0);
+  vec4 proj4 = vec4(1.0 / p00, 1.0 / p11, proj[2][2], 0.0);
   vec2 off = vec2(proj[2][0], proj[2][1]);
   vec3 P = viewPosition(vec2(p), depth, proj4, off, p32);
   float dist = -P.z;
