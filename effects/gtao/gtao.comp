@@ -25,7 +25,7 @@ layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 // Keep in sync with gi::gtao::Uniforms (gtao_params.h).
 layout(set = 0, binding = 1) uniform GtaoParams {
   vec4 params;     // radius R, falloff slope 1 / (falloff x R), thickness blend, 0
-  vec4 noise[16];  // per 4x4 phase: slice rotation in [0, 1) slices, step jitter in [0, 1)
+  vec4 noise[16];  // per 4x4 phase: cos, sin of the slice rotation, step jitter in [0, 1), 0
 } gtao;
 layout(set = 0, binding = 2) uniform sampler2D gDepth;
 layout(set = 0, binding = 3) uniform sampler2D gNormal;
@@ -46,17 +46,61 @@ vec3 viewPosition(vec2 t, float d, vec4 proj4, vec2 off, float p32) {
   return vec3((ndc + off) * proj4.xy * dist, -dist);
 }
 
+// The cosine of the highest elevation above the slice's tangent line on one side (sgn = +1:
+// towards +T) among kSteps depth samples within R; 1 = the tangent plane.
+//
+// Horizons are elevations above the tangent line of the slice (the normal's hemisphere edge),
+// in the slice frame: x along that line, y along the normal. For samples in the slice plane
+// this is the usual horizon angle from V; depth texels are sampled at their centres, off the
+// slice by up to half a texel, and measuring their height along the normal (instead of their
+// angle to V) keeps a plane's own samples exactly on the tangent line at any viewing angle: a
+// plane never occludes itself.
+float horizonCos(float sgn, vec2 d, vec3 tangentLine, float invProjLen, vec3 N, vec3 P,
+                 vec2 pixelCentre, float radiusPx, float R, float jitter, vec2 sizeF, ivec2 size,
+                 vec4 proj4, vec2 off, float p32) {
+  float hc = 1.0;
+  for (int step = 0; step < kSteps; ++step) {
+    float s = (float(step) + jitter) / float(kSteps);
+    // Guard: the first sample is at least one pixel out, never the centre texel itself (a
+    // zero-length offset has no direction).
+    vec2 pix = pixelCentre + sgn * d * (s * s * radiusPx + 1.0);
+    ivec2 t = ivec2(floor(pix));
+    bool inside = pix.x >= 0.0 && pix.y >= 0.0 && pix.x < sizeF.x && pix.y < sizeF.y;
+    float sd = texelFetch(gDepth, clamp(t, ivec2(0), size - 1), 0).r;
+    vec3 delta = viewPosition(vec2(t), sd, proj4, off, p32) - P;
+    float len = length(delta);
+    float x = sgn * dot(delta, tangentLine), y = dot(delta, N) * invProjLen;
+    // Guard: a zero offset has no direction (inversesqrt of 1e-30 stays finite).
+    float ce = x * inversesqrt(max(x * x + y * y, 1e-30));
+    // Falloff: full weight up to R (1 - falloff), none beyond R; the reference counts
+    // occluders within R exactly (falloff 0 is its hard cut-off).
+    float w = clamp((R - len) * gtao.params.y, 0.0, 1.0);
+    // Guards: off-screen and sky samples (depth 0: a point at infinity, len may overflow to inf
+    // and ce be NaN) and samples below the tangent plane are not occluders; selects never
+    // propagate the unselected NaN. Depth reconstruction leaves a plane's own samples within
+    // ~1e-4 x len of it: heights below 1e-3 x len (0.06 degrees) count as on the plane.
+    bool valid = inside && !isSky(sd) && w > 0.0 && y > 1e-3 * len;
+    float cw = valid ? mix(1.0, ce, w) : 1.0;
+    // Thickness heuristic (Jimenez et al. 2016, sec. 4.3): a sample below the horizon pulls it
+    // down by the blend factor (0: the plain maximum).
+    hc = cw < hc ? cw : mix(hc, cw, gtao.params.z);
+  }
+  return clamp(hc, -1.0, 1.0);  // guard: acos and sqrt(1 - c^2) need [-1, 1]
+}
+
 // Integral of cos(theta - n) |sin(theta)| from 0 to h (Jimenez et al. 2016, eq. 10): the
-// cosine-weighted visible arc on one side of V in a slice.
-float arc(float h, float n, float cosN, float sinN) {
-  return 0.25 * (cosN + 2.0 * h * sinN - cos(2.0 * h - n));
+// cosine-weighted visible arc on one side of V in a slice. cs = (cos h, sin h), so that
+// cos(2h - n) needs no trigonometry (llvmpipe evaluates each cos/acos as a long polynomial).
+float arc(float h, vec2 cs, float cosN, float sinN) {
+  float cos2h = 2.0 * cs.x * cs.x - 1.0, sin2h = 2.0 * cs.x * cs.y;
+  return 0.25 * (cosN + 2.0 * h * sinN - (cos2h * cosN + sin2h * sinN));
 }
 
 // Int_0^h (cos(theta), sin(theta)) cos(theta - n) sin(theta) dtheta: the V and T components
 // of the cosine-weighted directions on one side of V up to its horizon h (bent normals; the
 // other side is the same with n -> -n and the T component negated).
-vec2 bentArc(float h, float cosN, float sinN) {
-  float c = cos(h), s = sin(h), c3 = c * c * c, s3 = s * s * s;
+vec2 bentArc(vec2 cs, float cosN, float sinN) {
+  float c = cs.x, s = cs.y, c3 = c * c * c, s3 = s * s * s;
   return vec2(cosN * (1.0 - c3) + sinN * s3, cosN * s3 + sinN * (2.0 - 3.0 * c + c3)) / 3.0;
 }
 
@@ -98,8 +142,11 @@ void main() {
   float visible = 0.0, unoccluded = 0.0;
   vec3 bent = vec3(0.0);
   for (int slice = 0; slice < kSlices; ++slice) {
-    float phi = (float(slice) + noise.x) * (kPi / float(kSlices));
-    vec2 d = vec2(cos(phi), sin(phi));  // screen direction, pixels
+    // Slice angle pi slice / kSlices (folded at compile time once the loop unrolls), rotated by
+    // the pixel's phase (its cos and sin come from the table).
+    float base = float(slice) * (kPi / float(kSlices));
+    vec2 cb = vec2(cos(base), sin(base));
+    vec2 d = vec2(cb.x * noise.x - cb.y * noise.y, cb.y * noise.x + cb.x * noise.y);  // pixels
     vec3 dir3 = vec3(d * viewPerPixel, 0.0);
     // Guard: dir3 parallel to V needs a view ray at 90 degrees from the axis; fall back to any
     // perpendicular (the slice is then still a valid plane through V).
@@ -109,66 +156,40 @@ void main() {
     // slice, its angle n from V (towards T) centres the clamped hemisphere.
     float nt = dot(N, T), nv = dot(N, V);
     float projLen = sqrt(nt * nt + nv * nv);
-    // Guard: atan(0, 0) and back-facing normals: n is clamped to [-pi/2, pi/2] so that both
-    // horizons stay on their own side of V (h0 <= 0 <= h1) and the arc formula holds.
-    float n = abs(nt) + abs(nv) > 1e-12 ? clamp(atan(nt, nv), -kHalfPi, kHalfPi) : 0.0;
-    float cosN = cos(n), sinN = sin(n);
+    // Guard: back-facing normals (nv < 0) are clamped to n = +-pi/2 so that both horizons stay
+    // on their own side of V (h0 <= 0 <= h1) and the arc formula holds; a zero projection
+    // (atan(0, 0)) takes n = 0.
+    float cv = max(nv, 0.0), lenN = sqrt(cv * cv + nt * nt);
+    float cosN = lenN > 1e-12 ? cv / lenN : 1.0, sinN = lenN > 1e-12 ? nt / lenN : 0.0;
+    float n = atan(sinN, cosN);
 
-    // Horizons are elevations above the tangent line of the slice (the normal's hemisphere
-    // edge), in the slice frame: x along that line, y along the normal. For samples in the
-    // slice plane this is the usual horizon angle from V; depth texels are sampled at their
-    // centres, off the slice by up to half a texel, and measuring their height along the
-    // normal (instead of their angle to V) keeps a plane's own samples exactly on the tangent
-    // line at any viewing angle: a plane never occludes itself.
     vec3 tangentLine = T * cosN - V * sinN;  // towards +T
     // Guard: projLen -> 0 (a normal nearly perpendicular to the slice) only makes the slice's
     // weight vanish; 1e-6 keeps the scale finite.
     float invProjLen = 1.0 / max(projLen, 1e-6);
-    float elevation[2];
-    for (int side = 0; side < 2; ++side) {
-      float sgn = side == 0 ? 1.0 : -1.0;
-      float hc = 1.0;  // cos of the highest elevation so far; 1 = the tangent plane
-      for (int step = 0; step < kSteps; ++step) {
-        float s = (float(step) + noise.y) / float(kSteps);
-        // Guard: the first sample is at least one pixel out, never the centre texel itself
-        // (a zero-length offset has no direction).
-        vec2 pix = pixelCentre + sgn * d * (s * s * radiusPx + 1.0);
-        ivec2 t = ivec2(floor(pix));
-        bool inside = pix.x >= 0.0 && pix.y >= 0.0 && pix.x < sizeF.x && pix.y < sizeF.y;
-        float sd = texelFetch(gDepth, clamp(t, ivec2(0), size - 1), 0).r;
-        vec3 delta = viewPosition(vec2(t), sd, proj4, off, p32) - P;
-        float len = length(delta);
-        float x = sgn * dot(delta, tangentLine), y = dot(delta, N) * invProjLen;
-        // Guard: a zero offset has no direction (inversesqrt of 1e-30 stays finite).
-        float ce = x * inversesqrt(max(x * x + y * y, 1e-30));
-        // Falloff: full weight up to R (1 - falloff), none beyond R; the reference counts
-        // occluders within R exactly (falloff 0 is its hard cut-off).
-        float w = clamp((R - len) * gtao.params.y, 0.0, 1.0);
-        // Guard: off-screen and sky samples (depth 0: a point at infinity, len may overflow to
-        // inf and ce be NaN) and samples below the tangent plane are not occluders; selects
-        // never propagate the unselected NaN.
-        // Guard: depth reconstruction leaves a plane's own samples within ~1e-4 x len of it:
-        // heights below 1e-3 x len (0.06 degrees) count as on the plane, not above it.
-        bool valid = inside && !isSky(sd) && w > 0.0 && y > 1e-3 * len;
-        float cw = valid ? mix(1.0, ce, w) : 1.0;
-        // Thickness heuristic (Jimenez et al. 2016, sec. 4.3): a sample below the horizon pulls
-        // it down by the blend factor (0: the plain maximum).
-        hc = cw < hc ? cw : mix(hc, cw, gtao.params.z);
-      }
-      // Guard: acos needs [-1, 1].
-      elevation[side] = acos(clamp(hc, -1.0, 1.0));
-    }
+    // Two calls, not a loop over the sides: no array indexed by a loop counter (llvmpipe
+    // would keep it in memory if the loop did not unroll).
+    float c1 = horizonCos(1.0, d, tangentLine, invProjLen, N, P, pixelCentre, radiusPx, R,
+                          noise.z, sizeF, size, proj4, off, p32);
+    float c0 = horizonCos(-1.0, d, tangentLine, invProjLen, N, P, pixelCentre, radiusPx, R,
+                          noise.z, sizeF, size, proj4, off, p32);
     // Horizon angles from V; clamped at V (an occluder on one side cannot hide the other side).
-    float h1 = max(n + kHalfPi - elevation[0], 0.0);  // towards +T, in [0, n + pi/2]
-    float h0 = min(n - kHalfPi + elevation[1], 0.0);  // towards -T, in [n - pi/2, 0]
-    float v = projLen * (arc(h0, n, cosN, sinN) + arc(h1, n, cosN, sinN));
+    float s1 = sqrt(1.0 - c1 * c1), s0 = sqrt(1.0 - c0 * c0);  // elevations in [0, pi]
+    float h1 = n + kHalfPi - acos(c1);  // towards +T, in [0, n + pi/2] once clamped
+    float h0 = n - kHalfPi + acos(c0);  // towards -T, in [n - pi/2, 0] once clamped
+    // (cos h, sin h) by angle sums: h1 = n + pi/2 - e1, h0 = n - pi/2 + e0; (1, 0) at V.
+    vec2 cs1 = h1 > 0.0 ? vec2(cosN * s1 - sinN * c1, cosN * c1 + sinN * s1) : vec2(1.0, 0.0);
+    vec2 cs0 = h0 < 0.0 ? vec2(sinN * c0 + cosN * s0, sinN * s0 - cosN * c0) : vec2(1.0, 0.0);
+    h1 = max(h1, 0.0);
+    h0 = min(h0, 0.0);
+    float v = projLen * (arc(h0, cs0, cosN, sinN) + arc(h1, cs1, cosN, sinN));
     visible += v;
     // Unoccluded: horizons at n -+ pi/2, arc sum = cos n + n sin n.
     unoccluded += projLen * (cosN + n * sinN);
     if (kBentNormals) {
       // The cosine-weighted mean visible direction of the slice, in closed form (exactly N
       // for an open hemisphere): the (V, T) components on each side of V.
-      vec2 bp = bentArc(h1, cosN, sinN), bm = bentArc(-h0, cosN, -sinN);
+      vec2 bp = bentArc(cs1, cosN, sinN), bm = bentArc(vec2(cs0.x, -cs0.y), cosN, -sinN);
       bent += projLen * (V * (bp.x + bm.x) + T * (bp.y - bm.y));
     }
   }

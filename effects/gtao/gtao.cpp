@@ -215,10 +215,12 @@ class GtaoEffect : public gi::Effect {
   // Host-visible and written while recording: the renderer waits for each frame before it
   // records the next, so the GPU is not reading it. Rewritten only when a setting changed.
   void upload(const gi::SettingValues& s) {
-    const std::array<double, 4> key = {s.number("radius"), s.number("falloff"),
-                                       s.number("thickness"), s.flag("interleave") ? 1.0 : 0.0};
+    const std::array<double, 5> key = {s.number("radius"), s.number("falloff"),
+                                       s.number("thickness"), s.flag("interleave") ? 1.0 : 0.0,
+                                       double(s.integer("slices"))};
     if (key == uploaded_) return;
-    const gi::gtao::Uniforms u = gi::gtao::makeUniforms(key[0], key[1], key[2], key[3] != 0.0);
+    const gi::gtao::Uniforms u =
+        gi::gtao::makeUniforms(key[0], key[1], key[2], key[3] != 0.0, int(key[4]));
     uniforms_.write(&u, sizeof u);
     uploaded_ = key;
   }
@@ -273,7 +275,7 @@ class GtaoEffect : public gi::Effect {
   gi::vk::Buffer uniforms_;
   gi::vk::Image unusedBent_;
   bool unusedBentReady_ = false;
-  std::optional<std::array<double, 4>> uploaded_;  // the settings uniforms_ holds
+  std::optional<std::array<double, 5>> uploaded_;  // the settings uniforms_ holds
 };
 
 }  // namespace

@@ -31,7 +31,7 @@ struct Uniforms {
   float falloffSlope;  // 1 / (falloff x R): weight = clamp((R - distance) x slope, 0, 1)
   float thickness;     // horizon blend towards lower samples, 0 = off
   float pad;
-  float noise[16][4];  // per 4x4 phase: slice rotation and step jitter in [0, 1), 0, 0
+  float noise[16][4];  // per 4x4 phase: cos, sin of the slice rotation, step jitter, 0
 };
 static_assert(sizeof(Uniforms) == 16 + 16 * 16, "std140 layout");
 
@@ -49,7 +49,9 @@ inline std::array<float, 2> noise(int e, bool interleave) {
 }
 
 // falloff: the fraction of R over which an occluder's weight fades to 0 (0: hard cut-off).
-inline Uniforms makeUniforms(double radius, double falloff, double thickness, bool interleave) {
+// slices: the rotation of phase e is noise(e).x x pi / slices (one slice's angle, stratified).
+inline Uniforms makeUniforms(double radius, double falloff, double thickness, bool interleave,
+                             int slices) {
   Uniforms u{};
   u.radius = float(radius);
   // Guard: falloff 0 is a step; the slope stays finite (1e30 per world unit).
@@ -57,8 +59,10 @@ inline Uniforms makeUniforms(double radius, double falloff, double thickness, bo
   u.thickness = float(thickness);
   for (int e = 0; e < 16; ++e) {
     const auto n = noise(e, interleave);
-    u.noise[e][0] = n[0];
-    u.noise[e][1] = n[1];
+    const double rotation = n[0] * 3.14159265358979323846 / std::max(slices, 1);
+    u.noise[e][0] = float(std::cos(rotation));
+    u.noise[e][1] = float(std::sin(rotation));
+    u.noise[e][2] = n[1];
   }
   return u;
 }

@@ -20,8 +20,8 @@ layout(constant_id = 1) const int kSteps = 4;
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 // Keep in sync with gi::hbao::Uniforms (hbao_params.h).
 layout(set = 0, binding = 1) uniform HbaoParams {
-  vec4 params;     // radius R, 1 / R^2, angle bias (radians), 0
-  vec4 noise[16];  // per 4x4 phase: direction rotation in [0, 1) directions, step jitter
+  vec4 params;     // radius R, 1 / R^2, cos and sin of the angle bias
+  vec4 noise[16];  // per 4x4 phase: cos, sin of the direction rotation, step jitter, 0
 } hbao;
 layout(set = 0, binding = 2) uniform sampler2D gDepth;
 layout(set = 0, binding = 3) uniform sampler2D gNormal;
@@ -62,7 +62,8 @@ void main() {
   vec3 Pn = safeNormalize(P, vec3(0.0, 0.0, -1.0));
   vec3 N = safeNormalize(normalTexel.xyz, -Pn);
 
-  float R = hbao.params.x, invR2 = hbao.params.y, bias = hbao.params.z;
+  float R = hbao.params.x, invR2 = hbao.params.y;
+  float cosBias = hbao.params.z, sinBias = hbao.params.w;
   float radiusPx = R * abs(p11) * 0.5 * frame.viewport.y / max(dist, 1e-30);
   vec4 noise = hbao.noise[(p.y & 3) * 4 + (p.x & 3)];
   vec2 pixelCentre = vec2(p) + 0.5;
@@ -71,8 +72,12 @@ void main() {
 
   float occlusion = 0.0;
   for (int dir = 0; dir < kDirections; ++dir) {
-    float phi = (float(dir) + noise.x) * (2.0 * kPi / float(kDirections));
-    vec2 d = vec2(cos(phi), sin(phi));  // screen direction, pixels
+    // Direction angle 2 pi dir / kDirections (folded at compile time once the loop unrolls),
+    // rotated by the pixel's phase (its cos and sin come from the table): no trigonometry per
+    // pixel (llvmpipe evaluates each sin/cos/asin as a long polynomial).
+    float base = float(dir) * (2.0 * kPi / float(kDirections));
+    vec2 cb = vec2(cos(base), sin(base));
+    vec2 d = vec2(cb.x * noise.x - cb.y * noise.y, cb.y * noise.x + cb.x * noise.y);  // pixels
     vec3 dir3 = vec3(d * viewPerPixel, 0.0);  // view-space motion per pixel at this depth
     // Tangent angle t: elevation of the tangent plane's line in this direction's slice (the
     // plane through the eye holding P and dir3, where the samples lie), so that a plane's own
@@ -85,7 +90,7 @@ void main() {
     float lenT = length(tangent);
     // Guard: an edge-on surface (the tangent plane is the slice plane: no line) takes t = 0.
     float sinT = lenT > 1e-6 ? clamp(tangent.z / lenT, -1.0, 1.0) : 0.0;
-    float t = asin(sinT), cosT = cos(t);
+    float cosT = sqrt(1.0 - sinT * sinT);  // t in [-pi/2, pi/2]
     // Samples are measured in the slice frame: x along the tangent line, y along the normal
     // (scaled by 1 / |normal projected into the slice|): their elevation is t + atan(y, x).
     // Depth texels are sampled at their centres, off the slice by up to half a texel; measured
@@ -94,13 +99,13 @@ void main() {
     float nAxis = dot(N, safeNormalize(cross(Pn, Dn), vec3(0.0, 1.0, 0.0)));
     // Guard: a normal nearly perpendicular to the slice keeps a finite scale.
     float invProjLen = inversesqrt(max(1.0 - nAxis * nAxis, 1e-12));
-    // Guard: the biased horizon is clamped to 90 degrees (sin stays monotone).
-    float sinH = sin(min(t + bias, kHalfPi));
+    // sin(t + bias); guard: the biased horizon is clamped to 90 degrees (sin stays monotone).
+    float sinH = cosT * cosBias - sinT * sinBias < 0.0 ? 1.0 : sinT * cosBias + cosT * sinBias;
     float ao = 0.0;
     for (int step = 0; step < kSteps; ++step) {
       // Uniform steps with a jittered start; guard: at least one pixel out (a zero offset has
       // no elevation).
-      float s = (float(step) + noise.y) / float(kSteps);
+      float s = (float(step) + noise.z) / float(kSteps);
       vec2 pix = pixelCentre + d * (s * radiusPx + 1.0);
       ivec2 q = ivec2(floor(pix));
       bool inside = pix.x >= 0.0 && pix.y >= 0.0 && pix.x < sizeF.x && pix.y < sizeF.y;

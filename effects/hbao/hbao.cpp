@@ -174,10 +174,11 @@ class HbaoEffect : public gi::Effect {
   // Host-visible and written while recording: the renderer waits for each frame before it
   // records the next, so the GPU is not reading it. Rewritten only when a setting changed.
   void upload(const gi::SettingValues& s) {
-    const std::array<double, 3> key = {s.number("radius"), s.number("angle_bias"),
-                                       s.flag("interleave") ? 1.0 : 0.0};
+    const std::array<double, 4> key = {s.number("radius"), s.number("angle_bias"),
+                                       s.flag("interleave") ? 1.0 : 0.0,
+                                       double(s.integer("directions"))};
     if (key == uploaded_) return;
-    const gi::hbao::Uniforms u = gi::hbao::makeUniforms(key[0], key[1], key[2] != 0.0);
+    const gi::hbao::Uniforms u = gi::hbao::makeUniforms(key[0], key[1], key[2] != 0.0, int(key[3]));
     uniforms_.write(&u, sizeof u);
     uploaded_ = key;
   }
@@ -208,7 +209,7 @@ class HbaoEffect : public gi::Effect {
 
   gi::vk::Pipeline hbao_, blur_;
   gi::vk::Buffer uniforms_;
-  std::optional<std::array<double, 3>> uploaded_;  // the settings uniforms_ holds
+  std::optional<std::array<double, 4>> uploaded_;  // the settings uniforms_ holds
 };
 
 }  // namespace

@@ -23,11 +23,10 @@ inline constexpr float kBlurDepthTolerance = 0.25f;  // fraction of the radius
 
 // std140 mirror of the `HbaoParams` uniform block in hbao.comp.
 struct Uniforms {
-  float radius;      // R, world units
-  float invRadius2;  // 1 / R^2 (W(r) = 1 - r^2 / R^2)
-  float angleBias;   // radians
-  float pad;
-  float noise[16][4];  // per 4x4 phase: direction rotation and step jitter in [0, 1), 0, 0
+  float radius;            // R, world units
+  float invRadius2;        // 1 / R^2 (W(r) = 1 - r^2 / R^2)
+  float cosBias, sinBias;  // of the angle bias
+  float noise[16][4];      // per 4x4 phase: cos, sin of the direction rotation, step jitter, 0
 };
 static_assert(sizeof(Uniforms) == 16 + 16 * 16, "std140 layout");
 
@@ -43,15 +42,21 @@ inline std::array<float, 2> noise(int e, bool interleave) {
   return {(float(j) + 0.5f) / 16.0f, (float((j * 5) % 16) + 0.5f) / 16.0f};
 }
 
-inline Uniforms makeUniforms(double radius, double angleBiasDegrees, bool interleave) {
+// directions: the rotation of phase e is noise(e).x x 2 pi / directions (stratified).
+inline Uniforms makeUniforms(double radius, double angleBiasDegrees, bool interleave,
+                             int directions) {
+  constexpr double kPi = 3.14159265358979323846;
   Uniforms u{};
   u.radius = float(radius);
   u.invRadius2 = float(1.0 / (radius * radius));  // radius >= 1e-4 (the setting's range)
-  u.angleBias = float(angleBiasDegrees * 3.14159265358979323846 / 180.0);
+  u.cosBias = float(std::cos(angleBiasDegrees * kPi / 180.0));
+  u.sinBias = float(std::sin(angleBiasDegrees * kPi / 180.0));
   for (int e = 0; e < 16; ++e) {
     const auto n = noise(e, interleave);
-    u.noise[e][0] = n[0];
-    u.noise[e][1] = n[1];
+    const double rotation = n[0] * 2.0 * kPi / (directions < 1 ? 1 : directions);
+    u.noise[e][0] = float(std::cos(rotation));
+    u.noise[e][1] = float(std::sin(rotation));
+    u.noise[e][2] = n[1];
   }
   return u;
 }
