@@ -150,8 +150,8 @@ TEST_F(HorizonAoTest, PlaneIsOpen) {
 TEST_F(HorizonAoTest, GtaoCornerMatchesTheClosedForm) {
   // Hard cut-off at R (falloff 0) as the closed form; 4 slices x 8 steps, interleaved and
   // blurred (64 slice rotations averaged). Screen-space horizons are found at discrete samples,
-  // so they can only be lower than the true ones: AO errs high. Tolerance 0.05 at every
-  // distance; beyond R the floor is open.
+  // so they can only be lower than the true ones: AO errs high. Tolerance: within [-0.01,
+  // +0.03] of the closed form at every distance (measured +0.000 .. +0.017); beyond R, open.
   const float R = 0.5f;
   Result r = render("gtao", cornerScene(),
                     {"gtao.radius=0.5", "gtao.falloff=0", "gtao.slices=4", "gtao.steps=8"});
@@ -161,7 +161,8 @@ TEST_F(HorizonAoTest, GtaoCornerMatchesTheClosedForm) {
     std::printf("gtao corner d = %.2f R: rendered %.4f, closed form %.4f\n", d / R, rendered,
                 expected);
     ASSERT_GE(rendered, 0.0) << "no floor pixels on the line x = " << d;
-    EXPECT_NEAR(rendered, expected, 0.05) << "d = " << d;
+    EXPECT_GE(rendered - expected, -0.01) << "d = " << d;
+    EXPECT_LE(rendered - expected, 0.03) << "d = " << d;
   }
   EXPECT_LT(r.meanOnLine(0.05f), 0.65) << "near the crease AO tends to 1/2";
 }
@@ -184,7 +185,7 @@ TEST_F(HorizonAoTest, GtaoBeatsSsaoAtEqualTapCount) {
   }
   std::printf("mean |AO - closed form| at 16 taps: gtao %.4f, ssao %.4f\n", errG / n, errS / n);
   EXPECT_LT(errG, errS);
-  EXPECT_LT(errG / n, 0.08);  // measured 0.055 (the default falloff fades occluders before R)
+  EXPECT_LT(errG / n, 0.04);  // measured 0.024
 }
 
 TEST_F(HorizonAoTest, HbaoCornerOccludesWithinItsRadiusOnly) {
@@ -259,7 +260,7 @@ TEST_F(HorizonAoTest, BentNormalsPointAwayFromTheWall) {
         "bent normal at d = %.2f: tilt %.1f deg (closed form %.1f), mean z %.3f, %d of %d "
         "towards the wall\n",
         d, tilt * 180 / M_PI, expected * 180 / M_PI, sumZ / n, towardsWall, n);
-    EXPECT_NEAR(tilt, expected, 0.15) << "d = " << d;  // 8.6 degrees
+    EXPECT_NEAR(tilt, expected, 0.1) << "d = " << d;  // 5.7 degrees; measured 1.6 .. 3.1
     EXPECT_NEAR(sumZ / n, 0.0, 0.03) << "d = " << d;   // the wall is uniform along z
     if (d < 0.2f) {
       EXPECT_EQ(towardsWall, 0) << "d = " << d;

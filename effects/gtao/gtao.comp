@@ -60,10 +60,11 @@ float horizonCos(float sgn, vec2 d, vec3 tangentLine, float invProjLen, vec3 N, 
                  vec4 proj4, vec2 off, float p32) {
   float hc = 1.0;
   for (int step = 0; step < kSteps; ++step) {
+    // Uniform steps with a jittered start (see gtao_params.h).
     float s = (float(step) + jitter) / float(kSteps);
     // Guard: the first sample is at least one pixel out, never the centre texel itself (a
     // zero-length offset has no direction).
-    vec2 pix = pixelCentre + sgn * d * (s * s * radiusPx + 1.0);
+    vec2 pix = pixelCentre + sgn * d * (s * radiusPx + 1.0);
     ivec2 t = ivec2(floor(pix));
     bool inside = pix.x >= 0.0 && pix.y >= 0.0 && pix.x < sizeF.x && pix.y < sizeF.y;
     float sd = texelFetch(gDepth, clamp(t, ivec2(0), size - 1), 0).r;

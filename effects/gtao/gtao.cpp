@@ -61,7 +61,7 @@ class GtaoEffect : public gi::Effect {
          true},
         {"steps", SettingType::Int, 3, 1, gi::gtao::kMaxSteps,
          "depth samples per side of each slice (XeGTAO low 2, medium 2, high 3, ultra 3)", true},
-        {"falloff", SettingType::Float, 0.1, 0.0, 1.0,
+        {"falloff", SettingType::Float, 0.0, 0.0, 1.0,
          "fraction of R over which an occluder's weight fades to 0 before R (0: the reference's "
          "hard cut-off)",
          false},

@@ -2,10 +2,13 @@
 // by the plugin (which uploads it) and tests/test_horizon_ao.cpp.
 //
 // Estimator (gtao.comp). For kSlices planes through the view vector V at angles
-// phi_i = pi (i + noise.x) / kSlices, the horizon on each side is the highest direction (the
-// largest cos to V) to a depth-buffer sample within the radius R, found by kSteps samples at
-// pixel distances ((j + noise.y) / kSteps)^2 R_px + 1, and never below the tangent plane. With
-// n the angle of the normal projected into the slice and h0 <= 0 <= h1 the horizon angles,
+// phi_i = pi (i + rotation) / kSlices, the horizon on each side is the highest direction to a
+// depth-buffer sample within the radius R (never below the tangent plane), found by kSteps
+// samples at pixel distances ((j + jitter) / kSteps) R_px + 1. Uniform steps: the reference
+// counts occluders up to R alike (a squared distribution measured NRMSE 0.130 against 0.112 at
+// 8 steps). Horizons are elevations above the slice's tangent line (exact for planes at
+// texel-centre samples; README.md). With n the angle of the normal projected into the slice
+// and h0 <= 0 <= h1 the horizon angles from V,
 //   visible_i = |N_proj| (arc(h0) + arc(h1)),  arc(h) = (cos n + 2 h sin n - cos(2h - n)) / 4
 // (Jimenez et al. 2016, eq. 10: the integral of cos(theta - n) |sin theta| from 0 to h), and
 //   AO = sum_i visible_i / sum_i |N_proj| (cos n + n sin n),
