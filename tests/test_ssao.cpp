@@ -16,6 +16,7 @@
 #include "gi/effect_config.h"
 #include "gi/renderer.h"
 #include "gi/scene_io.h"
+#include "quad_scene.h"
 #include "test_support.h"
 #include "vulkan_fixture.h"
 
@@ -24,61 +25,12 @@ namespace {
 
 constexpr uint32_t kW = 160, kH = 120;
 
-Mesh quad(float half) {
-  Mesh m;
-  m.name = "quad";
-  for (auto [x, y] : {std::pair{-1.f, -1.f}, {1.f, -1.f}, {1.f, 1.f}, {-1.f, 1.f}})
-    m.vertices.push_back({glm::vec3(x * half, y * half, 0), glm::vec3(0, 0, 1), glm::vec2(0)});
-  m.indices = {0, 1, 2, 0, 2, 3};
-  m.boundsMin = glm::vec3(-half, -half, 0);
-  m.boundsMax = glm::vec3(half, half, 0);
-  m.triangleAreas = {2 * half * half, 2 * half * half};
-  return m;
-}
-
-// Quads: world transform (the quad faces local +z) and half size.
-using Quads = std::vector<std::pair<glm::mat4, float>>;
-
-// Scene of quads and a camera looking from `eye` at `target`. `scale` multiplies every length
-// (scale-invariance test).
-Scene quadScene(const Quads& quads, glm::vec3 eye, glm::vec3 target, float scale = 1.0f,
-                float znear = 0.05f, float zfar = 100.0f) {
-  Scene s;
-  s.materials.push_back(Material{});
-  const glm::mat4 S = glm::scale(glm::mat4(1.0f), glm::vec3(scale));
-  for (const auto& [transform, half] : quads) {
-    s.meshes.push_back(quad(half));
-    int n = s.addNode("quad", S * transform);
-    s.nodes[n].meshes = {int(s.meshes.size()) - 1};
-  }
-  Camera cam;
-  cam.yfov = glm::radians(60.0f);
-  cam.znear = znear * scale;
-  cam.zfar = zfar * scale;
-  s.cameras.push_back(cam);
-  int c = s.addNode("camera",
-                    glm::inverse(glm::lookAt(eye * scale, target * scale, glm::vec3(0, 1, 0))));
-  s.nodes[c].camera = 0;
-  s.activeCameraNode = c;
-  s.updateWorldTransforms();
-  return s;
-}
-
-// A floor (y = 0, facing +y) and a wall (x = 0, facing +x): a 90-degree concave corner.
-Quads cornerQuads() {
-  const glm::mat4 floor = glm::rotate(glm::mat4(1.0f), glm::radians(-90.0f), glm::vec3(1, 0, 0));
-  const glm::mat4 wall = glm::rotate(glm::mat4(1.0f), glm::radians(90.0f), glm::vec3(0, 1, 0));
-  return {{floor, 20.0f}, {wall, 20.0f}};
-}
-Scene cornerScene(float scale = 1.0f) {
-  return quadScene(cornerQuads(), glm::vec3(2.5f, 1.6f, 0.0f), glm::vec3(0.0f), scale);
-}
-
-bool finite(const ImageRGBA32F& img) {
-  for (float v : img.pixels)
-    if (!std::isfinite(v)) return false;
-  return true;
-}
+using test::cornerLinePixels;
+using test::cornerQuads;
+using test::cornerScene;
+using test::finite;
+using test::Quads;
+using test::quadScene;
 
 class SsaoTest : public test::VulkanTest {
  protected:
@@ -195,23 +147,6 @@ double cornerOcclusion(double a) {
     sum += (2.0 / M_PI) * std::sqrt(1.0 - t * t) * (1.0 - a / t);
   }
   return sum * (1.0 - a) / n;
-}
-
-// Floor pixels of the corner scene in the 4 rows nearest to the line x = d (every 4x4 phase
-// of the interleave pattern is present), away from the image border.
-std::vector<glm::ivec2> cornerLinePixels(const auto& r, float d) {
-  int bestRow = -1;
-  float bestErr = 1e9f;
-  for (int y = 8; y < r.h - 8; ++y) {
-    glm::vec3 p = r.worldAt(r.w / 2, y);
-    if (std::abs(p.y) < 1e-3f && std::abs(p.x - d) < bestErr)
-      bestErr = std::abs(p.x - d), bestRow = y;
-  }
-  std::vector<glm::ivec2> pixels;
-  for (int y = bestRow - 1; y <= bestRow + 2; ++y)
-    for (int x = r.w / 2 - 16; x < r.w / 2 + 16; ++x)
-      if (std::abs(r.worldAt(x, y).y) < 1e-3f) pixels.push_back({x, y});
-  return pixels;
 }
 
 // ---- tests ----------------------------------------------------------------------------------

@@ -1,0 +1,283 @@
+// Ground-truth ambient occlusion (Jimenez et al. 2016; RTR 4th ed. 11.3.7): horizon search in
+// slices through the view vector, the cosine-weighted visible arc in closed form, optional bent
+// normals and multi-bounce fit, and a depth-aware blur that removes the 4x4 interleave pattern.
+// Publishes "ao" (and "gtao_bent_normal"). Estimator: gtao_params.h; settings: README.md.
+#include <algorithm>
+#include <array>
+#include <map>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "gi/effect.h"
+#include "gi/effect_registry.h"
+#include "gi/vk/pipeline.h"
+#include "gi/vk/resources.h"
+#include "gtao.comp.h"       // const uint32_t gtao_comp[]
+#include "gtao_blur.comp.h"  // const uint32_t gtao_blur_comp[]
+#include "gtao_params.h"
+#include "spirv_specialize.h"
+
+namespace {
+
+namespace res = gi::resources;
+using gi::SettingType;
+
+// View-space bent normal (xyz, w = 1 on geometry), the G-buffer normal's layout. When the
+// setting is off, the G-buffer normal itself is published under this name (no pass, no
+// texture): the engine requires every declared write to be published.
+constexpr const char* kBentNormal = "gtao_bent_normal";
+constexpr VkFormat kAOFormat = VK_FORMAT_R16_SFLOAT, kBentFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
+constexpr uint32_t kGroupX = 32, kGroupY = 16;  // local_size of both shaders (32x16: llvmpipe)
+
+uint32_t groupsOf(uint32_t n, uint32_t size) {
+  return (n + size - 1) / size;
+}
+
+class GtaoEffect : public gi::Effect {
+ public:
+  gi::EffectInfo info() const override {
+    gi::EffectInfo i;
+    i.name = "gtao";
+    i.version = "1.0";
+    i.description =
+        "ground-truth ambient occlusion (horizon slices, cosine-weighted; optional bent normals "
+        "and multi-bounce)";
+    i.stage = gi::EffectStage::BeforeLighting;
+    i.reads = {res::kDepth, res::kNormal, res::kAlbedo};
+    i.writes = {res::kAO, kBentNormal};
+    i.debugView = res::kAO;
+    i.estimates = gi::GroundTruth::AmbientOcclusion;
+    return i;
+  }
+
+  std::vector<gi::SettingDesc> settings() const override {
+    return {
+        {"radius", SettingType::Float, 0.5, 1e-4, 1e4,
+         "world-space radius R: occluders farther than R are ignored (scale it with the scene)",
+         false},
+        {"slices", SettingType::Int, 3, 1, gi::gtao::kMaxSlices,
+         "slice planes through the view vector per pixel (XeGTAO low 1, medium 2, high 3, ultra 9)",
+         true},
+        {"steps", SettingType::Int, 3, 1, gi::gtao::kMaxSteps,
+         "depth samples per side of each slice (XeGTAO low 2, medium 2, high 3, ultra 3)", true},
+        {"falloff", SettingType::Float, 0.0, 0.0, 1.0,
+         "fraction of R over which an occluder's weight fades to 0 before R (0: the reference's "
+         "hard cut-off)",
+         false},
+        {"thickness", SettingType::Float, 0.0, 0.0, 1.0,
+         "thickness heuristic: a sample below the horizon pulls it down by this blend (0: off, "
+         "occluders are infinitely thick)",
+         false},
+        {"bent_normals", SettingType::Bool, 0, 0, 1,
+         "also write the view-space bent normal to 'gtao_bent_normal' (off: that name is the "
+         "G-buffer normal, at no cost)",
+         true},
+        {"multi_bounce", SettingType::Bool, 0, 0, 1,
+         "Jimenez et al. multi-bounce fit: AO' = max(AO, ((a AO + b) AO + c) AO) from the albedo "
+         "(reads the albedo G-buffer)",
+         true},
+        {"blur_radius", SettingType::Int, 2, 0, gi::gtao::kMaxBlurRadius,
+         "depth-aware denoise radius in pixels (0: no blur pass; even radii cancel the 4x4 "
+         "interleave pattern exactly)",
+         true},
+        {"interleave", SettingType::Bool, 1, 0, 1,
+         "rotate the slices and jitter the steps in a 4x4 pixel pattern for the blur to average",
+         false},
+    };
+  }
+
+  void prepare(gi::EffectContext& ctx, const gi::SettingValues& s) override {
+    gi::vk::Context& vk = ctx.vulkan();
+    vk.requireWorkgroup(kGroupX, kGroupY, "gtao");
+    const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
+               tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+               img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+    // Graph-changing settings are specialization constants: the loops unroll and the optional
+    // outputs vanish from the code when off.
+    const std::map<uint32_t, uint32_t> spec = {{0, uint32_t(s.integer("slices"))},
+                                               {1, uint32_t(s.integer("steps"))},
+                                               {2, s.flag("bent_normals") ? 1u : 0u},
+                                               {3, s.flag("multi_bounce") ? 1u : 0u}};
+    gtao_ = gi::vk::Pipeline::compute(
+        vk, gi::spirv::specialize({std::begin(gtao_comp), std::end(gtao_comp)}, spec, "gtao.comp"),
+        {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, tex}, {5, img}, {6, img}});
+    const int blurRadius = std::max(1, s.integer("blur_radius"));
+    blur_ = gi::vk::Pipeline::compute(
+        vk,
+        gi::spirv::specialize({std::begin(gtao_blur_comp), std::end(gtao_blur_comp)},
+                              {{0, uint32_t(blurRadius)}}, "gtao_blur.comp"),
+        {{0, ubo}, {1, tex}, {2, tex}, {3, tex}, {4, img}}, sizeof(BlurPush));
+    if (!uniforms_)
+      uniforms_ =
+          gi::vk::Buffer(vk, sizeof(gi::gtao::Uniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true);
+    if (!unusedBent_) {
+      gi::vk::ImageDesc d;
+      d.format = kBentFormat;
+      d.usage = VK_IMAGE_USAGE_STORAGE_BIT;
+      unusedBent_ = gi::vk::Image(vk, d);
+    }
+  }
+
+  void addPasses(gi::FrameGraph& graph, gi::EffectContext& ctx,
+                 const gi::SettingValues& settings) override {
+    struct Io {
+      gi::TextureHandle depth, normal, albedo, raw, half, ao, bent;
+    };
+    auto io = std::make_shared<Io>();
+    gi::Blackboard& bb = graph.blackboard();
+    // changesGraph settings: fixed for this graph.
+    const int blurRadius = settings.integer("blur_radius");
+    const bool bentNormals = settings.flag("bent_normals"),
+               multiBounce = settings.flag("multi_bounce");
+    const VkBuffer frame = ctx.frameUniforms();
+    const VkSampler nearest = ctx.nearestSampler();
+    // Persistent, not transient: no pass of the graph may read the bent normal, and the graph
+    // aliases a transient whose last use is the pass that wrote it with later transients (its
+    // aliasing barrier then reports a write-after-write hazard); a persistent texture is never
+    // aliased and stays readable after the frame.
+    const gi::TextureHandle bentTexture =
+        bentNormals ? graph.persistentTexture(kBentNormal, gi::TextureDesc{kBentFormat})
+                    : gi::TextureHandle{};
+
+    graph.addPass(
+        "gtao",
+        [&](gi::PassBuilder& b) {
+          io->depth = b.read(bb.texture(res::kDepth));
+          io->normal = b.read(bb.texture(res::kNormal));
+          if (multiBounce) io->albedo = b.read(bb.texture(res::kAlbedo));
+          io->raw =
+              b.write(b.create(blurRadius > 0 ? "gtao_raw" : res::kAO, gi::TextureDesc{kAOFormat}),
+                      gi::TextureUsage::StorageWrite);
+          if (bentNormals) io->bent = b.write(bentTexture, gi::TextureUsage::StorageWrite);
+        },
+        [this, io, values = &settings, frame, nearest, multiBounce,
+         bentNormals](gi::PassContext& pc) {
+          upload(*values);
+          if (!bentNormals) prepareUnusedBent(pc.cmd());
+          gi::vk::DescriptorWriter w;
+          w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame)
+              .buffer(1, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms_.handle())
+              .sampled(2, pc.view(io->depth), nearest)
+              .sampled(3, pc.view(io->normal), nearest)
+              .sampled(4, pc.view(multiBounce ? io->albedo : io->normal), nearest)
+              .storageImage(5, pc.view(io->raw))
+              .storageImage(6, bentNormals ? pc.view(io->bent) : unusedBent_.view());
+          const VkExtent2D e = pc.extent(io->raw);
+          dispatch(pc, gtao_, w, groupsOf(e.width, kGroupX), groupsOf(e.height, kGroupY));
+        });
+
+    io->ao = io->raw;
+    if (blurRadius > 0) {
+      // Separable: along x into `half`, then along y into "ao", two dispatches in one pass.
+      graph.addPass(
+          "gtao_blur",
+          [&](gi::PassBuilder& b) {
+            io->depth = b.read(io->depth);
+            io->normal = b.read(io->normal);
+            io->raw = b.read(io->raw);
+            io->half = b.write(b.create("gtao_blur_x", gi::TextureDesc{kAOFormat}),
+                               gi::TextureUsage::StorageWrite);
+            io->ao = b.write(b.create(res::kAO, gi::TextureDesc{kAOFormat}),
+                             gi::TextureUsage::StorageWrite);
+          },
+          [this, io, values = &settings, frame, nearest](gi::PassContext& pc) {
+            const VkExtent2D e = pc.extent(io->ao);
+            const float tolerance = float(gi::gtao::kBlurDepthTolerance * values->number("radius"));
+            auto axis = [&](VkImageView in, VkImageLayout inLayout, VkImageView out, int dx) {
+              gi::vk::DescriptorWriter w;
+              w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame)
+                  .sampled(1, pc.view(io->depth), nearest)
+                  .sampled(2, pc.view(io->normal), nearest)
+                  .sampled(3, in, nearest, inLayout)
+                  .storageImage(4, out);
+              const BlurPush push{{dx, 1 - dx}, tolerance};
+              dispatch(pc, blur_, w, groupsOf(e.width, kGroupX), groupsOf(e.height, kGroupY), &push,
+                       sizeof push);
+            };
+            axis(pc.view(io->raw), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, pc.view(io->half), 1);
+            // The graph orders passes, not dispatches inside one: the y dispatch reads what the
+            // x dispatch wrote (the image stays GENERAL, as storage images are).
+            imageBarrier(pc.cmd(), pc.image(io->half));
+            axis(pc.view(io->half), VK_IMAGE_LAYOUT_GENERAL, pc.view(io->ao), 0);
+          });
+    }
+    bb.put(res::kAO, io->ao);
+    bb.put(kBentNormal, bentNormals ? io->bent : bb.texture(res::kNormal));
+  }
+
+ private:
+  struct BlurPush {
+    int32_t axis[2];
+    float tolerance;
+  };
+
+  // Host-visible and written while recording: the renderer waits for each frame before it
+  // records the next, so the GPU is not reading it. Rewritten only when a setting changed.
+  void upload(const gi::SettingValues& s) {
+    const std::array<double, 5> key = {s.number("radius"), s.number("falloff"),
+                                       s.number("thickness"), s.flag("interleave") ? 1.0 : 0.0,
+                                       double(s.integer("slices"))};
+    if (key == uploaded_) return;
+    const gi::gtao::Uniforms u =
+        gi::gtao::makeUniforms(key[0], key[1], key[2], key[3] != 0.0, int(key[4]));
+    uniforms_.write(&u, sizeof u);
+    uploaded_ = key;
+  }
+
+  // Bent normals off: the shader never stores to binding 6 (specialized away), but the binding
+  // must hold an image of the declared format. A 1x1 image of the effect's own, outside the
+  // frame graph (a never-read graph transient may share memory with later ones), moved to
+  // GENERAL once.
+  void prepareUnusedBent(VkCommandBuffer cmd) {
+    if (unusedBentReady_) return;
+    VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
+    b.srcStageMask = VK_PIPELINE_STAGE_2_NONE;
+    b.dstStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+    b.dstAccessMask = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
+    b.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+    b.newLayout = VK_IMAGE_LAYOUT_GENERAL;
+    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    b.image = unusedBent_.handle();
+    b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+    VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+    dep.imageMemoryBarrierCount = 1;
+    dep.pImageMemoryBarriers = &b;
+    vkCmdPipelineBarrier2(cmd, &dep);
+    unusedBentReady_ = true;
+  }
+
+  static void dispatch(gi::PassContext& pc, const gi::vk::Pipeline& p, gi::vk::DescriptorWriter& w,
+                       uint32_t x, uint32_t y, const void* push = nullptr, uint32_t pushBytes = 0) {
+    pc.descriptors().bind(pc.cmd(), p, w);
+    if (pushBytes > 0)
+      vkCmdPushConstants(pc.cmd(), p.layout(), VK_SHADER_STAGE_ALL, 0, pushBytes, push);
+    vkCmdDispatch(pc.cmd(), x, y, 1);
+  }
+
+  // Compute write -> compute sampled read of a storage image that stays in GENERAL.
+  static void imageBarrier(VkCommandBuffer cmd, VkImage image) {
+    VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
+    b.srcStageMask = b.dstStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+    b.srcAccessMask = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
+    b.dstAccessMask = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT;
+    b.oldLayout = b.newLayout = VK_IMAGE_LAYOUT_GENERAL;
+    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    b.image = image;
+    b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+    VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+    dep.imageMemoryBarrierCount = 1;
+    dep.pImageMemoryBarriers = &b;
+    vkCmdPipelineBarrier2(cmd, &dep);
+  }
+
+  gi::vk::Pipeline gtao_, blur_;
+  gi::vk::Buffer uniforms_;
+  gi::vk::Image unusedBent_;
+  bool unusedBentReady_ = false;
+  std::optional<std::array<double, 5>> uploaded_;  // the settings uniforms_ holds
+};
+
+}  // namespace
+
+GI_EFFECT_MODULE(GtaoEffect)
