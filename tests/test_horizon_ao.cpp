@@ -13,7 +13,6 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "../effects/gtao/gtao_params.h"
-#include "../effects/gtao/spirv_specialize.h"
 #include "gi/effect_config.h"
 #include "gi/renderer.h"
 #include "quad_scene.h"
@@ -338,40 +337,6 @@ TEST_F(HorizonAoTest, PassListsAndTheUnusedBentNormal) {
   r.renderFrame();
   const ImageRGBA32F bent = r.readTarget("gtao_bent_normal"), normal = r.readTarget("normal");
   EXPECT_EQ(bent.pixels, normal.pixels);
-}
-
-// The SPIR-V patch that bakes specialization constants (Pipeline::compute takes no
-// VkSpecializationInfo): an int and a bool constant get their new defaults, everything else is
-// untouched, and unknown ids or malformed modules are errors.
-TEST(SpirvSpecialize, SetsDefaultsAndRejectsUnknownIds) {
-  // Header (magic, version, generator, bound, schema); OpDecorate %5 SpecId 0; OpDecorate %6
-  // SpecId 2; %5 = OpSpecConstant %int 3; %6 = OpSpecConstantTrue %bool.
-  const uint32_t decorate = (4u << 16) | 71, specInt = (4u << 16) | 50, specTrue = (3u << 16) | 48,
-                 specFalse = (3u << 16) | 49;
-  const std::vector<uint32_t> module = {0x07230203, 0x00010000, 0, 8, 0, decorate, 5, 1,
-                                        0,          decorate,   6, 1, 2, specInt,  2, 5,
-                                        3,          specTrue,   7, 6};
-  std::vector<uint32_t> expected = module;
-  expected[16] = 9;          // the int's value
-  expected[17] = specFalse;  // the bool
-  EXPECT_EQ(spirv::specialize(module, {{0, 9}, {2, 0}}, "m"), expected);
-  EXPECT_EQ(spirv::specialize(module, {}, "m"), module);
-  test::expectError(
-      [&] {
-        spirv::specialize(module, {{1, 4}}, "m.comp");
-      },
-      ErrorKind::InvalidData, {"m.comp", "constant_id 1"});
-  std::vector<uint32_t> truncated(module.begin(), module.end() - 1);
-  test::expectError(
-      [&] {
-        spirv::specialize(truncated, {{0, 1}}, "m.comp");
-      },
-      ErrorKind::InvalidData, {"truncated"});
-  test::expectError(
-      [&] {
-        spirv::specialize({1, 2, 3}, {}, "m.comp");
-      },
-      ErrorKind::InvalidData, {"not a SPIR-V module"});
 }
 
 }  // namespace

@@ -13,7 +13,7 @@
 // Assumes a perspective projection (clip.w = view distance), as every engine camera has.
 layout(local_size_x = 32, local_size_y = 16) in;
 
-// Specialized at pipeline creation (spirv_specialize.h): a constant trip count and the band
+// Specialized at pipeline creation (vk::Pipeline::compute): a constant trip count and the band
 // offset folded into the addressing.
 layout(constant_id = 0) const int kSamples = 12;
 layout(constant_id = 1) const int kBand = 0;

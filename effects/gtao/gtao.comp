@@ -13,7 +13,7 @@
 // Assumes a perspective projection (clip.w = view distance), as every engine camera has.
 layout(local_size_x = 32, local_size_y = 16) in;
 
-// Specialization constants (baked into the module by the plugin, gi::spirv::specialize):
+// Specialization constants (set by the plugin at pipeline creation):
 // the loops unroll and the optional outputs vanish when off (llvmpipe runs both sides of
 // every branch, so a runtime `if` would cost the full price).
 layout(constant_id = 0) const int kSlices = 3;

@@ -4,7 +4,6 @@
 // Publishes "ao" (and "gtao_bent_normal"). Estimator: gtao_params.h; settings: README.md.
 #include <algorithm>
 #include <array>
-#include <map>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -16,7 +15,6 @@
 #include "gtao.comp.h"       // const uint32_t gtao_comp[]
 #include "gtao_blur.comp.h"  // const uint32_t gtao_blur_comp[]
 #include "gtao_params.h"
-#include "spirv_specialize.h"
 
 namespace {
 
@@ -53,9 +51,8 @@ class GtaoEffect : public gi::Effect {
 
   std::vector<gi::SettingDesc> settings() const override {
     return {
-        {"radius", SettingType::Float, 0.5, 1e-4, 1e4,
-         "world-space radius R: occluders farther than R are ignored (scale it with the scene)",
-         false},
+        gi::SettingDesc::length("radius", 0.5, 1e-6, 1e9,
+                                "world-space radius R: occluders farther than R are ignored"),
         {"slices", SettingType::Int, 3, 1, gi::gtao::kMaxSlices,
          "slice planes through the view vector per pixel (XeGTAO low 1, medium 2, high 3, ultra 9)",
          true},
@@ -95,19 +92,15 @@ class GtaoEffect : public gi::Effect {
                img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
     // Graph-changing settings are specialization constants: the loops unroll and the optional
     // outputs vanish from the code when off.
-    const std::map<uint32_t, uint32_t> spec = {{0, uint32_t(s.integer("slices"))},
-                                               {1, uint32_t(s.integer("steps"))},
-                                               {2, s.flag("bent_normals") ? 1u : 0u},
-                                               {3, s.flag("multi_bounce") ? 1u : 0u}};
     gtao_ = gi::vk::Pipeline::compute(
-        vk, gi::spirv::specialize({std::begin(gtao_comp), std::end(gtao_comp)}, spec, "gtao.comp"),
-        {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, tex}, {5, img}, {6, img}});
+        vk, {std::begin(gtao_comp), std::end(gtao_comp)},
+        {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, tex}, {5, img}, {6, img}}, 0,
+        {uint32_t(s.integer("slices")), uint32_t(s.integer("steps")),
+         s.flag("bent_normals") ? 1u : 0u, s.flag("multi_bounce") ? 1u : 0u});
     const int blurRadius = std::max(1, s.integer("blur_radius"));
-    blur_ = gi::vk::Pipeline::compute(
-        vk,
-        gi::spirv::specialize({std::begin(gtao_blur_comp), std::end(gtao_blur_comp)},
-                              {{0, uint32_t(blurRadius)}}, "gtao_blur.comp"),
-        {{0, ubo}, {1, tex}, {2, tex}, {3, tex}, {4, img}}, sizeof(BlurPush));
+    blur_ = gi::vk::Pipeline::compute(vk, {std::begin(gtao_blur_comp), std::end(gtao_blur_comp)},
+                                      {{0, ubo}, {1, tex}, {2, tex}, {3, tex}, {4, img}},
+                                      sizeof(BlurPush), {uint32_t(blurRadius)});
     if (!uniforms_)
       uniforms_ =
           gi::vk::Buffer(vk, sizeof(gi::gtao::Uniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true);

@@ -13,7 +13,7 @@
 // Assumes a perspective projection (clip.w = view distance), as every engine camera has.
 layout(local_size_x = 32, local_size_y = 16) in;
 
-// Specialization constants baked in by the plugin (gi::spirv::specialize): the loops unroll.
+// Specialization constants set at pipeline creation by the plugin: the loops unroll.
 layout(constant_id = 0) const int kDirections = 6;
 layout(constant_id = 1) const int kSteps = 4;
 

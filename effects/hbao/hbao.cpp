@@ -4,7 +4,6 @@
 // Estimator: hbao_params.h; settings: README.md.
 #include <algorithm>
 #include <array>
-#include <map>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -16,7 +15,6 @@
 #include "hbao.comp.h"       // const uint32_t hbao_comp[]
 #include "hbao_blur.comp.h"  // const uint32_t hbao_blur_comp[]
 #include "hbao_params.h"
-#include "spirv_specialize.h"
 
 namespace {
 
@@ -49,10 +47,9 @@ class HbaoEffect : public gi::Effect {
 
   std::vector<gi::SettingDesc> settings() const override {
     return {
-        {"radius", SettingType::Float, 0.5, 1e-4, 1e4,
-         "world-space radius R: samples farther than R are ignored, nearer ones attenuated by "
-         "1 - r^2 / R^2 (scale it with the scene)",
-         false},
+        gi::SettingDesc::length("radius", 0.5, 1e-6, 1e9,
+                                "world-space radius R: samples farther than R are ignored, nearer "
+                                "ones attenuated by 1 - r^2 / R^2"),
         {"directions", SettingType::Int, 6, 1, gi::hbao::kMaxDirections,
          "screen directions per pixel (rotated per pixel by the 4x4 interleave)", true},
         {"steps", SettingType::Int, 4, 1, gi::hbao::kMaxSteps, "depth samples per direction", true},
@@ -78,17 +75,14 @@ class HbaoEffect : public gi::Effect {
                tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
                img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
     // Graph-changing settings are specialization constants: the loops unroll.
-    const std::map<uint32_t, uint32_t> spec = {{0, uint32_t(s.integer("directions"))},
-                                               {1, uint32_t(s.integer("steps"))}};
     hbao_ = gi::vk::Pipeline::compute(
-        vk, gi::spirv::specialize({std::begin(hbao_comp), std::end(hbao_comp)}, spec, "hbao.comp"),
-        {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, img}});
+        vk, {std::begin(hbao_comp), std::end(hbao_comp)},
+        {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, img}}, 0,
+        {uint32_t(s.integer("directions")), uint32_t(s.integer("steps"))});
     const int blurRadius = std::max(1, s.integer("blur_radius"));
-    blur_ = gi::vk::Pipeline::compute(
-        vk,
-        gi::spirv::specialize({std::begin(hbao_blur_comp), std::end(hbao_blur_comp)},
-                              {{0, uint32_t(blurRadius)}}, "hbao_blur.comp"),
-        {{0, ubo}, {1, tex}, {2, tex}, {3, tex}, {4, img}}, sizeof(BlurPush));
+    blur_ = gi::vk::Pipeline::compute(vk, {std::begin(hbao_blur_comp), std::end(hbao_blur_comp)},
+                                      {{0, ubo}, {1, tex}, {2, tex}, {3, tex}, {4, img}},
+                                      sizeof(BlurPush), {uint32_t(blurRadius)});
     if (!uniforms_)
       uniforms_ =
           gi::vk::Buffer(vk, sizeof(gi::hbao::Uniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true);
