@@ -69,7 +69,10 @@ void FrameGraph::execute(VkCommandBuffer cmd, vk::DescriptorArena& descriptors, 
       r->state = r->lastWrite = r->visible = {};
       for (SubState& s : r->ownSubs) s = {};
     }
-  for (Slot& slot : slots_) slot.usedStages = VK_PIPELINE_STAGE_2_NONE;
+  for (Slot& slot : slots_) {
+    slot.usedStages = VK_PIPELINE_STAGE_2_NONE;
+    slot.writtenAccess = VK_ACCESS_2_NONE;
+  }
   clearOwned(cmd);
   // The memory slot under a transient (nullptr for external resources).
   auto slotOf = [this](const Resource& r) -> Slot* {
@@ -93,11 +96,13 @@ void FrameGraph::execute(VkCommandBuffer cmd, vk::DescriptorArena& descriptors, 
       Slot* slot = slotOf(r);
       std::vector<SubBarrier> barriers(subs.size());
       VkPipelineStageFlags2 used = VK_PIPELINE_STAGE_2_NONE;
+      VkAccessFlags2 written = VK_ACCESS_2_NONE;
       for (size_t i = 0; i < subs.size(); ++i) {
         const SubNeed& x = subs[i];
         if (!x.read && !x.write) continue;
         SubState& st = (*r.subs)[i];
         used |= x.sync.stage;
+        if (x.write) written |= x.sync.access;
         const bool sameLayoutRead = !x.write && st.state.layout == x.sync.layout;
         if (sameLayoutRead && alreadyVisible(st.lastWrite, st.visible, x.sync)) {
           st.state.stage |= x.sync.stage;  // a later write waits for this reader too
@@ -116,8 +121,10 @@ void FrameGraph::execute(VkCommandBuffer cmd, vk::DescriptorArena& descriptors, 
         const bool discard = x.write && !x.read && !r.external();
         b.oldLayout = discard ? VK_IMAGE_LAYOUT_UNDEFINED : st.state.layout;
         b.newLayout = x.sync.layout;
-        if (b.srcStage == VK_PIPELINE_STAGE_2_NONE && slot)  // first use of aliased memory
+        if (b.srcStage == VK_PIPELINE_STAGE_2_NONE && slot) {  // first use of aliased memory
           b.srcStage = slot->usedStages;
+          b.srcAccess = slot->writtenAccess;
+        }
         if (b.srcStage == VK_PIPELINE_STAGE_2_NONE)
           b.srcStage = VK_PIPELINE_STAGE_2_TOP_OF_PIPE_BIT;
         if (sameLayoutRead) {
@@ -128,7 +135,10 @@ void FrameGraph::execute(VkCommandBuffer cmd, vk::DescriptorArena& descriptors, 
           afterBarrier(st.state, st.lastWrite, st.visible, x.sync, x.write);
         }
       }
-      if (slot) slot->usedStages |= used;
+      if (slot) {
+        slot->usedStages |= used;
+        slot->writtenAccess |= written;
+      }
       graph_detail::appendBarriers(barriers, r.dims, r.image, imageBarriers);
     }
     for (const Access& a : p->accesses) {
@@ -142,12 +152,19 @@ void FrameGraph::execute(VkCommandBuffer cmd, vk::DescriptorArena& descriptors, 
       }
       Slot* slot = slotOf(r);
       VkPipelineStageFlags2 src = a.write ? r.state.stage | r.lastWrite.stage : r.lastWrite.stage;
-      if (src == VK_PIPELINE_STAGE_2_NONE && slot) src = slot->usedStages;  // aliased memory
-      if (slot) slot->usedStages |= need.stage;
+      VkAccessFlags2 srcAccess = r.lastWrite.access;
+      if (src == VK_PIPELINE_STAGE_2_NONE && slot) {  // aliased memory
+        src = slot->usedStages;
+        srcAccess = slot->writtenAccess;
+      }
+      if (slot) {
+        slot->usedStages |= need.stage;
+        if (a.write) slot->writtenAccess |= need.access;
+      }
       if (src != VK_PIPELINE_STAGE_2_NONE) {
         VkBufferMemoryBarrier2 b{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER_2};
         b.srcStageMask = src;
-        b.srcAccessMask = r.lastWrite.access;
+        b.srcAccessMask = srcAccess;
         b.dstStageMask = need.stage;
         b.dstAccessMask = need.access;
         b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;

@@ -260,6 +260,9 @@ struct FrameGraph::Slot {
   // During execute: every stage that touched the memory this frame. A transient's first use
   // waits for them, since an earlier occupant's reads and writes share its memory.
   VkPipelineStageFlags2 usedStages = VK_PIPELINE_STAGE_2_NONE;
+  // ... and every write access: an occupant's first use must also make those available (a
+  // write after an earlier occupant's write is a hazard an execution dependency alone leaves).
+  VkAccessFlags2 writtenAccess = VK_ACCESS_2_NONE;
 };
 
 }  // namespace gi
