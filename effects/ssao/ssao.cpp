@@ -12,8 +12,9 @@
 #include "gi/effect_registry.h"
 #include "gi/vk/pipeline.h"
 #include "gi/vk/resources.h"
-#include "ssao.comp.h"       // const uint32_t ssao_comp[]
-#include "ssao_blur.comp.h"  // const uint32_t ssao_blur_comp[]
+#include "ssao.comp.h"         // const uint32_t ssao_comp[]
+#include "ssao_blur_x.comp.h"  // const uint32_t ssao_blur_x_comp[]
+#include "ssao_blur_y.comp.h"  // const uint32_t ssao_blur_y_comp[]
 #include "ssao_kernel.h"
 
 namespace {
@@ -22,7 +23,10 @@ namespace res = gi::resources;
 using gi::SettingType;
 
 constexpr VkFormat kAOFormat = VK_FORMAT_R16_SFLOAT;
-// Workgroup size of ssao.comp and ssao_blur.comp (local_size_x/y there). Large groups: on
+// The raw AO and the x-blurred AO travel with 1/z and the tangent-plane slopes (ssao.comp), so
+// each blur tap is one fetch.
+constexpr VkFormat kPackedFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
+// Workgroup size of ssao.comp and ssao_blur.glsl (local_size_x/y there). Large groups: on
 // llvmpipe each workgroup carries a fixed scheduling cost, which 8x8 groups paid 3600 times at
 // 640x360 (a quarter of the 64-tap pass); 32x16 measured fastest (32x32 loses cache locality).
 constexpr uint32_t kGroupX = 32, kGroupY = 16;
@@ -67,7 +71,7 @@ class SsaoEffect : public gi::Effect {
     };
   }
 
-  void prepare(gi::EffectContext& ctx, const gi::SettingValues&) override {
+  void prepare(gi::EffectContext& ctx, const gi::SettingValues& settings) override {
     gi::vk::Context& vk = ctx.vulkan();
     vk.requireWorkgroup(kGroupX, kGroupY, "ssao");
     const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
@@ -75,9 +79,14 @@ class SsaoEffect : public gi::Effect {
                img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
     ssao_ = gi::vk::Pipeline::compute(vk, {std::begin(ssao_comp), std::end(ssao_comp)},
                                       {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, img}});
-    blur_ = gi::vk::Pipeline::compute(vk, {std::begin(ssao_blur_comp), std::end(ssao_blur_comp)},
-                                      {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, tex}, {5, img}},
-                                      2 * sizeof(int32_t));  // the blur axis
+    // The blur radius is a specialization constant (changesGraph: prepare runs again).
+    const std::vector<uint32_t> radius = {
+        uint32_t(std::clamp(settings.integer("blur_radius"), 1, gi::ssao::kMaxBlurRadius))};
+    const std::vector<gi::vk::Binding> blurBindings = {{0, ubo}, {1, ubo}, {2, tex}, {3, img}};
+    blurX_ = gi::vk::Pipeline::compute(
+        vk, {std::begin(ssao_blur_x_comp), std::end(ssao_blur_x_comp)}, blurBindings, 0, radius);
+    blurY_ = gi::vk::Pipeline::compute(
+        vk, {std::begin(ssao_blur_y_comp), std::end(ssao_blur_y_comp)}, blurBindings, 0, radius);
     if (!uniforms_)
       uniforms_ =
           gi::vk::Buffer(vk, sizeof(gi::ssao::Uniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true);
@@ -88,6 +97,7 @@ class SsaoEffect : public gi::Effect {
     struct Io {
       gi::TextureHandle depth, normal, raw, half, ao;
     };
+    // Without a blur "ao" is the packed texture itself (its red channel is the AO).
     auto io = std::make_shared<Io>();
     gi::Blackboard& bb = graph.blackboard();
     const int blurRadius = settings.integer("blur_radius");  // changesGraph: fixed per graph
@@ -101,9 +111,9 @@ class SsaoEffect : public gi::Effect {
         [&](gi::PassBuilder& b) {
           io->depth = b.read(bb.texture(res::kDepth));
           io->normal = b.read(bb.texture(res::kNormal));
-          io->raw =
-              b.write(b.create(blurRadius > 0 ? "ssao_raw" : res::kAO, gi::TextureDesc{kAOFormat}),
-                      gi::TextureUsage::StorageWrite);
+          io->raw = b.write(
+              b.create(blurRadius > 0 ? "ssao_raw" : res::kAO, gi::TextureDesc{kPackedFormat}),
+              gi::TextureUsage::StorageWrite);
         },
         [this, io, values = &settings, frame, nearest](gi::PassContext& pc) {
           upload(*values);
@@ -123,33 +133,29 @@ class SsaoEffect : public gi::Effect {
       graph.addPass(
           "ssao_blur",
           [&](gi::PassBuilder& b) {
-            io->depth = b.read(io->depth);
-            io->normal = b.read(io->normal);
             io->raw = b.read(io->raw);
-            io->half = b.write(b.create("ssao_blur_x", gi::TextureDesc{kAOFormat}),
+            io->half = b.write(b.create("ssao_blur_x", gi::TextureDesc{kPackedFormat}),
                                gi::TextureUsage::StorageWrite);
             io->ao = b.write(b.create(res::kAO, gi::TextureDesc{kAOFormat}),
                              gi::TextureUsage::StorageWrite);
           },
           [this, io, frame, nearest](gi::PassContext& pc) {
             const VkExtent2D e = pc.extent(io->ao);
-            auto axis = [&](VkImageView in, VkImageLayout inLayout, VkImageView out, int dx) {
+            auto axis = [&](const gi::vk::Pipeline& p, VkImageView in, VkImageLayout inLayout,
+                            VkImageView out) {
               gi::vk::DescriptorWriter w;
               w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame)
                   .buffer(1, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms_.handle())
-                  .sampled(2, pc.view(io->depth), nearest)
-                  .sampled(3, pc.view(io->normal), nearest)
-                  .sampled(4, in, nearest, inLayout)
-                  .storageImage(5, out);
-              const int32_t direction[2] = {dx, 1 - dx};
-              dispatch(pc, blur_, w, groupsOf(e.width, kGroupX), groupsOf(e.height, kGroupY),
-                       direction, sizeof direction);
+                  .sampled(2, in, nearest, inLayout)
+                  .storageImage(3, out);
+              dispatch(pc, p, w, groupsOf(e.width, kGroupX), groupsOf(e.height, kGroupY));
             };
-            axis(pc.view(io->raw), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, pc.view(io->half), 1);
+            axis(blurX_, pc.view(io->raw), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                 pc.view(io->half));
             // The graph orders passes, not dispatches inside one: the y dispatch reads what the
             // x dispatch wrote (the image stays GENERAL, as storage images are).
             imageBarrier(pc.cmd(), pc.image(io->half));
-            axis(pc.view(io->half), VK_IMAGE_LAYOUT_GENERAL, pc.view(io->ao), 0);
+            axis(blurY_, pc.view(io->half), VK_IMAGE_LAYOUT_GENERAL, pc.view(io->ao));
           });
     }
     bb.put(res::kAO, io->ao);
@@ -174,10 +180,8 @@ class SsaoEffect : public gi::Effect {
   }
 
   static void dispatch(gi::PassContext& pc, const gi::vk::Pipeline& p, gi::vk::DescriptorWriter& w,
-                       uint32_t x, uint32_t y, const void* push = nullptr, uint32_t pushBytes = 0) {
+                       uint32_t x, uint32_t y) {
     pc.descriptors().bind(pc.cmd(), p, w);
-    if (pushBytes > 0)
-      vkCmdPushConstants(pc.cmd(), p.layout(), VK_SHADER_STAGE_ALL, 0, pushBytes, push);
     vkCmdDispatch(pc.cmd(), x, y, 1);
   }
 
@@ -197,7 +201,7 @@ class SsaoEffect : public gi::Effect {
     vkCmdPipelineBarrier2(cmd, &dep);
   }
 
-  gi::vk::Pipeline ssao_, blur_;
+  gi::vk::Pipeline ssao_, blurX_, blurY_;
   gi::vk::Buffer uniforms_;
   std::optional<std::array<double, 6>> uploaded_;  // the settings uniforms_ holds
 };
