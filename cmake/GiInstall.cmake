@@ -36,7 +36,8 @@ install(TARGETS gi_scene gi_engine EXPORT giTargets
 install(DIRECTORY ${CMAKE_SOURCE_DIR}/engine/include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(FILES ${CMAKE_SOURCE_DIR}/engine/shaders/common.glsl
   ${CMAKE_SOURCE_DIR}/engine/shaders/environment.glsl
-  ${CMAKE_SOURCE_DIR}/engine/shaders/lights.glsl DESTINATION ${GI_INSTALL_SHADERDIR})
+  ${CMAKE_SOURCE_DIR}/engine/shaders/lights.glsl
+  ${CMAKE_SOURCE_DIR}/engine/shaders/depth_aware_blur.glsl DESTINATION ${GI_INSTALL_SHADERDIR})
 install(EXPORT giTargets NAMESPACE gi:: DESTINATION ${GI_INSTALL_CMAKEDIR})
 
 # The executable keeps the layout of the build tree (bin/, bin/shaders, bin/plugins,

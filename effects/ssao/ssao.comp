@@ -1,12 +1,12 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "common.glsl"
+#include "depth_aware_blur.glsl"
 
 // Screen-space ambient occlusion (RTR 11.3.6, seed 001 §4.2-4.3). The estimator, kernel
 // distribution and interleaving are described in ssao_kernel.h. Reads the reverse-Z depth and
-// the view-space normal; writes per pixel AO (1 = open) with what the blur needs to stop at
-// edges: 1 / view distance (0: sky) and the tangent plane's d(1/z)/dpixel along x and y, so
-// each blur tap is one fetch (ssao_blur.glsl).
+// the view-space normal; writes per pixel AO (1 = open) packed for the engine's depth-aware
+// blur (depth_aware_blur.glsl: with 1 / view distance and the tangent plane's slopes).
 //
 // Assumes a perspective projection (clip.w = view distance), as every engine camera has.
 layout(local_size_x = 32, local_size_y = 16) in;
@@ -50,7 +50,7 @@ void main() {
   vec4 normalTexel = texelFetch(gNormal, p, 0);
   // Guard: sky / far-plane pixels (depth 0) and pixels without geometry are open; no taps.
   if (isSky(depth) || !(normalTexel.w > 0.5)) {
-    imageStore(outAO, p, vec4(1.0, 0.0, 0.0, 0.0));
+    imageStore(outAO, p, depthAwareBlurPack(frame, 1.0, vec3(0.0), vec3(0.0, 0.0, 1.0)));
     return;
   }
 
@@ -135,14 +135,5 @@ void main() {
                     : 0.0;
   }
   float ao = clamp(1.0 - ssao.params.z * occluded / float(count), 0.0, 1.0);
-
-  // For the blur: the tangent plane N.X = K through P predicts 1/z = (N.D) / K along the view
-  // rays D (z = -1), so d(1/z)/dpixel = (1/z) (N.x dDx, N.y dDy) / (N.D). Guard: a grazing
-  // normal (N.D near 0) predicts nothing, slope 0 (only equal distances are averaged).
-  float iz = 1.0 / dist;
-  vec3 D = vec3((ndc.x + p20) / p00, (ndc.y + p21) / p11, -1.0);
-  float nd = dot(N, D);
-  vec2 dD = 2.0 * frame.viewport.zw / vec2(p00, p11);
-  vec2 slopes = nd < -1e-4 * length(D) ? iz * N.xy * dD / nd : vec2(0.0);
-  imageStore(outAO, p, vec4(ao, iz, slopes));
+  imageStore(outAO, p, depthAwareBlurPack(frame, ao, P, N));
 }

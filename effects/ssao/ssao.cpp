@@ -8,13 +8,12 @@
 #include <optional>
 #include <vector>
 
+#include "gi/depth_aware_blur.h"
 #include "gi/effect.h"
 #include "gi/effect_registry.h"
 #include "gi/vk/pipeline.h"
 #include "gi/vk/resources.h"
-#include "ssao.comp.h"         // const uint32_t ssao_comp[]
-#include "ssao_blur_x.comp.h"  // const uint32_t ssao_blur_x_comp[]
-#include "ssao_blur_y.comp.h"  // const uint32_t ssao_blur_y_comp[]
+#include "ssao.comp.h"  // const uint32_t ssao_comp[]
 #include "ssao_kernel.h"
 
 namespace {
@@ -22,11 +21,7 @@ namespace {
 namespace res = gi::resources;
 using gi::SettingType;
 
-constexpr VkFormat kAOFormat = VK_FORMAT_R16_SFLOAT;
-// The raw AO and the x-blurred AO travel with 1/z and the tangent-plane slopes (ssao.comp), so
-// each blur tap is one fetch.
-constexpr VkFormat kPackedFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
-// Workgroup size of ssao.comp and ssao_blur.glsl (local_size_x/y there). Large groups: on
+// Workgroup size of ssao.comp (local_size_x/y there). Large groups: on
 // llvmpipe each workgroup carries a fixed scheduling cost, which 8x8 groups paid 3600 times at
 // 640x360 (a quarter of the 64-tap pass); 32x16 measured fastest (32x32 loses cache locality).
 constexpr uint32_t kGroupX = 32, kGroupY = 16;
@@ -79,14 +74,8 @@ class SsaoEffect : public gi::Effect {
                img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
     ssao_ = gi::vk::Pipeline::compute(vk, {std::begin(ssao_comp), std::end(ssao_comp)},
                                       {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, img}});
-    // The blur radius is a specialization constant (changesGraph: prepare runs again).
-    const std::vector<uint32_t> radius = {
-        uint32_t(std::clamp(settings.integer("blur_radius"), 1, gi::ssao::kMaxBlurRadius))};
-    const std::vector<gi::vk::Binding> blurBindings = {{0, ubo}, {1, ubo}, {2, tex}, {3, img}};
-    blurX_ = gi::vk::Pipeline::compute(
-        vk, {std::begin(ssao_blur_x_comp), std::end(ssao_blur_x_comp)}, blurBindings, 0, radius);
-    blurY_ = gi::vk::Pipeline::compute(
-        vk, {std::begin(ssao_blur_y_comp), std::end(ssao_blur_y_comp)}, blurBindings, 0, radius);
+    // The blur radius is compiled into the blur (changesGraph: prepare runs again).
+    if (settings.integer("blur_radius") > 0) blur_.prepare(ctx, settings.integer("blur_radius"));
     if (!uniforms_)
       uniforms_ =
           gi::vk::Buffer(vk, sizeof(gi::ssao::Uniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true);
@@ -95,7 +84,7 @@ class SsaoEffect : public gi::Effect {
   void addPasses(gi::FrameGraph& graph, gi::EffectContext& ctx,
                  const gi::SettingValues& settings) override {
     struct Io {
-      gi::TextureHandle depth, normal, raw, half, ao;
+      gi::TextureHandle depth, normal, raw;
     };
     // Without a blur "ao" is the packed texture itself (its red channel is the AO).
     auto io = std::make_shared<Io>();
@@ -111,9 +100,9 @@ class SsaoEffect : public gi::Effect {
         [&](gi::PassBuilder& b) {
           io->depth = b.read(bb.texture(res::kDepth));
           io->normal = b.read(bb.texture(res::kNormal));
-          io->raw = b.write(
-              b.create(blurRadius > 0 ? "ssao_raw" : res::kAO, gi::TextureDesc{kPackedFormat}),
-              gi::TextureUsage::StorageWrite);
+          io->raw = b.write(b.create(blurRadius > 0 ? "ssao_raw" : res::kAO,
+                                     gi::TextureDesc{gi::DepthAwareBlur::kPackedFormat}),
+                            gi::TextureUsage::StorageWrite);
         },
         [this, io, values = &settings, frame, nearest](gi::PassContext& pc) {
           upload(*values);
@@ -127,38 +116,12 @@ class SsaoEffect : public gi::Effect {
           dispatch(pc, ssao_, w, groupsOf(e.width, kGroupX), groupsOf(e.height, kGroupY));
         });
 
-    io->ao = io->raw;
-    if (blurRadius > 0) {
-      // Separable: along x into `half`, then along y into "ao", two dispatches in one pass.
-      graph.addPass(
-          "ssao_blur",
-          [&](gi::PassBuilder& b) {
-            io->raw = b.read(io->raw);
-            io->half = b.write(b.create("ssao_blur_x", gi::TextureDesc{kPackedFormat}),
-                               gi::TextureUsage::StorageWrite);
-            io->ao = b.write(b.create(res::kAO, gi::TextureDesc{kAOFormat}),
-                             gi::TextureUsage::StorageWrite);
-          },
-          [this, io, frame, nearest](gi::PassContext& pc) {
-            const VkExtent2D e = pc.extent(io->ao);
-            auto axis = [&](const gi::vk::Pipeline& p, VkImageView in, VkImageLayout inLayout,
-                            VkImageView out) {
-              gi::vk::DescriptorWriter w;
-              w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame)
-                  .buffer(1, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms_.handle())
-                  .sampled(2, in, nearest, inLayout)
-                  .storageImage(3, out);
-              dispatch(pc, p, w, groupsOf(e.width, kGroupX), groupsOf(e.height, kGroupY));
-            };
-            axis(blurX_, pc.view(io->raw), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                 pc.view(io->half));
-            // The graph orders passes, not dispatches inside one: the y dispatch reads what the
-            // x dispatch wrote (the image stays GENERAL, as storage images are).
-            imageBarrier(pc.cmd(), pc.image(io->half));
-            axis(blurY_, pc.view(io->half), VK_IMAGE_LAYOUT_GENERAL, pc.view(io->ao));
-          });
-    }
-    bb.put(res::kAO, io->ao);
+    gi::TextureHandle ao = io->raw;
+    if (blurRadius > 0)
+      ao = blur_.addPass(graph, ctx, "ssao_blur", io->raw, res::kAO, [values = &settings] {
+        return float(gi::ssao::kBlurDepthTolerance * values->number("radius"));
+      });
+    bb.put(res::kAO, ao);
   }
 
  private:
@@ -185,23 +148,8 @@ class SsaoEffect : public gi::Effect {
     vkCmdDispatch(pc.cmd(), x, y, 1);
   }
 
-  // Compute write -> compute sampled read of a storage image that stays in GENERAL.
-  static void imageBarrier(VkCommandBuffer cmd, VkImage image) {
-    VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
-    b.srcStageMask = b.dstStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
-    b.srcAccessMask = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
-    b.dstAccessMask = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT;
-    b.oldLayout = b.newLayout = VK_IMAGE_LAYOUT_GENERAL;
-    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-    b.image = image;
-    b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-    VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-    dep.imageMemoryBarrierCount = 1;
-    dep.pImageMemoryBarriers = &b;
-    vkCmdPipelineBarrier2(cmd, &dep);
-  }
-
-  gi::vk::Pipeline ssao_, blurX_, blurY_;
+  gi::vk::Pipeline ssao_;
+  gi::DepthAwareBlur blur_;
   gi::vk::Buffer uniforms_;
   std::optional<std::array<double, 6>> uploaded_;  // the settings uniforms_ holds
 };
