@@ -1,6 +1,7 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "common.glsl"
+#include "depth_aware_blur.glsl"
 
 // Ground-truth ambient occlusion (Jimenez et al. 2016, "Practical realtime strategies for
 // accurate indirect occlusion"; RTR 4th ed. 11.3.7, eq. 11.18 with the cosine term). For each
@@ -30,7 +31,7 @@ layout(set = 0, binding = 1) uniform GtaoParams {
 layout(set = 0, binding = 2) uniform sampler2D gDepth;
 layout(set = 0, binding = 3) uniform sampler2D gNormal;
 layout(set = 0, binding = 4) uniform sampler2D gAlbedo;  // the normal when multi_bounce is off
-layout(set = 0, binding = 5, r16f) uniform writeonly image2D outAO;
+layout(set = 0, binding = 5, rgba32f) uniform writeonly image2D outAO;  // depthAwareBlurPack
 layout(set = 0, binding = 6, rgba16f) uniform writeonly image2D outBent;  // 1x1 when off
 
 const float kPi = 3.14159265358979;
@@ -207,7 +208,7 @@ void main() {
     float fa = 2.0404 * a - 0.3324, fb = -4.7951 * a + 0.6417, fc = 2.7552 * a + 0.6903;
     ao = clamp(max(ao, ((fa * ao + fb) * ao + fc) * ao), 0.0, 1.0);
   }
-  imageStore(outAO, p, vec4(open ? 1.0 : ao));
+  imageStore(outAO, p, depthAwareBlurPack(frame, open ? 1.0 : ao, open ? vec3(0.0) : P, N));
   if (kBentNormals) {
     // Guard: no visible arc at all (fully occluded) or NaN falls back to the normal.
     vec3 bn = safeNormalize(bent, N);

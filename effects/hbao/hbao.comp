@@ -1,6 +1,7 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "common.glsl"
+#include "depth_aware_blur.glsl"
 
 // Horizon-based ambient occlusion (Bavoil, Sainz and Dimitrov 2008, "Image-space horizon-based
 // ambient occlusion"). For kDirections screen directions (rotated per pixel by the 4x4
@@ -25,7 +26,7 @@ layout(set = 0, binding = 1) uniform HbaoParams {
 } hbao;
 layout(set = 0, binding = 2) uniform sampler2D gDepth;
 layout(set = 0, binding = 3) uniform sampler2D gNormal;
-layout(set = 0, binding = 4, r16f) uniform writeonly image2D outAO;
+layout(set = 0, binding = 4, rgba32f) uniform writeonly image2D outAO;  // depthAwareBlurPack
 
 const float kPi = 3.14159265358979;
 const float kHalfPi = 1.57079632679490;
@@ -131,5 +132,5 @@ void main() {
     occlusion += ao;
   }
   float visibility = clamp(1.0 - occlusion / float(kDirections), 0.0, 1.0);
-  imageStore(outAO, p, vec4(open ? 1.0 : visibility));
+  imageStore(outAO, p, depthAwareBlurPack(frame, open ? 1.0 : visibility, open ? vec3(0.0) : P, N));
 }

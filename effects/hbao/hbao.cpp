@@ -8,12 +8,12 @@
 #include <optional>
 #include <vector>
 
+#include "gi/depth_aware_blur.h"
 #include "gi/effect.h"
 #include "gi/effect_registry.h"
 #include "gi/vk/pipeline.h"
 #include "gi/vk/resources.h"
-#include "hbao.comp.h"       // const uint32_t hbao_comp[]
-#include "hbao_blur.comp.h"  // const uint32_t hbao_blur_comp[]
+#include "hbao.comp.h"  // const uint32_t hbao_comp[]
 #include "hbao_params.h"
 
 namespace {
@@ -21,7 +21,6 @@ namespace {
 namespace res = gi::resources;
 using gi::SettingType;
 
-constexpr VkFormat kAOFormat = VK_FORMAT_R16_SFLOAT;
 constexpr uint32_t kGroupX = 32, kGroupY = 16;  // local_size of both shaders (32x16: llvmpipe)
 
 uint32_t groupsOf(uint32_t n, uint32_t size) {
@@ -79,10 +78,8 @@ class HbaoEffect : public gi::Effect {
         vk, {std::begin(hbao_comp), std::end(hbao_comp)},
         {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, img}}, 0,
         {uint32_t(s.integer("directions")), uint32_t(s.integer("steps"))});
-    const int blurRadius = std::max(1, s.integer("blur_radius"));
-    blur_ = gi::vk::Pipeline::compute(vk, {std::begin(hbao_blur_comp), std::end(hbao_blur_comp)},
-                                      {{0, ubo}, {1, tex}, {2, tex}, {3, tex}, {4, img}},
-                                      sizeof(BlurPush), {uint32_t(blurRadius)});
+    // The blur radius is compiled into the blur (changesGraph: prepare runs again).
+    if (s.integer("blur_radius") > 0) blur_.prepare(ctx, s.integer("blur_radius"));
     if (!uniforms_)
       uniforms_ =
           gi::vk::Buffer(vk, sizeof(gi::hbao::Uniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true);
@@ -91,7 +88,7 @@ class HbaoEffect : public gi::Effect {
   void addPasses(gi::FrameGraph& graph, gi::EffectContext& ctx,
                  const gi::SettingValues& settings) override {
     struct Io {
-      gi::TextureHandle depth, normal, raw, half, ao;
+      gi::TextureHandle depth, normal, raw, ao;
     };
     auto io = std::make_shared<Io>();
     gi::Blackboard& bb = graph.blackboard();
@@ -105,9 +102,9 @@ class HbaoEffect : public gi::Effect {
         [&](gi::PassBuilder& b) {
           io->depth = b.read(bb.texture(res::kDepth));
           io->normal = b.read(bb.texture(res::kNormal));
-          io->raw =
-              b.write(b.create(blurRadius > 0 ? "hbao_raw" : res::kAO, gi::TextureDesc{kAOFormat}),
-                      gi::TextureUsage::StorageWrite);
+          io->raw = b.write(b.create(blurRadius > 0 ? "hbao_raw" : res::kAO,
+                                     gi::TextureDesc{gi::DepthAwareBlur::kPackedFormat}),
+                            gi::TextureUsage::StorageWrite);
         },
         [this, io, values = &settings, frame, nearest](gi::PassContext& pc) {
           upload(*values);
@@ -122,49 +119,14 @@ class HbaoEffect : public gi::Effect {
         });
 
     io->ao = io->raw;
-    if (blurRadius > 0) {
-      // Separable: along x into `half`, then along y into "ao", two dispatches in one pass.
-      graph.addPass(
-          "hbao_blur",
-          [&](gi::PassBuilder& b) {
-            io->depth = b.read(io->depth);
-            io->normal = b.read(io->normal);
-            io->raw = b.read(io->raw);
-            io->half = b.write(b.create("hbao_blur_x", gi::TextureDesc{kAOFormat}),
-                               gi::TextureUsage::StorageWrite);
-            io->ao = b.write(b.create(res::kAO, gi::TextureDesc{kAOFormat}),
-                             gi::TextureUsage::StorageWrite);
-          },
-          [this, io, values = &settings, frame, nearest](gi::PassContext& pc) {
-            const VkExtent2D e = pc.extent(io->ao);
-            const float tolerance = float(gi::hbao::kBlurDepthTolerance * values->number("radius"));
-            auto axis = [&](VkImageView in, VkImageLayout inLayout, VkImageView out, int dx) {
-              gi::vk::DescriptorWriter w;
-              w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame)
-                  .sampled(1, pc.view(io->depth), nearest)
-                  .sampled(2, pc.view(io->normal), nearest)
-                  .sampled(3, in, nearest, inLayout)
-                  .storageImage(4, out);
-              const BlurPush push{{dx, 1 - dx}, tolerance};
-              dispatch(pc, blur_, w, groupsOf(e.width, kGroupX), groupsOf(e.height, kGroupY), &push,
-                       sizeof push);
-            };
-            axis(pc.view(io->raw), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, pc.view(io->half), 1);
-            // The graph orders passes, not dispatches inside one: the y dispatch reads what the
-            // x dispatch wrote (the image stays GENERAL, as storage images are).
-            imageBarrier(pc.cmd(), pc.image(io->half));
-            axis(pc.view(io->half), VK_IMAGE_LAYOUT_GENERAL, pc.view(io->ao), 0);
-          });
-    }
+    if (blurRadius > 0)
+      io->ao = blur_.addPass(graph, ctx, "hbao_blur", io->raw, res::kAO, [values = &settings] {
+        return float(gi::hbao::kBlurDepthTolerance * values->number("radius"));
+      });
     bb.put(res::kAO, io->ao);
   }
 
  private:
-  struct BlurPush {
-    int32_t axis[2];
-    float tolerance;
-  };
-
   // Host-visible and written while recording: the renderer waits for each frame before it
   // records the next, so the GPU is not reading it. Rewritten only when a setting changed.
   void upload(const gi::SettingValues& s) {
@@ -178,30 +140,13 @@ class HbaoEffect : public gi::Effect {
   }
 
   static void dispatch(gi::PassContext& pc, const gi::vk::Pipeline& p, gi::vk::DescriptorWriter& w,
-                       uint32_t x, uint32_t y, const void* push = nullptr, uint32_t pushBytes = 0) {
+                       uint32_t x, uint32_t y) {
     pc.descriptors().bind(pc.cmd(), p, w);
-    if (pushBytes > 0)
-      vkCmdPushConstants(pc.cmd(), p.layout(), VK_SHADER_STAGE_ALL, 0, pushBytes, push);
     vkCmdDispatch(pc.cmd(), x, y, 1);
   }
 
-  // Compute write -> compute sampled read of a storage image that stays in GENERAL.
-  static void imageBarrier(VkCommandBuffer cmd, VkImage image) {
-    VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
-    b.srcStageMask = b.dstStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
-    b.srcAccessMask = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
-    b.dstAccessMask = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT;
-    b.oldLayout = b.newLayout = VK_IMAGE_LAYOUT_GENERAL;
-    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-    b.image = image;
-    b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-    VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-    dep.imageMemoryBarrierCount = 1;
-    dep.pImageMemoryBarriers = &b;
-    vkCmdPipelineBarrier2(cmd, &dep);
-  }
-
-  gi::vk::Pipeline hbao_, blur_;
+  gi::vk::Pipeline hbao_;
+  gi::DepthAwareBlur blur_;
   gi::vk::Buffer uniforms_;
   std::optional<std::array<double, 4>> uploaded_;  // the settings uniforms_ holds
 };
