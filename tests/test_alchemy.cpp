@@ -16,6 +16,7 @@
 #include "../effects/alchemy/alchemy_kernel.h"
 #include "gi/effect_config.h"
 #include "gi/renderer.h"
+#include "quad_scene.h"
 #include "test_support.h"
 #include "vulkan_fixture.h"
 
@@ -24,58 +25,13 @@ namespace {
 
 constexpr uint32_t kW = 160, kH = 120;
 
-// The analytic quad scenes of test_ssao.cpp (quads facing local +z, one camera).
-Mesh quad(float half) {
-  Mesh m;
-  m.name = "quad";
-  for (auto [x, y] : {std::pair{-1.f, -1.f}, {1.f, -1.f}, {1.f, 1.f}, {-1.f, 1.f}})
-    m.vertices.push_back({glm::vec3(x * half, y * half, 0), glm::vec3(0, 0, 1), glm::vec2(0)});
-  m.indices = {0, 1, 2, 0, 2, 3};
-  m.boundsMin = glm::vec3(-half, -half, 0);
-  m.boundsMax = glm::vec3(half, half, 0);
-  m.triangleAreas = {2 * half * half, 2 * half * half};
-  return m;
-}
+using test::cornerScene;
+using test::finite;
+using test::Quads;
+using test::quadScene;
 
-using Quads = std::vector<std::pair<glm::mat4, float>>;  // world transform, half size
-
-Scene quadScene(const Quads& quads, glm::vec3 eye, glm::vec3 target, float scale = 1.0f,
-                float znear = 0.05f, float zfar = 100.0f, float yfov = glm::radians(60.0f)) {
-  Scene s;
-  s.materials.push_back(Material{});
-  const glm::mat4 S = glm::scale(glm::mat4(1.0f), glm::vec3(scale));
-  for (const auto& [transform, half] : quads) {
-    s.meshes.push_back(quad(half));
-    int n = s.addNode("quad", S * transform);
-    s.nodes[n].meshes = {int(s.meshes.size()) - 1};
-  }
-  Camera cam;
-  cam.yfov = yfov;
-  cam.znear = znear * scale;
-  cam.zfar = zfar * scale;
-  s.cameras.push_back(cam);
-  int c = s.addNode("camera",
-                    glm::inverse(glm::lookAt(eye * scale, target * scale, glm::vec3(0, 1, 0))));
-  s.nodes[c].camera = 0;
-  s.activeCameraNode = c;
-  s.updateWorldTransforms();
-  return s;
-}
-
-const glm::mat4 kFloor = glm::rotate(glm::mat4(1.0f), glm::radians(-90.0f), glm::vec3(1, 0, 0));
+const glm::mat4 kFloor = test::floorTransform();
 const glm::mat4 kWall = glm::rotate(glm::mat4(1.0f), glm::radians(90.0f), glm::vec3(0, 1, 0));
-
-// A floor (y = 0) and a wall (x = 0) meeting in a concave crease that runs across the image.
-Scene cornerScene(float scale = 1.0f, float yfov = glm::radians(60.0f)) {
-  return quadScene({{kFloor, 20.0f}, {kWall, 20.0f}}, glm::vec3(2.5f, 1.6f, 0.0f), glm::vec3(0.0f),
-                   scale, 0.05f, 100.0f, yfov);
-}
-
-bool finite(const ImageRGBA32F& img) {
-  for (float v : img.pixels)
-    if (!std::isfinite(v)) return false;
-  return true;
-}
 
 class AlchemyTest : public test::VulkanTest {
  protected:

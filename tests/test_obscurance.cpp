@@ -16,6 +16,7 @@
 #include "../effects/obscurance/obscurance_kernel.h"
 #include "gi/effect_config.h"
 #include "gi/renderer.h"
+#include "quad_scene.h"
 #include "test_support.h"
 #include "vulkan_fixture.h"
 
@@ -25,41 +26,13 @@ namespace {
 namespace obs = obscurance;
 constexpr uint32_t kW = 160, kH = 120;
 
-Mesh quad(float half) {
-  Mesh m;
-  m.name = "quad";
-  for (auto [x, y] : {std::pair{-1.f, -1.f}, {1.f, -1.f}, {1.f, 1.f}, {-1.f, 1.f}})
-    m.vertices.push_back({glm::vec3(x * half, y * half, 0), glm::vec3(0, 0, 1), glm::vec2(0)});
-  m.indices = {0, 1, 2, 0, 2, 3};
-  m.boundsMin = glm::vec3(-half, -half, 0);
-  m.boundsMax = glm::vec3(half, half, 0);
-  m.triangleAreas = {2 * half * half, 2 * half * half};
-  return m;
-}
-
-using Quads = std::vector<std::pair<glm::mat4, float>>;  // transform (faces local +z), half size
+using test::Quads;
 
 // Quads of one material with linear albedo `albedo`, seen from `eye` towards `target`.
 Scene quadScene(const Quads& quads, glm::vec3 eye, glm::vec3 target, float albedo = 0.8f,
                 float znear = 0.05f, float zfar = 100.0f) {
-  Scene s;
-  Material m;
-  m.baseColor = glm::vec4(glm::vec3(albedo), 1.0f);
-  s.materials.push_back(m);
-  for (const auto& [transform, half] : quads) {
-    s.meshes.push_back(quad(half));
-    int n = s.addNode("quad", transform);
-    s.nodes[n].meshes = {int(s.meshes.size()) - 1};
-  }
-  Camera cam;
-  cam.yfov = glm::radians(60.0f);
-  cam.znear = znear;
-  cam.zfar = zfar;
-  s.cameras.push_back(cam);
-  int c = s.addNode("camera", glm::inverse(glm::lookAt(eye, target, glm::vec3(0, 1, 0))));
-  s.nodes[c].camera = 0;
-  s.activeCameraNode = c;
-  s.updateWorldTransforms();
+  Scene s = test::quadScene(quads, eye, target, 1.0f, znear, zfar);
+  s.materials[0].baseColor = glm::vec4(glm::vec3(albedo), 1.0f);
   return s;
 }
 

@@ -32,7 +32,7 @@ using Quads = std::vector<std::pair<glm::mat4, float>>;
 // Scene of quads (material 0, the default material) and a camera looking from `eye` at
 // `target`. `scale` multiplies every length (scale-invariance test).
 inline Scene quadScene(const Quads& quads, glm::vec3 eye, glm::vec3 target, float scale = 1.0f,
-                       float znear = 0.05f, float zfar = 100.0f) {
+                       float znear = 0.05f, float zfar = 100.0f, float yfov = glm::radians(60.0f)) {
   Scene s;
   s.materials.push_back(Material{});
   const glm::mat4 S = glm::scale(glm::mat4(1.0f), glm::vec3(scale));
@@ -42,7 +42,7 @@ inline Scene quadScene(const Quads& quads, glm::vec3 eye, glm::vec3 target, floa
     s.nodes[n].meshes = {int(s.meshes.size()) - 1};
   }
   Camera cam;
-  cam.yfov = glm::radians(60.0f);
+  cam.yfov = yfov;
   cam.znear = znear * scale;
   cam.zfar = zfar * scale;
   s.cameras.push_back(cam);
@@ -64,8 +64,9 @@ inline Quads cornerQuads() {
   const glm::mat4 wall = glm::rotate(glm::mat4(1.0f), glm::radians(90.0f), glm::vec3(0, 1, 0));
   return {{floorTransform(), 20.0f}, {wall, 20.0f}};
 }
-inline Scene cornerScene(float scale = 1.0f) {
-  return quadScene(cornerQuads(), glm::vec3(2.5f, 1.6f, 0.0f), glm::vec3(0.0f), scale);
+inline Scene cornerScene(float scale = 1.0f, float yfov = glm::radians(60.0f)) {
+  return quadScene(cornerQuads(), glm::vec3(2.5f, 1.6f, 0.0f), glm::vec3(0.0f), scale, 0.05f,
+                   100.0f, yfov);
 }
 
 inline bool finite(const ImageRGBA32F& img) {
