@@ -183,7 +183,7 @@ class ObscuranceEffect : public gi::Effect {
                pc.view(io->half));
           // The graph orders passes, not dispatches inside one: the y dispatch reads what the
           // x dispatch wrote (the image stays GENERAL, as storage images are).
-          imageBarrier(pc.cmd(), pc.image(io->half));
+          gi::vk::storageWriteToSampledRead(pc.cmd(), pc.image(io->half));
           axis(resolve_, pc.view(io->half), VK_IMAGE_LAYOUT_GENERAL, pc.view(io->ao));
         });
     bb.put(res::kAO, io->ao);
@@ -207,22 +207,6 @@ class ObscuranceEffect : public gi::Effect {
                        uint32_t x, uint32_t y) {
     pc.descriptors().bind(pc.cmd(), p, w);
     vkCmdDispatch(pc.cmd(), x, y, 1);
-  }
-
-  // Compute write -> compute sampled read of a storage image that stays in GENERAL.
-  static void imageBarrier(VkCommandBuffer cmd, VkImage image) {
-    VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
-    b.srcStageMask = b.dstStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
-    b.srcAccessMask = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
-    b.dstAccessMask = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT;
-    b.oldLayout = b.newLayout = VK_IMAGE_LAYOUT_GENERAL;
-    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-    b.image = image;
-    b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-    VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-    dep.imageMemoryBarrierCount = 1;
-    dep.pImageMemoryBarriers = &b;
-    vkCmdPipelineBarrier2(cmd, &dep);
   }
 
   gi::vk::Pipeline main_, filterX_, resolve_;

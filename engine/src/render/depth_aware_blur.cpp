@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <memory>
 
+#include "gi/vk/resources.h"
+
 namespace gi {
 namespace {
 
@@ -10,23 +12,6 @@ constexpr uint32_t kGroupX = 32, kGroupY = 16;  // depth_aware_blur_pass.glsl
 
 uint32_t groupsOf(uint32_t n, uint32_t size) {
   return (n + size - 1) / size;
-}
-
-// Compute write -> compute sampled read of a storage image that stays in GENERAL: the graph
-// orders passes, not the two dispatches inside this one.
-void storageToSampled(VkCommandBuffer cmd, VkImage image) {
-  VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
-  b.srcStageMask = b.dstStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
-  b.srcAccessMask = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
-  b.dstAccessMask = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT;
-  b.oldLayout = b.newLayout = VK_IMAGE_LAYOUT_GENERAL;
-  b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-  b.image = image;
-  b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-  VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-  dep.imageMemoryBarrierCount = 1;
-  dep.pImageMemoryBarriers = &b;
-  vkCmdPipelineBarrier2(cmd, &dep);
 }
 
 }  // namespace
@@ -75,7 +60,7 @@ TextureHandle DepthAwareBlur::addPass(FrameGraph& graph, EffectContext& ctx,
           vkCmdDispatch(pc.cmd(), groupsOf(e.width, kGroupX), groupsOf(e.height, kGroupY), 1);
         };
         axis(x_, pc.view(io->packed), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, pc.view(io->half));
-        storageToSampled(pc.cmd(), pc.image(io->half));
+        vk::storageWriteToSampledRead(pc.cmd(), pc.image(io->half));
         axis(y_, pc.view(io->half), VK_IMAGE_LAYOUT_GENERAL, pc.view(io->out));
       });
   return io->out;

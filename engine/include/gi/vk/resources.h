@@ -87,6 +87,11 @@ void imageBarrier(VkCommandBuffer cmd, VkImage image, VkImageAspectFlags aspect,
                   VkAccessFlags2 srcAccess, VkPipelineStageFlags2 dstStage,
                   VkAccessFlags2 dstAccess);
 
+// A compute shader's storage writes to a GENERAL colour image made visible to a later compute
+// dispatch that samples it (two dispatches inside one frame-graph pass: the graph orders
+// passes, not the dispatches inside one).
+void storageWriteToSampledRead(VkCommandBuffer cmd, VkImage image);
+
 class Sampler {
  public:
   Sampler() = default;
