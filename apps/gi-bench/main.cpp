@@ -238,6 +238,9 @@ Comparison comparisonFor(const std::vector<gi::EffectConfig>& effects,
     if (aoDeclared) {
       c.resource = gi::resources::kAO;
       c.declared = declared;
+      // The ao-split reference's value is AO bit for bit: one reference serves both scores.
+      if (aoSplit && declared.quantity == ref::Quantity::AO)
+        c.declared.quantity = ref::Quantity::AOSplit;
       c.target = gi::bench::targetSpec(truth, q, aoSplit);
       c.effect = e.name;
       return c;
@@ -440,7 +443,7 @@ struct Timing {
 };
 
 // The rendered configuration: its timings over the repetitions and, after the last one, the
-// compared resource and the depth.
+// compared resource and the depth (dropped once scored).
 struct Measurement {
   std::vector<gi::bench::PassTime> passes;
   Interval total, effect, floor, wall;
@@ -540,10 +543,12 @@ void measureRepetition(gi::Renderer& renderer, int frames, Timing& t) {
 // every configuration of a batch runs before repetition r + 1 of any.
 constexpr size_t kInterleaveBatch = 16;
 
-std::vector<Measurement> measureAll(gi::vk::Context& ctx, const gi::EffectRegistry& registry,
-                                    const std::vector<RenderJob>& jobs, const Options& o,
-                                    bool floorPass, ProgressBar* bar,
-                                    const std::function<std::string(size_t)>& label) {
+// `scoreNow(i, m)` is called once job i is measured, while its images are held; they are
+// dropped afterwards (a sweep at a large resolution would otherwise hold all of them).
+std::vector<Measurement> measureAll(
+    gi::vk::Context& ctx, const gi::EffectRegistry& registry, const std::vector<RenderJob>& jobs,
+    const Options& o, bool floorPass,
+    const std::function<void(size_t, const Measurement&)>& scoreNow) {
   std::vector<Measurement> out(jobs.size());
   for (size_t first = 0; first < jobs.size(); first += kInterleaveBatch) {
     const size_t last = std::min(jobs.size(), first + kInterleaveBatch);
@@ -574,7 +579,9 @@ std::vector<Measurement> measureAll(gi::vk::Context& ctx, const gi::EffectRegist
       m.out = renderers[i - first]->readTarget(jobs[i].resource);
       m.depth = renderers[i - first]->readTarget(gi::resources::kDepth);
       renderers[i - first].reset();
-      if (bar) bar->step(label(i));
+      scoreNow(i, m);
+      m.out = {};
+      m.depth = {};
     }
   }
   return out;
@@ -813,10 +820,15 @@ int runSweep(const Options& o) {
   for (const Config& c : configs)
     jobs.push_back({&s.scenes[c.scene].scene, &c.effects, &c.engine, c.comparison.resource});
   ProgressBar bar(o.progress, "configurations", configs.size());
+  std::vector<Scores> vsTargets(configs.size()), vsDeclareds(configs.size());
   const std::vector<Measurement> measured =
-      measureAll(ctx, s.registry, jobs, o, true, &bar, [&](size_t i) {
-        return s.scenes[configs[i].scene].name + " " + configs[i].effectLabel + " " +
-               configs[i].params;
+      measureAll(ctx, s.registry, jobs, o, true, [&](size_t i, const Measurement& m) {
+        const Config& c = configs[i];
+        vsTargets[i] =
+            score(m, c.comparison.target, refs.at(ReferenceKey{c.scene, c.comparison.target}), o);
+        vsDeclareds[i] = score(m, c.comparison.declared,
+                               refs.at(ReferenceKey{c.scene, c.comparison.declared}), o);
+        bar.step(s.scenes[c.scene].name + " " + c.effectLabel + " " + c.params);
       });
   std::vector<Row> rows;
   for (size_t i = 0; i < configs.size(); ++i) {
@@ -824,8 +836,8 @@ int runSweep(const Options& o) {
     const Measurement& m = measured[i];
     const Reference& target = refs.at(ReferenceKey{c.scene, c.comparison.target});
     const Reference& declared = refs.at(ReferenceKey{c.scene, c.comparison.declared});
-    const Scores vsTarget = score(m, c.comparison.target, target, o);
-    const Scores vsDeclared = score(m, c.comparison.declared, declared, o);
+    const Scores& vsTarget = vsTargets[i];
+    const Scores& vsDeclared = vsDeclareds[i];
     Row r;
     r.scene = s.scenes[c.scene].name;
     r.effect = c.effectLabel;
@@ -970,15 +982,17 @@ int runCalibrate(const Options& o) {
   std::vector<RenderJob> jobs;
   for (const auto& cfg : configs) jobs.push_back({&scene, &cfg, &engine, cmp.resource});
   ProgressBar bar(o.progress, "candidates", candidates.size());
+  std::vector<Scores> scores(candidates.size());
   const std::vector<Measurement> measured =
-      measureAll(ctx, s.registry, jobs, o, false, &bar, [&](size_t i) { return labels[i]; });
+      measureAll(ctx, s.registry, jobs, o, false, [&](size_t i, const Measurement& m) {
+        scores[i] = score(m, cmp.target, reference, o);
+        bar.step(labels[i]);
+      });
   const bool bySsim = o.metric == "ssim";
   std::vector<gi::bench::CalibrationCandidate> cands;
-  std::vector<Scores> scores;
   double cheapest = INFINITY;
   for (size_t ci = 0; ci < candidates.size(); ++ci) {
-    scores.push_back(score(measured[ci], cmp.target, reference, o));
-    const gi::bench::Metrics& mt = scores.back().metrics;
+    const gi::bench::Metrics& mt = scores[ci].metrics;
     cands.push_back({candidates[ci], measured[ci].total, bySsim ? -mt.ssim : mt.nrmse});
     cheapest = std::min(cheapest, measured[ci].total.median);
   }
