@@ -997,7 +997,10 @@ int runCalibrate(const Options& o) {
     cheapest = std::min(cheapest, measured[ci].total.median);
   }
   const gi::bench::CalibrationChoice choice = gi::bench::chooseCalibrated(cands, limit);
-  std::printf("%-40s %10s %21s %12s %10s %8s %5s\n", "settings", "frame ms", "95% interval",
+  char intervalHeader[32];
+  std::snprintf(intervalHeader, sizeof intervalHeader, "%.4g%% interval",
+                100.0 * (measured.empty() ? 0.0 : measured[0].total.coverage));
+  std::printf("%-40s %10s %21s %12s %10s %8s %5s\n", "settings", "frame ms", intervalHeader,
               "cost bound", "NRMSE", "SSIM", "fits");
   for (size_t ci = 0; ci < candidates.size(); ++ci) {
     const Interval& t = measured[ci].total;
