@@ -3,6 +3,7 @@
 // whose configuration measures within the budget.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -11,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bench_support.h"
+#include "gi/image_io.h"
 #include "process.h"
 #include "test_support.h"
 
@@ -37,13 +39,33 @@ TEST(BenchCli, QuickSweepWritesFiniteResults) {
   ASSERT_EQ(r.exitCode, 0) << r.output;
   for (const char* f : {"results.csv", "results.json", "report.md"})
     EXPECT_TRUE(fs::exists(out + "/" + f)) << f;
-  size_t svgs = 0;
+  // Every plot twice: SVG and its PNG twin (drawn by gi-bench's rasteriser: not blank, the
+  // series colour present).
+  size_t svgs = 0, pngs = 0;
   for (const auto& e : fs::directory_iterator(out + "/plots")) {
+    if (e.path().extension() == ".png") {
+      const ImageRGBA8 img = readPng(e.path().string());
+      EXPECT_EQ(img.width, 760);
+      EXPECT_EQ(img.height, 480);
+      size_t blue = 0;
+      for (size_t i = 0; i + 3 < img.pixels.size(); i += 4)
+        blue += img.pixels[i] == 0x1f && img.pixels[i + 1] == 0x77 && img.pixels[i + 2] == 0xb4;
+      EXPECT_GT(blue, 50u) << e.path();
+      EXPECT_TRUE(fs::exists(fs::path(e.path()).replace_extension(".svg"))) << e.path();
+      ++pngs;
+      continue;
+    }
     EXPECT_EQ(e.path().extension(), ".svg");
-    EXPECT_NE(readAll(e.path().string()).find("</svg>"), std::string::npos);
+    const std::string svg = readAll(e.path().string());
+    EXPECT_NE(svg.find("</svg>"), std::string::npos);
+    if (hasSsao()) {
+      EXPECT_NE(svg.find("ssao.samples=16"), std::string::npos) << "points named by the setting";
+      EXPECT_NE(svg.find("Pareto front"), std::string::npos);
+    }
     ++svgs;
   }
   EXPECT_GE(svgs, 1u);
+  EXPECT_EQ(pngs, svgs);
   for (const auto& e : fs::recursive_directory_iterator(out))
     EXPECT_EQ(e.path().string().find(".partial"), std::string::npos) << e.path();
 
@@ -70,6 +92,10 @@ TEST(BenchCli, QuickSweepWritesFiniteResults) {
   if (hasSsao()) {
     EXPECT_GE(rows, 2u) << "--quick sweeps ssao samples";
   }
+  // Timing intervals around the medians; both scores named.
+  for (const char* h : {"reps", "total_lo_ms", "total_hi_ms", "interval_coverage", "declared",
+                        "declared_nrmse", "declared_ssim"})
+    EXPECT_NE(std::find(header.begin(), header.end(), h), header.end()) << h;
 
   // JSON: the same rows, finite metrics, the floor pass measured.
   const nlohmann::json j = nlohmann::json::parse(readAll(out + "/results.json"));
@@ -82,6 +108,19 @@ TEST(BenchCli, QuickSweepWritesFiniteResults) {
     EXPECT_GT(row["floor_ms"].get<double>(), 0.0);
     EXPECT_GT(row["pixels"].get<size_t>(), 0u);
     EXPECT_LE(row["ssim"].get<double>(), 1.0 + 1e-9);
+    EXPECT_EQ(row["reps"].get<int>(), 5);
+    const auto& total = row["total_interval"];
+    EXPECT_LE(total["lo"].get<double>(), row["total_ms"].get<double>());
+    EXPECT_GE(total["hi"].get<double>(), row["total_ms"].get<double>());
+    EXPECT_DOUBLE_EQ(total["coverage"].get<double>(), 1.0 - 2.0 / 32.0);  // 5 reps: [min, max]
+    ASSERT_TRUE(row["declared_nrmse"].is_number());
+    if (hasSsao()) {
+      // SSAO declares obscurance with the linear membership; its target is AO.
+      EXPECT_EQ(row["declared"].get<std::string>().rfind("obscurance linear r=0.5", 0), 0u)
+          << row["declared"];
+      EXPECT_EQ(row["reference"].get<std::string>().rfind("ao r=0.5", 0), 0u) << row["reference"];
+      EXPECT_NE(row["declared_nrmse"].get<double>(), row["nrmse"].get<double>());
+    }
   }
   // A rerun uses the cached reference and gives the same errors.
   auto again = test::runCommand(bench("--quick --cache '" + dir + "/cache' --out '" + out + "'"));
@@ -90,6 +129,28 @@ TEST(BenchCli, QuickSweepWritesFiniteResults) {
   for (size_t i = 0; i < rows; ++i)
     EXPECT_DOUBLE_EQ(j2["results"][i]["nrmse"].get<double>(),
                      j["results"][i]["nrmse"].get<double>());
+}
+
+// The declared quantity's parameters come from the configuration's settings: another radius is
+// another reference (its own cache entry) for both scores.
+TEST(BenchCli, DeclaredQuantityFollowsTheSweptRadius) {
+  if (!hasSsao()) GTEST_SKIP() << "the ssao plugin is not built";
+  const std::string dir = test::makeTempDir("bench-declared");
+  const std::string out = dir + "/out", cache = dir + "/cache";
+  auto r =
+      test::runCommand(bench("--quick --reps 2 --effects ssao --grid ssao.radius=0.3,0.6 "
+                             "--cache '" +
+                             cache + "' --out '" + out + "'"));
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  const nlohmann::json j = nlohmann::json::parse(readAll(out + "/results.json"));
+  ASSERT_EQ(j["results"].size(), 2u);
+  EXPECT_EQ(j["results"][0]["declared"].get<std::string>().rfind("obscurance linear r=0.3", 0), 0u);
+  EXPECT_EQ(j["results"][1]["declared"].get<std::string>().rfind("obscurance linear r=0.6", 0), 0u);
+  EXPECT_EQ(j["results"][1]["reference"].get<std::string>().rfind("ao r=0.6", 0), 0u);
+  EXPECT_NE(j["results"][0]["declared_nrmse"], j["results"][1]["declared_nrmse"]);
+  size_t entries = 0;
+  for (const auto& e : fs::directory_iterator(cache)) entries += e.path().extension() == ".json";
+  EXPECT_EQ(entries, 4u) << "AO and obscurance(linear) at two radii";
 }
 
 TEST(BenchCli, BadInputFailsBeforeRendering) {

@@ -6,7 +6,16 @@
 #include <utility>
 #include <vector>
 
+#include "stats.h"
+
 namespace gi::bench {
+
+// GPU time of one pass: the median over repetitions of the per-repetition median over frames,
+// and its confidence interval (stats.h).
+struct PassTime {
+  std::string name;
+  Interval ms;
+};
 
 struct Row {
   std::string scene, effect, preset;  // effect "none": engine only
@@ -16,16 +25,26 @@ struct Row {
   double gridValue = 0.0;             // its value in this configuration
   unsigned width = 0, height = 0;
   int frames = 0;
-  std::vector<std::pair<std::string, double>> passes;  // median GPU ms per pass, graph order
-  double totalMs = 0.0;   // sum of the pass medians, floor pass excluded
+  int reps = 0;                  // repetitions (each the median over `frames` frames)
+  std::vector<PassTime> passes;  // GPU ms per pass, graph order
+  // Medians over the repetitions; each repetition's total and effect time sum its pass
+  // medians. The *Ci fields hold the same medians with their confidence intervals.
+  double totalMs = 0.0;   // floor pass excluded
   double effectMs = 0.0;  // passes that are not the engine's (gbuffer, lighting, ...)
   double floorMs = 0.0;   // the engine's floor pass (a fixed full-screen cost baseline)
   double wallMs = 0.0;    // median CPU wall time of renderFrame() (submit + wait)
-  std::string compared;   // "ao" or "lit"
-  std::string reference;  // "ao r=0.5 spp=256" ...
+  Interval totalCi, effectCi, floorCi, wallCi;
+  std::string compared;  // "ao" or "lit"
+  // Two scores: against the physical target (AO for AO-like effects, direct + indirect for GI
+  // effects, else direct light) and against the quantity the effect declares it estimates
+  // (Effect::estimatedQuantity, from its settings in this configuration).
+  std::string reference;  // the target: "ao r=0.5 spp=256" ...
   unsigned referenceSpp = 0;
   double referenceStdError = 0.0;  // mean per-pixel standard error of the reference
-  double nrmse = 0.0, ssim = 1.0;
+  double nrmse = 0.0, ssim = 1.0;  // against the target
+  std::string declared;            // "obscurance linear r=0.5 spp=256" ...
+  double declaredStdError = 0.0;
+  double declaredNrmse = 0.0, declaredSsim = 1.0;
   size_t pixels = 0;              // compared (unmasked) pixels
   double referenceSeconds = 0.0;  // wall time the reference took (when it was computed)
   // With --ao-split (AO effects): the effect's error e = S - F (S the effect's AO, F = AO_full)
@@ -53,9 +72,11 @@ struct RunInfo {
 void writeFileAtomic(const std::string& path, const std::string& text);
 // results.csv, results.json, report.md and plots/<scene>_<effect>.svg under `dir`.
 void writeResults(const std::string& dir, const std::vector<Row>& rows, const RunInfo& info);
-// Indices of the rows on the Pareto front of (time, nrmse): no other row is both faster and
-// more accurate. `time` picks the time of a row.
+// Indices of the rows on the Pareto front of (plotted time with its interval, nrmse against
+// the target), ordered by time: stats.h's paretoFront, so time differences inside the
+// intervals do not keep a less accurate row on the front.
 std::vector<size_t> paretoFront(const std::vector<const Row*>& rows);
-double plotTime(const Row& row);  // effect ms when the effect has passes, else total ms
+double plotTime(const Row& row);        // effect ms when the effect has passes, else total ms
+Interval plotInterval(const Row& row);  // the same choice, with its interval
 
 }  // namespace gi::bench

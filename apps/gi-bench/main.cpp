@@ -14,6 +14,7 @@
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -34,11 +35,15 @@
 #include "gi/scene_io.h"
 #include "gi/vk/context.h"
 #include "metrics.h"
+#include "quantity.h"
+#include "stats.h"
 
 namespace {
 
 namespace fs = std::filesystem;
 namespace ref = gi::reference;
+using gi::bench::Interval;
+using gi::bench::ReferenceSpec;
 using gi::bench::Row;
 
 const char* kUsage =
@@ -52,7 +57,11 @@ const char* kUsage =
     "                        'none' is the engine alone (default: ssao when found, else none)\n"
     "  --presets P,none      quality presets (names or files; 'none': effect defaults)\n"
     "  --grid E.K=V1,V2      sweep one setting; several --grid flags form a cartesian product\n"
-    "  --frames K            frames measured per configuration, after one warm-up (default 5)\n"
+    "  --frames K            frames per repetition, after one warm-up frame (default 5)\n"
+    "  --reps R              repetitions per configuration (default 5), interleaved round-\n"
+    "                        robin across configurations; times are medians over the\n"
+    "                        repetitions with a 95% order-statistics interval (R >= 6 reaches\n"
+    "                        95%; R = 5 gives [min, max], 93.75%)\n"
     "  --width W --height H  resolution (default 320x240)\n"
     "  --ref-spp N           reference samples per pixel (default 256)\n"
     "  --ref-seed N          reference seed (default 1)\n"
@@ -61,18 +70,23 @@ const char* kUsage =
     "                        --quantity ao-split) and report where the effect cannot converge\n"
     "  --cache DIR           reference cache (default <bin>/../bench-cache)\n"
     "  --budget-ms B         --calibrate: frame budget (GPU ms, all passes)\n"
-    "  --headroom F          --calibrate: keep the measured time under (1 - F) * budget (0.1)\n"
+    "  --headroom F          --calibrate: keep the measured time under (1 - F) * budget (0.1);\n"
+    "                        the upper end of the time interval must fit, and cost is assumed\n"
+    "                        not to fall when a sample count rises unless measured clearly\n"
+    "                        lower\n"
     "  --metric M            --calibrate: accuracy to maximise, ssim (default) or nrmse. SSIM\n"
     "                        sees noise and interleave patterns that a biased estimator's\n"
     "                        NRMSE hides (SSAO's NRMSE is ~flat from 1 to 64 samples)\n"
     "  --no-progress         no progress lines on stderr\n"
     "  --validation          Vulkan validation layers (also GI_VALIDATION=1)\n"
     "  --device NAME         Vulkan device by name or index (also GI_DEVICE)\n"
-    "Ground truth: what each effect declares it estimates (EffectInfo::estimates, shown by\n"
-    "gi-render --list-effects): ambient occlusion -> its 'ao' resource vs reference AO of the\n"
-    "effect's 'radius'; indirect light -> the lit image vs reference direct+indirect; direct\n"
-    "light (and none) -> the lit image vs reference direct. Sky pixels (reference sky mask or\n"
-    "G-buffer depth 0) are excluded.\n";
+    "Ground truth, two scores per configuration: against the quantity the effect declares it\n"
+    "estimates with its current settings (Effect::estimatedQuantity: AO, obscurance with a\n"
+    "membership, the Alchemy integral, direct or direct+indirect light) and against its\n"
+    "physical target (EffectInfo::estimates: reference AO of its radius for AO-like effects,\n"
+    "direct+indirect for indirect light, else direct). AO-like quantities are read from the\n"
+    "'ao' resource, light from the lit image. Sky pixels (reference sky mask or G-buffer\n"
+    "depth 0) are excluded.\n";
 
 struct Options {
   std::string out, cache, device;
@@ -80,7 +94,7 @@ struct Options {
   std::optional<std::vector<std::string>> effects;
   uint32_t width = 320, height = 240, refSpp = 256;
   uint64_t refSeed = 1;
-  int frames = 5;
+  int frames = 5, reps = 5;
   bool quick = false, calibrate = false, progress = true, validation = false, aoSplit = false;
   double budgetMs = 0.0, headroom = 0.1;
   std::string metric = "ssim";  // --calibrate: what "most accurate" means
@@ -133,7 +147,9 @@ Options parseArgs(int argc, char** argv) {
     else if (a == "--frames") {
       o.frames = int(parseNumber(a, value(), 1, 10000));
       o.framesGiven = true;
-    } else if (a == "--width") {
+    } else if (a == "--reps")
+      o.reps = int(parseNumber(a, value(), 1, 1000));
+    else if (a == "--width") {
       o.width = uint32_t(parseNumber(a, value(), 1, 16384));
       o.sizeGiven = true;
     } else if (a == "--height") {
@@ -196,52 +212,52 @@ Options parseArgs(int argc, char** argv) {
 
 struct Comparison {
   std::string resource = gi::resources::kLit;  // what the frame is read at
-  ref::Quantity quantity = ref::Quantity::Direct;
-  float radius = 0.0f;  // AO radius (from the effect's "radius" setting)
-  std::string effect;   // the effect that decided it ("" for the engine)
+  ReferenceSpec declared, target;              // what it estimates; its physical target
+  std::string effect;                          // the effect that decided it ("" for the engine)
 };
 
-bool isAo(ref::Quantity q) {
-  return q == ref::Quantity::AO || q == ref::Quantity::AOSplit;
-}
-
-// `aoSplit`: AO effects are compared with the ao-split reference (its value is AO_full).
-// What the effects estimate (EffectInfo::estimates) decides the ground truth: AO first, then
-// indirect light, else direct light.
-gi::GroundTruth estimates(const gi::EffectRegistry& registry, const std::string& effect) {
-  return registry.has(effect) ? registry.info(effect).estimates : gi::GroundTruth::DirectLight;
-}
-
+// The first effect with an AO-like declaration or target decides (its "ao" is compared), else
+// the first that estimates indirect light, else direct light. `aoSplit`: the AO target is the
+// ao-split reference (its value is AO_full).
 Comparison comparisonFor(const std::vector<gi::EffectConfig>& effects,
                          const gi::EffectRegistry& registry, bool aoSplit) {
   Comparison c;
-  for (const auto& e : effects)
-    if (estimates(registry, e.name) == gi::GroundTruth::AmbientOcclusion) {
+  c.declared.quantity = c.target.quantity = ref::Quantity::Direct;
+  bool indirect = false;
+  for (const auto& e : effects) {
+    if (!registry.has(e.name)) continue;
+    const gi::GroundTruth truth = registry.info(e.name).estimates;
+    const gi::EstimatedQuantity q = registry.create(e.name)->estimatedQuantity(e.settings);
+    const ReferenceSpec declared = gi::bench::declaredSpec(q);
+    const bool aoDeclared = gi::bench::isAoLike(declared.quantity);
+    if (aoDeclared != (truth == gi::GroundTruth::AmbientOcclusion))
+      throw gi::Error(gi::ErrorKind::InvalidData, e.name,
+                      "the effect's estimatedQuantity (" + gi::bench::label(declared) +
+                          ") and its ground truth (info().estimates) disagree on whether it "
+                          "outputs AO or light");
+    if (aoDeclared) {
       c.resource = gi::resources::kAO;
-      c.quantity = aoSplit ? ref::Quantity::AOSplit : ref::Quantity::AO;
+      c.declared = declared;
+      // The ao-split reference's value is AO bit for bit: one reference serves both scores.
+      if (aoSplit && declared.quantity == ref::Quantity::AO)
+        c.declared.quantity = ref::Quantity::AOSplit;
+      c.target = gi::bench::targetSpec(truth, q, aoSplit);
       c.effect = e.name;
-      bool hasRadius = false;
-      for (const auto& d : e.settings.descs()) hasRadius |= d.name == "radius";
-      c.radius = hasRadius ? float(e.settings.number("radius")) : 0.5f;
       return c;
     }
-  for (const auto& e : effects)
-    if (estimates(registry, e.name) == gi::GroundTruth::IndirectLight) {
-      c.quantity = ref::Quantity::DirectIndirect;
+    if (!indirect && (truth == gi::GroundTruth::IndirectLight ||
+                      declared.quantity == ref::Quantity::DirectIndirect)) {
+      indirect = true;
+      c.declared = declared;
+      c.target = gi::bench::targetSpec(gi::GroundTruth::IndirectLight, q, false);
       c.effect = e.name;
     }
+  }
   return c;
 }
 
-std::string referenceLabel(const Comparison& c, uint32_t spp) {
-  // The ao-split reference's value is AO itself (the same estimate, see reference.h).
-  std::string s = ref::quantityName(isAo(c.quantity) ? ref::Quantity::AO : c.quantity);
-  if (isAo(c.quantity)) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, " r=%g", double(c.radius));
-    s += buf;
-  }
-  return s + " spp=" + std::to_string(spp);
+std::string referenceLabel(const ReferenceSpec& spec, uint32_t spp) {
+  return gi::bench::label(spec) + " spp=" + std::to_string(spp);
 }
 
 // ---- Reference cache -------------------------------------------------------------------------
@@ -261,10 +277,9 @@ struct Reference {
 
 struct ReferenceKey {
   size_t scene = 0;
-  ref::Quantity quantity = ref::Quantity::Direct;
-  float radius = 0.0f;
+  ReferenceSpec spec;  // quantity and every parameter it uses
   bool operator<(const ReferenceKey& o) const {
-    return std::tie(scene, quantity, radius) < std::tie(o.scene, o.quantity, o.radius);
+    return scene != o.scene ? scene < o.scene : spec < o.spec;
   }
 };
 
@@ -276,7 +291,7 @@ struct LoadedScene {
 
 std::string cacheStem(const Options& o, const LoadedScene& s, const ReferenceKey& k) {
   std::ostringstream key;
-  key << "gi-bench-reference-v1|" << s.contents.size() << '|';
+  key << "gi-bench-reference-v2|" << s.contents.size() << '|';
   const gi::CameraView cam = gi::activeCamera(s.scene, float(o.width) / float(o.height));
   const float* v = &cam.view[0][0];
   const float* p = &cam.proj[0][0];
@@ -285,9 +300,8 @@ std::string cacheStem(const Options& o, const LoadedScene& s, const ReferenceKey
     std::snprintf(buf, sizeof buf, "%a,%a,", double(v[i]), double(p[i]));
     key << buf;
   }
-  std::snprintf(buf, sizeof buf, "%a", double(k.radius));
-  key << '|' << o.width << 'x' << o.height << '|' << ref::quantityName(k.quantity) << '|' << buf
-      << '|' << o.refSpp << '|' << o.refSeed << '|' << s.scene.triangleCount();
+  key << '|' << o.width << 'x' << o.height << '|' << gi::bench::keyText(k.spec) << '|' << o.refSpp
+      << '|' << o.refSeed << '|' << s.scene.triangleCount();
   char hex[17];
   std::snprintf(hex, sizeof hex, "%016llx",
                 static_cast<unsigned long long>(fnv1a(s.contents, fnv1a(key.str()))));
@@ -303,13 +317,13 @@ Reference computeReference(const Options& o, const LoadedScene& s, const Referen
       const nlohmann::json meta = nlohmann::json::parse(in);
       r.value = gi::readPfm(stem + ".value.pfm");
       r.depth = gi::readPfm(stem + ".depth.pfm");
-      if (k.quantity == ref::Quantity::AOSplit) r.split = gi::readPfm(stem + ".split.pfm");
+      if (k.spec.quantity == ref::Quantity::AOSplit) r.split = gi::readPfm(stem + ".split.pfm");
       r.spp = meta.at("spp");
       r.meanStdError = meta.at("mean_stderr");
       r.seconds = meta.at("seconds");
       r.cached = true;
       if (r.value.width == int(o.width) && r.value.height == int(o.height) &&
-          (k.quantity != ref::Quantity::AOSplit ||
+          (k.spec.quantity != ref::Quantity::AOSplit ||
            (r.split.width == r.value.width && r.split.height == r.value.height)))
         return r;
     } catch (const std::exception& e) {
@@ -320,8 +334,7 @@ Reference computeReference(const Options& o, const LoadedScene& s, const Referen
   ref::Settings rs;
   rs.width = o.width;
   rs.height = o.height;
-  rs.quantity = k.quantity;
-  rs.radius = isAo(k.quantity) ? k.radius : 0.5f;
+  gi::bench::apply(k.spec, rs);
   rs.spp = o.refSpp;
   rs.minSpp = std::min(rs.minSpp, o.refSpp);
   rs.seed = o.refSeed;
@@ -331,11 +344,15 @@ Reference computeReference(const Options& o, const LoadedScene& s, const Referen
   // The metadata is written last: its presence marks a complete entry.
   gi::writePfm(stem + ".value.pfm", r.value);
   gi::writePfm(stem + ".depth.pfm", r.depth);
-  if (k.quantity == ref::Quantity::AOSplit) gi::writePfm(stem + ".split.pfm", r.split);
-  nlohmann::json meta = {{"scene", s.name},     {"quantity", ref::quantityName(k.quantity)},
-                         {"radius", k.radius},  {"width", o.width},
-                         {"height", o.height},  {"spp", r.spp},
-                         {"seed", o.refSeed},   {"mean_stderr", r.meanStdError},
+  if (k.spec.quantity == ref::Quantity::AOSplit) gi::writePfm(stem + ".split.pfm", r.split);
+  nlohmann::json meta = {{"scene", s.name},
+                         {"quantity", gi::bench::label(k.spec)},
+                         {"key", gi::bench::keyText(k.spec)},
+                         {"width", o.width},
+                         {"height", o.height},
+                         {"spp", r.spp},
+                         {"seed", o.refSeed},
+                         {"mean_stderr", r.meanStdError},
                          {"seconds", r.seconds}};
   gi::bench::writeFileAtomic(stem + ".json", meta.dump(2) + "\n");
   return r;
@@ -415,17 +432,22 @@ std::string knownEffects(const gi::EffectRegistry& registry) {
 // ---- Measuring one configuration
 // -----------------------------------------------------------------
 
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
-}
+using gi::bench::median;
 
+// One configuration's timings: per repetition, each pass's median over the frames, and the
+// totals summed from them.
+struct Timing {
+  std::vector<std::string> passNames;  // graph order
+  std::map<std::string, std::vector<double>> passes;
+  std::vector<double> total, effect, floor, wall;
+};
+
+// The rendered configuration: its timings over the repetitions and, after the last one, the
+// compared resource and the depth (dropped once scored).
 struct Measurement {
-  std::vector<std::pair<std::string, double>> passes;
-  double totalMs = 0.0, effectMs = 0.0, floorMs = 0.0, wallMs = 0.0;
-  gi::bench::Metrics metrics;
-  Row::AoSplit split;
+  std::vector<gi::bench::PassTime> passes;
+  Interval total, effect, floor, wall;
+  gi::ImageRGBA32F out, depth;
 };
 
 // The effect's AO error against the ao-split reference, decomposed as in Row::AoSplit, over the
@@ -478,60 +500,120 @@ Row::AoSplit splitError(const gi::ImageRGBA32F& out, const Reference& reference,
   return s;
 }
 
-Measurement measure(gi::vk::Context& ctx, const gi::EffectRegistry& registry,
-                    const gi::Scene& scene, const std::vector<gi::EffectConfig>& effects,
-                    const gi::SettingValues& engine, const Options& o, bool floorPass,
-                    const Comparison& cmp, const Reference& reference) {
-  gi::RenderSettings settings;
-  gi::applyEngineSettings(engine, settings);
-  settings.width = o.width;
-  settings.height = o.height;
-  settings.floorPass = floorPass;
-  settings.effects = effects;
-  gi::Renderer renderer(ctx, scene, settings, &registry);
-  renderer.renderFrame();  // warm-up: first-use costs stay out of the medians
+// What a configuration renders.
+struct RenderJob {
+  const gi::Scene* scene = nullptr;
+  const std::vector<gi::EffectConfig>* effects = nullptr;
+  const gi::SettingValues* engine = nullptr;
+  std::string resource;  // read back after the last repetition
+};
+
+// One repetition: a warm-up frame (the previous repetition ran other configurations), then
+// `frames` timed frames; each pass's median over them.
+void measureRepetition(gi::Renderer& renderer, int frames, Timing& t) {
+  renderer.renderFrame();
   std::map<std::string, std::vector<double>> samples;
   std::vector<double> wall;
-  for (int f = 0; f < o.frames; ++f) {
+  for (int f = 0; f < frames; ++f) {
     const auto t0 = std::chrono::steady_clock::now();
     renderer.renderFrame();
     wall.push_back(
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-    for (const auto& t : renderer.lastTimings()) samples[t.name].push_back(t.ms);
+    for (const auto& pt : renderer.lastTimings()) samples[pt.name].push_back(pt.ms);
   }
-  Measurement m;
-  m.wallMs = median(wall);
-  for (const std::string& name : renderer.passNames()) {
+  t.passNames = renderer.passNames();
+  double total = 0.0, effect = 0.0, floor = 0.0;
+  for (const std::string& name : t.passNames) {
     const double ms = median(samples[name]);
-    m.passes.emplace_back(name, ms);
+    t.passes[name].push_back(ms);
     if (name == "floor") {
-      m.floorMs = ms;
+      floor = ms;
       continue;
     }
-    m.totalMs += ms;
-    if (!renderer.isEnginePass(name)) m.effectMs += ms;
+    total += ms;
+    if (!renderer.isEnginePass(name)) effect += ms;
   }
-  // Error against the reference, over pixels that are geometry in both.
-  const gi::ImageRGBA32F out = renderer.readTarget(cmp.resource);
-  const gi::ImageRGBA32F depth = renderer.readTarget(gi::resources::kDepth);
+  t.total.push_back(total);
+  t.effect.push_back(effect);
+  t.floor.push_back(floor);
+  t.wall.push_back(median(wall));
+}
+
+// Configurations measured together, at most this many renderers alive at once: repetition r of
+// every configuration of a batch runs before repetition r + 1 of any.
+constexpr size_t kInterleaveBatch = 16;
+
+// `scoreNow(i, m)` is called once job i is measured, while its images are held; they are
+// dropped afterwards (a sweep at a large resolution would otherwise hold all of them).
+std::vector<Measurement> measureAll(
+    gi::vk::Context& ctx, const gi::EffectRegistry& registry, const std::vector<RenderJob>& jobs,
+    const Options& o, bool floorPass,
+    const std::function<void(size_t, const Measurement&)>& scoreNow) {
+  std::vector<Measurement> out(jobs.size());
+  for (size_t first = 0; first < jobs.size(); first += kInterleaveBatch) {
+    const size_t last = std::min(jobs.size(), first + kInterleaveBatch);
+    std::vector<std::unique_ptr<gi::Renderer>> renderers;
+    for (size_t i = first; i < last; ++i) {
+      gi::RenderSettings settings;
+      gi::applyEngineSettings(*jobs[i].engine, settings);
+      settings.width = o.width;
+      settings.height = o.height;
+      settings.floorPass = floorPass;
+      settings.effects = *jobs[i].effects;
+      renderers.push_back(std::make_unique<gi::Renderer>(ctx, *jobs[i].scene, settings, &registry));
+      renderers.back()->renderFrame();  // first-use costs stay out of every repetition
+    }
+    std::vector<Timing> timings(last - first);
+    for (int r = 0; r < o.reps; ++r)
+      for (size_t i = first; i < last; ++i)
+        measureRepetition(*renderers[i - first], o.frames, timings[i - first]);
+    for (size_t i = first; i < last; ++i) {
+      const Timing& t = timings[i - first];
+      Measurement& m = out[i];
+      for (const std::string& name : t.passNames)
+        m.passes.push_back({name, gi::bench::medianInterval(t.passes.at(name))});
+      m.total = gi::bench::medianInterval(t.total);
+      m.effect = gi::bench::medianInterval(t.effect);
+      m.floor = gi::bench::medianInterval(t.floor);
+      m.wall = gi::bench::medianInterval(t.wall);
+      m.out = renderers[i - first]->readTarget(jobs[i].resource);
+      m.depth = renderers[i - first]->readTarget(gi::resources::kDepth);
+      renderers[i - first].reset();
+      scoreNow(i, m);
+      m.out = {};
+      m.depth = {};
+    }
+  }
+  return out;
+}
+
+// The effect's output against one reference, over pixels that are geometry in both.
+struct Scores {
+  gi::bench::Metrics metrics;
+  Row::AoSplit split;
+};
+
+Scores score(const Measurement& m, const ReferenceSpec& spec, const Reference& reference,
+             const Options& o) {
   const size_t n = size_t(o.width) * size_t(o.height);
   std::vector<unsigned char> mask(n);
   for (size_t i = 0; i < n; ++i)
-    mask[i] = reference.depth.pixels[i * 4 + 2] > 0.5f && depth.pixels[i * 4] > 0.0f;
+    mask[i] = reference.depth.pixels[i * 4 + 2] > 0.5f && m.depth.pixels[i * 4] > 0.0f;
   const int w = int(o.width), h = int(o.height);
-  if (isAo(cmp.quantity)) {
-    m.metrics = gi::bench::compare(gi::bench::channel(w, h, out.pixels, 0),
+  Scores s;
+  if (gi::bench::isAoLike(spec.quantity)) {
+    s.metrics = gi::bench::compare(gi::bench::channel(w, h, m.out.pixels, 0),
                                    gi::bench::channel(w, h, reference.value.pixels, 0), mask);
-    if (cmp.quantity == ref::Quantity::AOSplit && reference.split.pixels.size() == n * 4)
-      m.split = splitError(out, reference, mask);
+    if (spec.quantity == ref::Quantity::AOSplit && reference.split.pixels.size() == n * 4)
+      s.split = splitError(m.out, reference, mask);
   } else {
-    const gi::bench::Plane test = gi::bench::channel(w, h, out.pixels, -1);
+    const gi::bench::Plane test = gi::bench::channel(w, h, m.out.pixels, -1);
     const gi::bench::Plane truth = gi::bench::channel(w, h, reference.value.pixels, -1);
-    m.metrics = gi::bench::compare(test, truth, mask);
-    m.metrics.ssim =
+    s.metrics = gi::bench::compare(test, truth, mask);
+    s.metrics.ssim =
         gi::bench::ssim(gi::bench::reinhard(test), gi::bench::reinhard(truth), mask, 1.0);
   }
-  return m;
+  return s;
 }
 
 std::string formatDouble(double v) {
@@ -666,7 +748,8 @@ std::vector<Config> buildConfigs(const Options& o, const Setup& s,
           c.comparison = comparisonFor(c.effects, s.registry, o.aoSplit);
           // The reference renders the scene's environment as it is: a scaled one would be
           // compared with the wrong ground truth.
-          if (c.engine.number("environment_intensity") != 1.0 && !isAo(c.comparison.quantity))
+          if (c.engine.number("environment_intensity") != 1.0 &&
+              !gi::bench::isAoLike(c.comparison.target.quantity))
             throw gi::Error(gi::ErrorKind::Usage, "",
                             "engine.environment_intensity must be 1 when lit images are "
                             "compared with the reference (preset '" +
@@ -697,7 +780,7 @@ std::map<ReferenceKey, Reference> computeReferences(const Options& o, const Setu
   for (const ReferenceKey& k : keys) {
     if (refs.count(k)) continue;
     refs[k] = computeReference(o, s.scenes[k.scene], k);
-    bar.step(s.scenes[k.scene].name + " " + ref::quantityName(k.quantity) +
+    bar.step(s.scenes[k.scene].name + " " + gi::bench::label(k.spec) +
              (refs[k].cached ? " (cached)" : ""));
   }
   return refs;
@@ -705,10 +788,11 @@ std::map<ReferenceKey, Reference> computeReferences(const Options& o, const Setu
 
 void checkFinite(const Row& r) {
   const Row::AoSplit& s = r.split;
-  for (double v :
-       {r.totalMs, r.effectMs, r.floorMs, r.wallMs, r.nrmse, r.ssim, s.limitNrmse, s.offscreenNrmse,
-        s.hiddenNrmse, s.estimatorNrmse, s.visibleFraction, s.offscreenFraction, s.hiddenFraction,
-        s.shareOffscreen, s.shareHidden, s.shareEstimator})
+  for (double v : {r.totalMs,        r.effectMs,       r.floorMs,         r.wallMs,
+                   r.totalCi.lo,     r.totalCi.hi,     r.nrmse,           r.ssim,
+                   r.declaredNrmse,  r.declaredSsim,   s.limitNrmse,      s.offscreenNrmse,
+                   s.hiddenNrmse,    s.estimatorNrmse, s.visibleFraction, s.offscreenFraction,
+                   s.hiddenFraction, s.shareOffscreen, s.shareHidden,     s.shareEstimator})
     if (!std::isfinite(v))
       throw gi::Error(gi::ErrorKind::NonFinite, r.scene,
                       "non-finite measurement for " + r.effect + " " + r.params);
@@ -723,21 +807,37 @@ int runSweep(const Options& o) {
   const std::vector<Config> configs = buildConfigs(o, s, items, grids);
   // Everything is validated; now the work.
   std::vector<ReferenceKey> keys;
-  for (const Config& c : configs) {
-    ReferenceKey k{c.scene, c.comparison.quantity, c.comparison.radius};
-    if (std::find_if(keys.begin(), keys.end(),
-                     [&](const ReferenceKey& x) { return !(x < k) && !(k < x); }) == keys.end())
-      keys.push_back(k);
-  }
+  for (const Config& c : configs)
+    for (const ReferenceSpec& spec : {c.comparison.target, c.comparison.declared}) {
+      const ReferenceKey k{c.scene, spec};
+      if (std::find_if(keys.begin(), keys.end(),
+                       [&](const ReferenceKey& x) { return !(x < k) && !(k < x); }) == keys.end())
+        keys.push_back(k);
+    }
   const std::map<ReferenceKey, Reference> refs = computeReferences(o, s, keys);
   gi::vk::Context ctx = makeContext(o);
-  std::vector<Row> rows;
+  std::vector<RenderJob> jobs;
+  for (const Config& c : configs)
+    jobs.push_back({&s.scenes[c.scene].scene, &c.effects, &c.engine, c.comparison.resource});
   ProgressBar bar(o.progress, "configurations", configs.size());
-  for (const Config& c : configs) {
-    const Reference& reference =
-        refs.at(ReferenceKey{c.scene, c.comparison.quantity, c.comparison.radius});
-    const Measurement m = measure(ctx, s.registry, s.scenes[c.scene].scene, c.effects, c.engine, o,
-                                  true, c.comparison, reference);
+  std::vector<Scores> vsTargets(configs.size()), vsDeclareds(configs.size());
+  const std::vector<Measurement> measured =
+      measureAll(ctx, s.registry, jobs, o, true, [&](size_t i, const Measurement& m) {
+        const Config& c = configs[i];
+        vsTargets[i] =
+            score(m, c.comparison.target, refs.at(ReferenceKey{c.scene, c.comparison.target}), o);
+        vsDeclareds[i] = score(m, c.comparison.declared,
+                               refs.at(ReferenceKey{c.scene, c.comparison.declared}), o);
+        bar.step(s.scenes[c.scene].name + " " + c.effectLabel + " " + c.params);
+      });
+  std::vector<Row> rows;
+  for (size_t i = 0; i < configs.size(); ++i) {
+    const Config& c = configs[i];
+    const Measurement& m = measured[i];
+    const Reference& target = refs.at(ReferenceKey{c.scene, c.comparison.target});
+    const Reference& declared = refs.at(ReferenceKey{c.scene, c.comparison.declared});
+    const Scores& vsTarget = vsTargets[i];
+    const Scores& vsDeclared = vsDeclareds[i];
     Row r;
     r.scene = s.scenes[c.scene].name;
     r.effect = c.effectLabel;
@@ -749,23 +849,31 @@ int runSweep(const Options& o) {
     r.width = o.width;
     r.height = o.height;
     r.frames = o.frames;
+    r.reps = o.reps;
     r.passes = m.passes;
-    r.totalMs = m.totalMs;
-    r.effectMs = m.effectMs;
-    r.floorMs = m.floorMs;
-    r.wallMs = m.wallMs;
+    r.totalCi = m.total;
+    r.effectCi = m.effect;
+    r.floorCi = m.floor;
+    r.wallCi = m.wall;
+    r.totalMs = m.total.median;
+    r.effectMs = m.effect.median;
+    r.floorMs = m.floor.median;
+    r.wallMs = m.wall.median;
     r.compared = c.comparison.resource;
-    r.reference = referenceLabel(c.comparison, reference.spp);
-    r.referenceSpp = reference.spp;
-    r.referenceStdError = reference.meanStdError;
-    r.nrmse = m.metrics.nrmse;
-    r.ssim = m.metrics.ssim;
-    r.pixels = m.metrics.pixels;
-    r.referenceSeconds = reference.seconds;
-    r.split = m.split;
+    r.reference = referenceLabel(c.comparison.target, target.spp);
+    r.referenceSpp = target.spp;
+    r.referenceStdError = target.meanStdError;
+    r.nrmse = vsTarget.metrics.nrmse;
+    r.ssim = vsTarget.metrics.ssim;
+    r.pixels = vsTarget.metrics.pixels;
+    r.referenceSeconds = target.seconds;
+    r.split = vsTarget.split;
+    r.declared = referenceLabel(c.comparison.declared, declared.spp);
+    r.declaredStdError = declared.meanStdError;
+    r.declaredNrmse = vsDeclared.metrics.nrmse;
+    r.declaredSsim = vsDeclared.metrics.ssim;
     checkFinite(r);
     rows.push_back(std::move(r));
-    bar.step(rows.back().scene + " " + c.effectLabel + " " + c.params);
   }
   if (ctx.validationErrors() > 0) {
     std::fprintf(stderr, "gi-bench: error: %u Vulkan validation error(s)\n",
@@ -848,24 +956,17 @@ int runCalibrate(const Options& o) {
   const Comparison cmp = comparisonFor(base, s.registry, false);
   const gi::SettingValues engine = gi::resolveEngineSettings(scene, nullptr, {}, {});
   const std::map<ReferenceKey, Reference> refs =
-      computeReferences(o, s, {ReferenceKey{0, cmp.quantity, cmp.radius}});
+      computeReferences(o, s, {ReferenceKey{0, cmp.target}});
   const Reference& reference = refs.begin()->second;
   gi::vk::Context ctx = makeContext(o);
   const double limit = o.budgetMs * (1.0 - o.headroom);
-  std::printf("calibrating on %s: %s %ux%u, budget %.3f ms (measured time must stay under %.3f)\n",
-              ctx.deviceName().c_str(), s.scenes[0].name.c_str(), o.width, o.height, o.budgetMs,
-              limit);
-  std::printf("%-40s %12s %10s %8s %8s\n", "settings", "frame ms", "NRMSE", "SSIM", "fits");
-  ProgressBar bar(o.progress, "candidates", candidates.size());
-  struct Choice {
-    size_t index = 0;
-    double ms = 0.0, nrmse = 0.0, ssim = 0.0;
-  };
-  const bool bySsim = o.metric == "ssim";
-  // Lower is better; among equal scores the earlier (cheaper) candidate stays.
-  auto score = [&](double nrmse, double ssim) { return bySsim ? -ssim : nrmse; };
-  std::optional<Choice> best;
-  double cheapest = INFINITY;
+  std::printf(
+      "calibrating on %s: %s %ux%u, budget %.3f ms (the upper end of the measured "
+      "time's interval must stay under %.3f)\n",
+      ctx.deviceName().c_str(), s.scenes[0].name.c_str(), o.width, o.height, o.budgetMs, limit);
+  // Every candidate measured, repetitions interleaved across candidates.
+  std::vector<std::vector<gi::EffectConfig>> configs;
+  std::vector<std::string> labels;
   for (size_t ci = 0; ci < candidates.size(); ++ci) {
     gi::EffectOverrides ov;
     ov.effects = effects;
@@ -875,37 +976,71 @@ int runCalibrate(const Options& o) {
                         std::to_string(candidates[ci][k]));
       label += (label.empty() ? "" : " ") + ov.sets.back();
     }
-    const auto cfg = gi::resolveEffects(scene, nullptr, ov, s.registry);
-    const Measurement m = measure(ctx, s.registry, scene, cfg, engine, o, false, cmp, reference);
-    const bool fits = m.totalMs <= limit;
-    cheapest = std::min(cheapest, m.totalMs);
-    std::printf("%-40s %12.3f %10.5f %8.5f %8s\n", label.c_str(), m.totalMs, m.metrics.nrmse,
-                m.metrics.ssim, fits ? "yes" : "no");
-    if (fits &&
-        (!best || score(m.metrics.nrmse, m.metrics.ssim) < score(best->nrmse, best->ssim) - 1e-12))
-      best = Choice{ci, m.totalMs, m.metrics.nrmse, m.metrics.ssim};
-    bar.step(label);
+    configs.push_back(gi::resolveEffects(scene, nullptr, ov, s.registry));
+    labels.push_back(label);
   }
-  if (!best)
+  std::vector<RenderJob> jobs;
+  for (const auto& cfg : configs) jobs.push_back({&scene, &cfg, &engine, cmp.resource});
+  ProgressBar bar(o.progress, "candidates", candidates.size());
+  std::vector<Scores> scores(candidates.size());
+  const std::vector<Measurement> measured =
+      measureAll(ctx, s.registry, jobs, o, false, [&](size_t i, const Measurement& m) {
+        scores[i] = score(m, cmp.target, reference, o);
+        bar.step(labels[i]);
+      });
+  const bool bySsim = o.metric == "ssim";
+  std::vector<gi::bench::CalibrationCandidate> cands;
+  double cheapest = INFINITY;
+  for (size_t ci = 0; ci < candidates.size(); ++ci) {
+    const gi::bench::Metrics& mt = scores[ci].metrics;
+    cands.push_back({candidates[ci], measured[ci].total, bySsim ? -mt.ssim : mt.nrmse});
+    cheapest = std::min(cheapest, measured[ci].total.median);
+  }
+  const gi::bench::CalibrationChoice choice = gi::bench::chooseCalibrated(cands, limit);
+  char intervalHeader[32];
+  std::snprintf(intervalHeader, sizeof intervalHeader, "%.4g%% interval",
+                100.0 * (measured.empty() ? 0.0 : measured[0].total.coverage));
+  std::printf("%-40s %10s %21s %12s %10s %8s %5s\n", "settings", "frame ms", intervalHeader,
+              "cost bound", "NRMSE", "SSIM", "fits");
+  for (size_t ci = 0; ci < candidates.size(); ++ci) {
+    const Interval& t = measured[ci].total;
+    std::printf("%-40s %10.3f [%8.3f, %8.3f] %12.3f %10.5f %8.5f %5s\n", labels[ci].c_str(),
+                t.median, t.lo, t.hi, choice.boundMs[ci], scores[ci].metrics.nrmse,
+                scores[ci].metrics.ssim, choice.boundMs[ci] <= limit ? "yes" : "no");
+  }
+  if (!choice.index)
     throw gi::Error(gi::ErrorKind::InvalidData, o.out,
                     "no configuration fits the budget of " + formatDouble(o.budgetMs) +
                         " ms (cheapest measured: " + formatDouble(cheapest) +
-                        " ms at the lowest sample counts); nothing written");
+                        " ms at the lowest sample counts, upper ends of the intervals must "
+                        "fit); nothing written");
+  struct Choice {
+    size_t index = 0;
+    double ms = 0.0, nrmse = 0.0, ssim = 0.0;
+  };
+  const Choice best{*choice.index, measured[*choice.index].total.median,
+                    scores[*choice.index].metrics.nrmse, scores[*choice.index].metrics.ssim};
+  std::printf(
+      "margin kept: %.3f ms under the limit %.3f (cost bound %.3f ms, of which %.3f ms "
+      "above the median for noise and the monotone-cost assumption; coverage %.4g)\n",
+      choice.marginMs, limit, choice.boundMs[best.index], choice.noiseMarginMs,
+      measured[best.index].total.coverage);
   nlohmann::json preset;
   preset["name"] = fs::path(o.out).stem().string();
-  preset["description"] = "Calibrated by gi-bench on " + ctx.deviceName() + " with " +
-                          s.scenes[0].name + " at " + std::to_string(o.width) + "x" +
-                          std::to_string(o.height) + ": measured " + formatDouble(best->ms) +
-                          " ms per frame, NRMSE " + formatDouble(best->nrmse) + ", SSIM " +
-                          formatDouble(best->ssim) + " vs " + referenceLabel(cmp, reference.spp) +
-                          " (the sample counts of highest " + (bySsim ? "SSIM" : "NRMSE accuracy") +
-                          " within " + formatDouble(o.budgetMs) + " ms)";
+  preset["description"] =
+      "Calibrated by gi-bench on " + ctx.deviceName() + " with " + s.scenes[0].name + " at " +
+      std::to_string(o.width) + "x" + std::to_string(o.height) + ": measured " +
+      formatDouble(best.ms) + " ms per frame (median of " + std::to_string(o.reps) +
+      " repetitions, cost bound " + formatDouble(choice.boundMs[best.index]) + " ms), NRMSE " +
+      formatDouble(best.nrmse) + ", SSIM " + formatDouble(best.ssim) + " vs " +
+      referenceLabel(cmp.target, reference.spp) + " (the sample counts of highest " +
+      (bySsim ? "SSIM" : "NRMSE accuracy") + " within " + formatDouble(o.budgetMs) + " ms)";
   preset["platform"] = ctx.deviceName();
   preset["target_ms"] = o.budgetMs;
   preset["reference_resolution"] = {o.width, o.height};
   preset["effects"] = nlohmann::json::object();
   for (size_t k = 0; k < knobs.size(); ++k)
-    preset["effects"][knobs[k].effect][knobs[k].key] = candidates[best->index][k];
+    preset["effects"][knobs[k].effect][knobs[k].key] = candidates[best.index][k];
   // Written, then checked by the engine's own loader, then moved into place.
   const std::string tmp = o.out + ".check.json";
   gi::bench::writeFileAtomic(tmp, preset.dump(2) + "\n");
@@ -917,7 +1052,7 @@ int runCalibrate(const Options& o) {
   }
   fs::rename(tmp, o.out);
   std::printf("chose %s: %.3f ms (budget %.3f), NRMSE %.5f, SSIM %.5f -> wrote %s\n",
-              preset["effects"].dump().c_str(), best->ms, o.budgetMs, best->nrmse, best->ssim,
+              preset["effects"].dump().c_str(), best.ms, o.budgetMs, best.nrmse, best.ssim,
               o.out.c_str());
   return 0;
 }

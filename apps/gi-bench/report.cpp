@@ -1,5 +1,6 @@
-// gi-bench outputs: CSV, JSON, a Markdown report and SVG plots (written by hand, no plotting
-// library): NRMSE against time per scene and effect, one polyline per series, Pareto front.
+// gi-bench outputs: CSV, JSON, a Markdown report and SVG + PNG plots (written by hand, no
+// plotting library): NRMSE against time per scene and effect, one polyline per series, error
+// bars, the Pareto front.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -13,6 +14,8 @@
 
 #include "bench.h"
 #include "gi/errors.h"
+#include "gi/image_io.h"
+#include "plot.h"
 
 namespace gi::bench {
 
@@ -37,21 +40,14 @@ double plotTime(const Row& row) {
   return row.effectMs > 0.0 ? row.effectMs : row.totalMs;
 }
 
+Interval plotInterval(const Row& row) {
+  return row.effectMs > 0.0 ? row.effectCi : row.totalCi;
+}
+
 std::vector<size_t> paretoFront(const std::vector<const Row*>& rows) {
-  std::vector<size_t> order(rows.size());
-  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
-    const double ta = plotTime(*rows[a]), tb = plotTime(*rows[b]);
-    return ta != tb ? ta < tb : rows[a]->nrmse < rows[b]->nrmse;
-  });
-  std::vector<size_t> front;
-  double best = INFINITY;
-  for (size_t i : order)
-    if (rows[i]->nrmse < best) {
-      best = rows[i]->nrmse;
-      front.push_back(i);
-    }
-  return front;
+  std::vector<TradeoffPoint> points;
+  for (const Row* r : rows) points.push_back({plotInterval(*r), r->nrmse});
+  return paretoFront(points);
 }
 
 namespace {
@@ -69,10 +65,17 @@ std::string csvField(const std::string& s) {
   return out + "\"";
 }
 
+// "gbuffer=1.2[1.1,1.3] ssao=3.4[3.3,3.6]": median and interval per pass.
 std::string passList(const Row& r) {
   std::string s;
-  for (const auto& [name, ms] : r.passes) s += (s.empty() ? "" : " ") + name + "=" + fmt(ms);
+  for (const PassTime& p : r.passes)
+    s += (s.empty() ? "" : " ") + p.name + "=" + fmt(p.ms.median) + "[" + fmt(p.ms.lo) + "," +
+         fmt(p.ms.hi) + "]";
   return s;
+}
+
+std::string withInterval(const Interval& i, int digits = 4) {
+  return fmt(i.median, digits) + " [" + fmt(i.lo, digits) + ", " + fmt(i.hi, digits) + "]";
 }
 
 std::string fileSafe(const std::string& s) {
@@ -88,9 +91,11 @@ bool anySplit(const std::vector<Row>& rows) {
 std::string csv(const std::vector<Row>& rows) {
   std::ostringstream o;
   const bool split = anySplit(rows);
-  o << "scene,effect,preset,params,width,height,frames,passes_ms,total_ms,effect_ms,floor_ms,"
+  o << "scene,effect,preset,params,width,height,frames,reps,passes_ms,total_ms,total_lo_ms,"
+       "total_hi_ms,effect_ms,effect_lo_ms,effect_hi_ms,interval_coverage,floor_ms,"
        "total_over_floor,effect_over_floor,wall_ms,compared,reference,reference_spp,"
-       "reference_stderr,pixels,nrmse,ssim";
+       "reference_stderr,pixels,nrmse,ssim,declared,declared_stderr,declared_nrmse,"
+       "declared_ssim";
   // --ao-split runs only, so that other runs keep their columns.
   if (split)
     o << ",reference_seconds,limit_nrmse,offscreen_nrmse,hidden_nrmse,estimator_nrmse,"
@@ -99,13 +104,16 @@ std::string csv(const std::vector<Row>& rows) {
   o << '\n';
   for (const Row& r : rows) {
     o << csvField(r.scene) << ',' << csvField(r.effect) << ',' << csvField(r.preset) << ','
-      << csvField(r.params) << ',' << r.width << ',' << r.height << ',' << r.frames << ','
-      << csvField(passList(r)) << ',' << fmt(r.totalMs, 6) << ',' << fmt(r.effectMs, 6) << ','
+      << csvField(r.params) << ',' << r.width << ',' << r.height << ',' << r.frames << ',' << r.reps
+      << ',' << csvField(passList(r)) << ',' << fmt(r.totalMs, 6) << ',' << fmt(r.totalCi.lo, 6)
+      << ',' << fmt(r.totalCi.hi, 6) << ',' << fmt(r.effectMs, 6) << ',' << fmt(r.effectCi.lo, 6)
+      << ',' << fmt(r.effectCi.hi, 6) << ',' << fmt(r.totalCi.coverage, 6) << ','
       << fmt(r.floorMs, 6) << ',' << fmt(r.floorMs > 0 ? r.totalMs / r.floorMs : 0.0, 6) << ','
       << fmt(r.floorMs > 0 ? r.effectMs / r.floorMs : 0.0, 6) << ',' << fmt(r.wallMs, 6) << ','
       << r.compared << ',' << csvField(r.reference) << ',' << r.referenceSpp << ','
       << fmt(r.referenceStdError, 6) << ',' << r.pixels << ',' << fmt(r.nrmse, 6) << ','
-      << fmt(r.ssim, 6);
+      << fmt(r.ssim, 6) << ',' << csvField(r.declared) << ',' << fmt(r.declaredStdError, 6) << ','
+      << fmt(r.declaredNrmse, 6) << ',' << fmt(r.declaredSsim, 6);
     if (split) {
       const Row::AoSplit& s = r.split;
       o << ',' << fmt(r.referenceSeconds, 6);
@@ -128,7 +136,15 @@ std::string json(const std::vector<Row>& rows, const RunInfo& info) {
   j["results"] = nlohmann::json::array();
   for (const Row& r : rows) {
     nlohmann::json p = nlohmann::json::object(), passes = nlohmann::json::array();
-    for (const auto& [name, ms] : r.passes) passes.push_back({{"pass", name}, {"ms", ms}});
+    auto ci = [](const Interval& i) {
+      return nlohmann::json{{"median", i.median},
+                            {"lo", i.lo},
+                            {"hi", i.hi},
+                            {"coverage", i.coverage},
+                            {"reps", i.samples}};
+    };
+    for (const PassTime& pt : r.passes)
+      passes.push_back({{"pass", pt.name}, {"ms", pt.ms.median}, {"interval", ci(pt.ms)}});
     j["results"].push_back({{"scene", r.scene},
                             {"effect", r.effect},
                             {"preset", r.preset},
@@ -136,8 +152,13 @@ std::string json(const std::vector<Row>& rows, const RunInfo& info) {
                             {"width", r.width},
                             {"height", r.height},
                             {"frames", r.frames},
+                            {"reps", r.reps},
                             {"passes", passes},
                             {"total_ms", r.totalMs},
+                            {"total_interval", ci(r.totalCi)},
+                            {"effect_interval", ci(r.effectCi)},
+                            {"floor_interval", ci(r.floorCi)},
+                            {"wall_interval", ci(r.wallCi)},
                             {"effect_ms", r.effectMs},
                             {"floor_ms", r.floorMs},
                             {"total_over_floor", r.floorMs > 0 ? r.totalMs / r.floorMs : 0.0},
@@ -150,6 +171,10 @@ std::string json(const std::vector<Row>& rows, const RunInfo& info) {
                             {"pixels", r.pixels},
                             {"nrmse", r.nrmse},
                             {"ssim", r.ssim},
+                            {"declared", r.declared},
+                            {"declared_stderr", r.declaredStdError},
+                            {"declared_nrmse", r.declaredNrmse},
+                            {"declared_ssim", r.declaredSsim},
                             {"reference_seconds", r.referenceSeconds}});
     if (r.split.present) {
       const Row::AoSplit& s = r.split;
@@ -164,9 +189,13 @@ std::string json(const std::vector<Row>& rows, const RunInfo& info) {
   return j.dump(2) + "\n";
 }
 
+std::string percent(double v) {
+  return fmt(100.0 * v, 3) + "%";
+}
+
 // "Nice" axis ticks covering [0, hi].
 std::vector<double> ticks(double hi) {
-  if (!(hi > 0)) hi = 1;
+  if (!(hi > 0) || !std::isfinite(hi)) hi = 1;
   const double raw = hi / 5.0, mag = std::pow(10.0, std::floor(std::log10(raw)));
   const double step = raw / mag < 1.5   ? mag
                       : raw / mag < 3.5 ? 2 * mag
@@ -185,94 +214,148 @@ std::string xmlEscape(const std::string& s) {
   return o;
 }
 
-std::string svgPlot(const std::string& title, const std::vector<const Row*>& rows) {
-  const double W = 720, H = 460, left = 70, right = 200, top = 40, bottom = 50;
-  const double pw = W - left - right, ph = H - top - bottom;
-  double tmax = 0, emax = 0;
-  for (const Row* r : rows) {
-    tmax = std::max(tmax, plotTime(*r));
-    emax = std::max(emax, r->nrmse);
-  }
-  const std::vector<double> xt = ticks(tmax), yt = ticks(emax);
-  const double xhi = xt.back(), yhi = yt.back();
-  auto X = [&](double t) { return left + pw * t / xhi; };
-  auto Y = [&](double e) { return top + ph * (1.0 - e / yhi); };
+// Rows of one scene and effect as a plot: series by `Row::series`, points in swept-value
+// order, labelled by the swept setting ("ssao.samples=16"), error bars from the intervals.
+Plot buildPlot(const std::string& title, const std::vector<const Row*>& rows) {
+  Plot p;
+  p.title = title;
   const bool effectTime = !rows.empty() && rows.front()->effectMs > 0.0;
-  std::ostringstream o;
-  o << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << W << "\" height=\"" << H
-    << "\" viewBox=\"0 0 " << W << ' ' << H << "\" font-family=\"sans-serif\" font-size=\"12\">\n"
-    << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
-    << "<text x=\"" << left << "\" y=\"22\" font-size=\"15\">" << xmlEscape(title) << "</text>\n";
-  for (double t : xt)
-    o << "<line x1=\"" << X(t) << "\" y1=\"" << top << "\" x2=\"" << X(t) << "\" y2=\"" << top + ph
-      << "\" stroke=\"#ddd\"/><text x=\"" << X(t) << "\" y=\"" << top + ph + 16
-      << "\" text-anchor=\"middle\">" << fmt(t, 3) << "</text>\n";
-  for (double e : yt)
-    o << "<line x1=\"" << left << "\" y1=\"" << Y(e) << "\" x2=\"" << left + pw << "\" y2=\""
-      << Y(e) << "\" stroke=\"#ddd\"/><text x=\"" << left - 6 << "\" y=\"" << Y(e) + 4
-      << "\" text-anchor=\"end\">" << fmt(e, 3) << "</text>\n";
-  o << "<rect x=\"" << left << "\" y=\"" << top << "\" width=\"" << pw << "\" height=\"" << ph
-    << "\" fill=\"none\" stroke=\"black\"/>\n"
-    << "<text x=\"" << left + pw / 2 << "\" y=\"" << H - 12 << "\" text-anchor=\"middle\">"
-    << (effectTime ? "effect GPU time (ms, median)" : "frame GPU time (ms, median)") << "</text>\n"
-    << "<text transform=\"translate(18," << top + ph / 2
-    << ") rotate(-90)\" text-anchor=\"middle\">NRMSE vs reference</text>\n";
-  // Series, in first-appearance order.
-  std::vector<std::string> names;
-  std::map<std::string, std::vector<const Row*>> series;
+  p.xLabel = std::string(effectTime ? "effect" : "frame") + " GPU time, ms (median; bars: " +
+             (rows.empty() ? std::string("-") : percent(rows.front()->totalCi.coverage)) +
+             " interval)";
+  p.yLabel = "NRMSE vs " + (rows.empty() ? std::string("reference") : rows.front()->reference);
+  const std::vector<size_t> front = paretoFront(rows);
+  std::set<const Row*> onFront;
+  for (size_t i : front) onFront.insert(rows[i]);
+  auto point = [&](const Row* r) {
+    const Interval t = plotInterval(*r);
+    PlotPoint pt{t.median, t.lo, t.hi, r->nrmse, "", onFront.count(r) > 0};
+    pt.label = r->gridKey.empty() ? (r->params.empty() ? r->preset : r->params)
+                                  : r->gridKey + "=" + fmt(r->gridValue);
+    return pt;
+  };
+  std::map<std::string, size_t> index;
   for (const Row* r : rows) {
-    if (!series.count(r->series)) names.push_back(r->series);
-    series[r->series].push_back(r);
+    if (!index.count(r->series)) {
+      index[r->series] = p.series.size();
+      std::string name = r->series.empty() ? "default" : r->series;
+      if (!r->gridKey.empty()) name += " (" + r->gridKey + ")";
+      p.series.push_back({name, {}});
+    }
   }
-  const char* colours[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd",
-                           "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"};
-  for (size_t s = 0; s < names.size(); ++s) {
-    std::vector<const Row*> pts = series[names[s]];
+  for (auto& [key, i] : index) {
+    std::vector<const Row*> pts;
+    for (const Row* r : rows)
+      if (r->series == key) pts.push_back(r);
     std::stable_sort(pts.begin(), pts.end(),
                      [](const Row* a, const Row* b) { return a->gridValue < b->gridValue; });
-    const char* c = colours[s % 10];
-    o << "<polyline fill=\"none\" stroke=\"" << c << "\" stroke-width=\"1.5\" points=\"";
-    for (const Row* r : pts) o << X(plotTime(*r)) << ',' << Y(r->nrmse) << ' ';
-    o << "\"/>\n";
-    for (const Row* r : pts) {
-      o << "<circle cx=\"" << X(plotTime(*r)) << "\" cy=\"" << Y(r->nrmse) << "\" r=\"3.5\" fill=\""
-        << c << "\"><title>" << xmlEscape(r->params.empty() ? r->preset : r->params) << ": "
-        << fmt(plotTime(*r)) << " ms, NRMSE " << fmt(r->nrmse) << "</title></circle>\n";
-      if (!r->gridKey.empty())
-        o << "<text x=\"" << X(plotTime(*r)) + 5 << "\" y=\"" << Y(r->nrmse) - 5
-          << "\" font-size=\"10\" fill=\"" << c << "\">" << fmt(r->gridValue) << "</text>\n";
+    for (const Row* r : pts) p.series[i].points.push_back(point(r));
+  }
+  for (size_t i : front) p.front.push_back(point(rows[i]));
+  return p;
+}
+
+}  // namespace
+
+PlotLayout layoutFor(const Plot& plot) {
+  PlotLayout l;
+  double tmax = 0, emax = 0;
+  for (const PlotSeries& s : plot.series)
+    for (const PlotPoint& p : s.points) {
+      tmax = std::max(tmax, std::max(p.time, p.timeHi));
+      emax = std::max(emax, p.error);
     }
-    const double ly = top + 10 + 18 * double(s);
-    o << "<line x1=\"" << left + pw + 12 << "\" y1=\"" << ly << "\" x2=\"" << left + pw + 32
+  l.xTicks = ticks(tmax);
+  l.yTicks = ticks(emax);
+  l.xMax = l.xTicks.back();
+  l.yMax = l.yTicks.back();
+  return l;
+}
+
+const char* seriesColour(size_t i) {
+  static const char* colours[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd",
+                                  "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"};
+  return colours[i % 10];
+}
+
+std::string formatTick(double v) {
+  return fmt(v, 3);
+}
+
+std::string pointValues(const PlotPoint& p) {
+  return fmt(p.time, 3) + " ms, " + fmt(p.error, 3);
+}
+
+std::string svgPlot(const Plot& plot) {
+  const PlotLayout l = layoutFor(plot);
+  const double pw = l.width - l.left - l.right, ph = l.height - l.top - l.bottom;
+  std::ostringstream o;
+  o << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" << l.width << "\" height=\"" << l.height
+    << "\" viewBox=\"0 0 " << l.width << ' ' << l.height
+    << "\" font-family=\"sans-serif\" font-size=\"12\">\n"
+    << "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n"
+    << "<text x=\"" << l.left << "\" y=\"22\" font-size=\"15\">" << xmlEscape(plot.title)
+    << "</text>\n";
+  for (double t : l.xTicks)
+    o << "<line x1=\"" << l.x(t) << "\" y1=\"" << l.top << "\" x2=\"" << l.x(t) << "\" y2=\""
+      << l.top + ph << "\" stroke=\"#ddd\"/><text x=\"" << l.x(t) << "\" y=\"" << l.top + ph + 16
+      << "\" text-anchor=\"middle\">" << formatTick(t) << "</text>\n";
+  for (double e : l.yTicks)
+    o << "<line x1=\"" << l.left << "\" y1=\"" << l.y(e) << "\" x2=\"" << l.left + pw << "\" y2=\""
+      << l.y(e) << "\" stroke=\"#ddd\"/><text x=\"" << l.left - 6 << "\" y=\"" << l.y(e) + 4
+      << "\" text-anchor=\"end\">" << formatTick(e) << "</text>\n";
+  o << "<rect x=\"" << l.left << "\" y=\"" << l.top << "\" width=\"" << pw << "\" height=\"" << ph
+    << "\" fill=\"none\" stroke=\"black\"/>\n"
+    << "<text x=\"" << l.left + pw / 2 << "\" y=\"" << l.height - 12 << "\" text-anchor=\"middle\">"
+    << xmlEscape(plot.xLabel) << "</text>\n"
+    << "<text transform=\"translate(18," << l.top + ph / 2
+    << ") rotate(-90)\" text-anchor=\"middle\">" << xmlEscape(plot.yLabel) << "</text>\n";
+  for (size_t s = 0; s < plot.series.size(); ++s) {
+    const PlotSeries& ser = plot.series[s];
+    const char* c = seriesColour(s);
+    o << "<polyline fill=\"none\" stroke=\"" << c << "\" stroke-width=\"1.5\" points=\"";
+    for (const PlotPoint& p : ser.points) o << l.x(p.time) << ',' << l.y(p.error) << ' ';
+    o << "\"/>\n";
+    for (const PlotPoint& p : ser.points) {
+      const double x = l.x(p.time), y = l.y(p.error);
+      // Error bar: the time interval, with end ticks.
+      o << "<path d=\"M" << l.x(p.timeLo) << ' ' << y << "H" << l.x(p.timeHi) << "M"
+        << l.x(p.timeLo) << ' ' << y - 4 << "v8M" << l.x(p.timeHi) << ' ' << y - 4
+        << "v8\" stroke=\"" << c << "\" fill=\"none\"/>\n";
+      o << "<circle cx=\"" << x << "\" cy=\"" << y << "\" r=\"3.5\" fill=\"" << c << "\"><title>"
+        << xmlEscape(p.label) << ": " << fmt(p.time) << " ms [" << fmt(p.timeLo) << ", "
+        << fmt(p.timeHi) << "], NRMSE " << fmt(p.error) << "</title></circle>\n";
+      o << "<text x=\"" << x + 6 << "\" y=\"" << y - 6 << "\" font-size=\"10\" fill=\"" << c
+        << "\">" << xmlEscape(p.label) << "</text><text x=\"" << x + 6 << "\" y=\"" << y + 12
+        << "\" font-size=\"9\" fill=\"#555\">" << xmlEscape(pointValues(p)) << "</text>\n";
+    }
+    const double ly = l.top + 10 + 18 * double(s);
+    o << "<line x1=\"" << l.left + pw + 12 << "\" y1=\"" << ly << "\" x2=\"" << l.left + pw + 32
       << "\" y2=\"" << ly << "\" stroke=\"" << c << "\" stroke-width=\"2\"/><text x=\""
-      << left + pw + 36 << "\" y=\"" << ly + 4 << "\">"
-      << xmlEscape(names[s].empty() ? "default" : names[s]) << "</text>\n";
+      << l.left + pw + 36 << "\" y=\"" << ly + 4 << "\">" << xmlEscape(ser.name) << "</text>\n";
   }
   // Pareto front: dashed staircase and rings.
-  const std::vector<size_t> front = paretoFront(rows);
-  if (!front.empty()) {
+  if (!plot.front.empty()) {
     o << "<polyline fill=\"none\" stroke=\"black\" stroke-dasharray=\"4 3\" points=\"";
-    for (size_t k = 0; k < front.size(); ++k) {
-      const Row& r = *rows[front[k]];
-      if (k > 0) o << X(plotTime(r)) << ',' << Y(rows[front[k - 1]]->nrmse) << ' ';
-      o << X(plotTime(r)) << ',' << Y(r.nrmse) << ' ';
+    for (size_t k = 0; k < plot.front.size(); ++k) {
+      const PlotPoint& p = plot.front[k];
+      if (k > 0) o << l.x(p.time) << ',' << l.y(plot.front[k - 1].error) << ' ';
+      o << l.x(p.time) << ',' << l.y(p.error) << ' ';
     }
     o << "\"/>\n";
-    for (size_t i : front)
-      o << "<circle cx=\"" << X(plotTime(*rows[i])) << "\" cy=\"" << Y(rows[i]->nrmse)
+    for (const PlotPoint& p : plot.front)
+      o << "<circle cx=\"" << l.x(p.time) << "\" cy=\"" << l.y(p.error)
         << "\" r=\"7\" fill=\"none\" stroke=\"black\"/>\n";
-    const double ly = top + 10 + 18 * double(names.size());
-    o << "<circle cx=\"" << left + pw + 22 << "\" cy=\"" << ly
-      << "\" r=\"6\" fill=\"none\" stroke=\"black\"/><text x=\"" << left + pw + 36 << "\" y=\""
-      << ly + 4 << "\">Pareto front</text>\n";
+    const double ly = l.top + 10 + 18 * double(plot.series.size());
+    o << "<circle cx=\"" << l.left + pw + 22 << "\" cy=\"" << ly
+      << "\" r=\"6\" fill=\"none\" stroke=\"black\"/><text x=\"" << l.left + pw + 36 << "\" y=\""
+      << ly + 4 << "\">Pareto front (beyond the intervals)</text>\n";
   }
   o << "</svg>\n";
   return o.str();
 }
 
-std::string percent(double v) {
-  return fmt(100.0 * v, 3) + "%";
-}
+namespace {
 
 // "Where screen-space AO cannot converge" (--ao-split): per scene and AO effect, the reference's
 // occlusion split by occluder class and the decomposition of the effect's error at its most
@@ -343,37 +426,54 @@ std::string markdown(const std::vector<Row>& rows, const RunInfo& info,
   o << "# gi-bench report\n\n"
     << "Device: " << info.device << "  \nCommand: `" << info.commandLine
     << "`  \nDate: " << info.date << " (" << fmt(info.seconds, 3) << " s)\n\n"
-    << "GPU times are medians over the frames of Vulkan timestamp queries; *total* sums the "
+    << "GPU times come from Vulkan timestamp queries. Each configuration is measured in "
+    << (rows.empty() ? 0 : rows.front().reps)
+    << " repetitions, interleaved round-robin across configurations (repetition 1 of all, "
+       "then repetition 2, ...) so that drift hits all alike; a repetition's value is the "
+       "median over its "
+    << (rows.empty() ? 0 : rows.front().frames)
+    << " frames. Times are the median over the repetitions with a confidence interval "
+       "[lo, hi] of the median from order statistics (binomial, distribution-free; coverage "
+    << (rows.empty() ? std::string("-") : percent(rows.front().totalCi.coverage))
+    << ": 95% needs at least 6 repetitions, fewer give [min, max]). *total* sums the "
        "frame's passes (the floor pass excluded), *effect* the passes that are not the engine's, "
        "and *x floor* divides them by the floor pass (a fixed full-screen pass measured in the "
        "same frame: a device-independent cost unit). NRMSE (RMSE / mean of the reference) and "
-       "SSIM compare the effect's output with the CPU ray-traced reference over the pixels that "
-       "show geometry in both. Rows on the Pareto front of (time, NRMSE) within their scene and "
-       "effect are marked *.\n\n";
+       "SSIM compare the effect's output with CPU ray-traced references over the pixels that "
+       "show geometry in both, twice: against the *target* (the physically meaningful quantity: "
+       "AO of the effect's radius for AO-like effects, direct + indirect light for GI effects) "
+       "and against the quantity the effect *declares* it estimates with these settings "
+       "(obscurance with a membership, the Alchemy integral, ...; equal to the target when the "
+       "effect declares nothing else). Rows on the Pareto front of (time, NRMSE vs target) "
+       "within their scene and effect are marked *; a time difference inside the intervals "
+       "does not keep a less accurate row on the front.\n\n";
   std::set<const Row*> onFront;
   std::map<std::pair<std::string, std::string>, std::vector<const Row*>> groups;
   for (const Row& r : rows) groups[{r.scene, r.effect}].push_back(&r);
   for (const auto& [key, g] : groups)
     for (size_t i : paretoFront(g)) onFront.insert(g[i]);
-  o << "| scene | effect | preset / params | GPU ms per pass | total ms | effect ms | total x "
-       "floor "
-       "| effect x floor | compared with | NRMSE | SSIM |\n"
-    << "|---|---|---|---|---:|---:|---:|---:|---|---:|---:|\n";
+  o << "| scene | effect | preset / params | GPU ms per pass [interval] | total ms [interval] | "
+       "effect ms [interval] | total x floor | effect x floor | target | NRMSE vs target | SSIM "
+       "vs target | declared | NRMSE vs declared | SSIM vs declared |\n"
+    << "|---|---|---|---|---:|---:|---:|---:|---|---:|---:|---|---:|---:|\n";
   for (const Row& r : rows) {
     std::string passes;
-    for (const auto& [name, ms] : r.passes)
-      passes += (passes.empty() ? "" : ", ") + name + " " + fmt(ms, 3);
+    for (const PassTime& p : r.passes)
+      passes += (passes.empty() ? "" : ", ") + p.name + " " + withInterval(p.ms, 3);
     std::string pp = r.preset + (r.params.empty() ? "" : " " + r.params);
     o << "| " << r.scene << " | " << r.effect << " | " << pp << (onFront.count(&r) ? " *" : "")
-      << " | " << passes << " | " << fmt(r.totalMs, 4) << " | " << fmt(r.effectMs, 4) << " | "
-      << fmt(r.floorMs > 0 ? r.totalMs / r.floorMs : 0.0, 3) << " | "
+      << " | " << passes << " | " << withInterval(r.totalCi) << " | " << withInterval(r.effectCi)
+      << " | " << fmt(r.floorMs > 0 ? r.totalMs / r.floorMs : 0.0, 3) << " | "
       << fmt(r.floorMs > 0 ? r.effectMs / r.floorMs : 0.0, 3) << " | " << r.compared << " vs "
-      << r.reference << " | " << fmt(r.nrmse, 4) << " | " << fmt(r.ssim, 4) << " |\n";
+      << r.reference << " | " << fmt(r.nrmse, 4) << " | " << fmt(r.ssim, 4) << " | " << r.declared
+      << " | " << fmt(r.declaredNrmse, 4) << " | " << fmt(r.declaredSsim, 4) << " |\n";
   }
   if (anySplit(rows)) o << splitSection(rows);
   if (!plots.empty()) {
     o << "\n## Error against time\n\n";
-    for (const auto& [title, file] : plots) o << "![" << title << "](" << file << ")\n\n";
+    // The PNG shows in any viewer; the SVG beside it has tooltips and scales.
+    for (const auto& [title, file] : plots)
+      o << "![" << title << "](" << file << ".png) ([SVG](" << file << ".svg))\n\n";
   }
   return o.str();
 }
@@ -392,10 +492,14 @@ void writeResults(const std::string& dir, const std::vector<Row>& rows, const Ru
   std::vector<std::pair<std::string, std::string>> plots;
   for (const auto& key : order) {
     const std::string stem = fs::path(key.first).stem().string();
-    const std::string file = "plots/" + fileSafe(stem) + "_" + fileSafe(key.second) + ".svg";
+    const std::string file = "plots/" + fileSafe(stem) + "_" + fileSafe(key.second);
     const std::string title = stem + ": " + key.second + " (" + groups[key].front()->compared +
                               " vs " + groups[key].front()->reference + ")";
-    writeFileAtomic((fs::path(dir) / file).string(), svgPlot(title, groups[key]));
+    const Plot plot = buildPlot(title, groups[key]);
+    writeFileAtomic((fs::path(dir) / (file + ".svg")).string(), svgPlot(plot));
+    const std::string png = (fs::path(dir) / (file + ".png")).string();
+    writePng(png + ".partial", rasterPlot(plot));
+    fs::rename(png + ".partial", png);
     plots.emplace_back(title, file);
   }
   writeFileAtomic((fs::path(dir) / "results.csv").string(), csv(rows));

@@ -59,6 +59,20 @@ class AlchemyEffect : public gi::Effect {
     return i;
   }
 
+  // The Alchemy integral of eq. 10 (README "What it estimates"): sigma = intensity, u = 0,
+  // epsilon, k = contrast, within r; the bias beta is a depth-precision concession, not part
+  // of the quantity.
+  gi::EstimatedQuantity estimatedQuantity(const gi::SettingValues& s) const override {
+    gi::EstimatedQuantity q;
+    q.kind = gi::EstimatedQuantity::Kind::Alchemy;
+    q.radius = s.number("radius");
+    q.sigma = s.number("intensity");
+    q.u = 0.0;
+    q.epsilon = s.number("epsilon");
+    q.contrast = s.number("contrast");
+    return q;
+  }
+
   std::vector<gi::SettingDesc> settings() const override {
     using gi::alchemy::kMaxBlurRadius, gi::alchemy::kMaxGuardBand, gi::alchemy::kMaxSamples;
     gi::SettingDesc epsilon{"epsilon",

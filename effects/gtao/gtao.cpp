@@ -45,6 +45,9 @@ class GtaoEffect : public gi::Effect {
     i.reads = {res::kDepth, res::kNormal, res::kAlbedo};
     i.writes = {res::kAO, kBentNormal};
     i.debugView = res::kAO;
+    // Declares cosine-weighted AO of `radius` (the default estimatedQuantity): with falloff
+    // 0, thickness 0 and multi_bounce off it is the reference's quantity; those settings
+    // depart from it.
     i.estimates = gi::GroundTruth::AmbientOcclusion;
     return i;
   }

@@ -40,6 +40,9 @@ class HbaoEffect : public gi::Effect {
     i.reads = {res::kDepth, res::kNormal};
     i.writes = {res::kAO};
     i.debugView = res::kAO;
+    // Declares AO of `radius` (the default estimatedQuantity): its own quantity (README: no
+    // cosine term, elevations from the image plane, attenuation W(r) = 1 - r^2 / R^2 instead
+    // of a hard cut at R, the angle bias) has no reference, so both columns are against AO.
     i.estimates = gi::GroundTruth::AmbientOcclusion;
     return i;
   }

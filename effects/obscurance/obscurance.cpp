@@ -52,10 +52,26 @@ class ObscuranceEffect : public gi::Effect {
     i.reads = {res::kDepth, res::kNormal, res::kAlbedo, res::kEmission};
     i.writes = {res::kAO};
     i.debugView = res::kAO;
-    // It estimates obscurance (gi-reference --quantity obscurance --membership <membership>);
-    // AO is the closest ground truth an effect can declare today (equal for membership step).
+    // Its physical target is AO (equal to obscurance for membership step); what it estimates
+    // exactly is estimatedQuantity().
     i.estimates = gi::GroundTruth::AmbientOcclusion;
     return i;
+  }
+
+  // transfer off: obscurance with the membership setting (gi-reference --quantity obscurance
+  // --membership <membership>). The transfer modes output W (interreflections with the
+  // occluders' albedo or radiance), which no reference computes: they declare AO of R, their
+  // physical target, so both of gi-bench's columns are against AO.
+  gi::EstimatedQuantity estimatedQuantity(const gi::SettingValues& s) const override {
+    gi::EstimatedQuantity q;
+    q.radius = s.number("radius");
+    if (s.option("transfer") == "off") {
+      q.kind = gi::EstimatedQuantity::Kind::Obscurance;
+      q.membership = s.option("membership");
+    } else {
+      q.kind = gi::EstimatedQuantity::Kind::AmbientOcclusion;
+    }
+    return q;
   }
 
   std::vector<gi::SettingDesc> settings() const override {

@@ -47,6 +47,17 @@ class SsaoEffect : public gi::Effect {
     return i;
   }
 
+  // Obscurance with the linear membership mu(d) = d / R (ssao_kernel.h: cosine-distributed
+  // directions with distances uniform in [0, R] count a hit at d as occluding 1 - d / R of the
+  // taps). Exact for intensity 1 (the default): AO = 1 - intensity x occluded fraction.
+  gi::EstimatedQuantity estimatedQuantity(const gi::SettingValues& s) const override {
+    gi::EstimatedQuantity q;
+    q.kind = gi::EstimatedQuantity::Kind::Obscurance;
+    q.radius = s.number("radius");
+    q.membership = "linear";
+    return q;
+  }
+
   std::vector<gi::SettingDesc> settings() const override {
     return {
         gi::SettingDesc::length("radius", 0.5, 1e-6, 1e9,

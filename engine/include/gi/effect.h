@@ -19,7 +19,7 @@
 
 // Bumped whenever this header, settings.h, frame_graph.h or the shader interface change in a
 // way that breaks compiled modules; the registry refuses modules built against another value.
-#define GI_EFFECT_ABI_VERSION 4u
+#define GI_EFFECT_ABI_VERSION 5u
 
 namespace gi {
 
@@ -62,11 +62,33 @@ inline constexpr const char* kEnvironmentSampling = "environment_sampling";
 // AO) or after it (it can read the lit colour, e.g. an indirect bounce).
 enum class EffectStage { BeforeLighting, AfterLighting };
 
-// What an effect's output approximates: gi-bench compares it with that ground truth.
+// The physically meaningful target of an effect's output (EffectInfo::estimates): gi-bench
+// reports the error against it beside the error against the quantity the effect declares it
+// estimates exactly (Effect::estimatedQuantity).
 enum class GroundTruth {
   DirectLight,       // the lit image against ray-traced direct light (the default)
   AmbientOcclusion,  // its "ao" resource against ray-traced AO of its `radius` setting
   IndirectLight,     // the lit image against direct light + one diffuse bounce
+};
+
+// Exactly what an effect's output estimates, with the parameters its current settings give
+// (Effect::estimatedQuantity). Each kind is one quantity of the CPU reference renderer
+// (gi/reference/reference.h, gi-reference --quantity), so gi-bench can render it with the same
+// parameters. The AO-like kinds are read from the effect's "ao" resource, the lighting kinds
+// from the lit image.
+struct EstimatedQuantity {
+  enum class Kind {
+    AmbientOcclusion,  // binary AO of radius r, cosine-weighted (reference "ao")
+    Obscurance,        // (1/pi) int mu(t(w)) cos dw, mu = membership reaching 1 at r
+    Alchemy,           // max(0, 1 - I)^contrast, I the Alchemy integral (reference "alchemy")
+    DirectLight,       // the lit image: direct light (reference "direct")
+    DirectIndirect,    // the lit image: direct light + one diffuse bounce ("direct+indirect")
+  };
+  Kind kind = Kind::DirectLight;
+  double radius = 0.5;              // r of AO, R of obscurance, r of Alchemy (world units)
+  std::string membership = "sqrt";  // obscurance: sqrt, linear, smoothstep, step or exp
+  // Alchemy (seed 003 eq. 10): falloff g(t) = sigma t / (max(u^2, t^2) + epsilon).
+  double sigma = 1.0, u = 0.0, epsilon = 1e-4, contrast = 1.0;
 };
 
 // Camera uniforms of an extra view (EffectContext::createView): a FrameUniforms buffer the engine
@@ -122,6 +144,27 @@ class Effect {
   virtual ~Effect() = default;
   virtual EffectInfo info() const = 0;
   virtual std::vector<SettingDesc> settings() const = 0;
+  // What the output estimates exactly for these (validated) settings. The default follows
+  // info().estimates: AO of the `radius` setting (0.5 without one), direct + indirect light,
+  // or direct light. Override it when the effect computes another quantity (obscurance, the
+  // Alchemy integral, ...): gi-bench then scores it against that too. See effects/README.md.
+  virtual EstimatedQuantity estimatedQuantity(const SettingValues& settings) const {
+    EstimatedQuantity q;
+    switch (info().estimates) {
+      case GroundTruth::AmbientOcclusion:
+        q.kind = EstimatedQuantity::Kind::AmbientOcclusion;
+        for (const SettingDesc& d : settings.descs())
+          if (d.name == "radius") q.radius = settings.number("radius");
+        break;
+      case GroundTruth::IndirectLight:
+        q.kind = EstimatedQuantity::Kind::DirectIndirect;
+        break;
+      case GroundTruth::DirectLight:
+        q.kind = EstimatedQuantity::Kind::DirectLight;
+        break;
+    }
+    return q;
+  }
   // Creates pipelines and other long-lived objects; called again only when a setting marked
   // `changesGraph` changed. `settings` are validated against settings().
   virtual void prepare(EffectContext& ctx, const SettingValues& settings) = 0;
