@@ -131,6 +131,36 @@ TEST_F(SsdoTest, OpenPlaneUnderAConstantEnvironmentIsAlbedoTimesRadiance) {
   EXPECT_GT(checked, int(kW * kH) / 3);
 }
 
+// The same under a constant equirect map (environment kind 2, whose samples the shader sums
+// through the SH9's moments): the SH of a constant map is that constant, so ambient = albedo x
+// L again. Tolerance 2%: the map's RGBE quantization and the SH projection's quadrature.
+TEST_F(SsdoTest, OpenPlaneUnderAConstantMapIsAlbedoTimesRadiance) {
+  const std::string dir = ::testing::TempDir();
+  {
+    std::ofstream out(dir + "/ssdo_flat.hdr", std::ios::binary);
+    out << "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 8 +X 16\n";
+    const unsigned char px[4] = {128, 96, 64, 128};  // (0.5, 0.375, 0.25)
+    for (int i = 0; i < 16 * 8; ++i) out.write(reinterpret_cast<const char*>(px), 4);
+  }
+  const Scene s = jsonScene("map", R"({
+      "models": [ { "primitive": "plane", "size": 40, "material": { "base_color": [0.5, 0.5, 0.5] } } ],
+      "lights": [ { "type": "directional", "intensity": 0, "casts_shadows": false } ],
+      "camera": { "position": [0, 2, 3], "target": [0, 0, 0] },
+      "environment": { "type": "map", "file": ")" +
+                                       dir + R"(/ssdo_flat.hdr" } })");
+  const Result r = render(s, {});
+  const glm::vec3 expected = 0.5f * glm::vec3(0.5f, 0.375f, 0.25f);
+  int checked = 0;
+  for (int y = 0; y < r.h; ++y)
+    for (int x = 0; x < r.w; ++x) {
+      if (r.sky(x, y)) continue;
+      ++checked;
+      for (int c = 0; c < 3; ++c)
+        ASSERT_NEAR(r.px(r.ambient, x, y)[c], expected[c], 0.02f * expected[c]) << x << "," << y;
+    }
+  EXPECT_GT(checked, int(kW * kH) / 3);
+}
+
 // A box on a floor under a sky whose zenith is red and whose horizon and ground are blue. Next
 // to the box the blocked directions are mostly low (toward the box's wall at small elevation
 // more of the step reaches it), i.e. bluish: SSDO's shadow there turns redder than the open

@@ -12,13 +12,18 @@
 //                                                              (x albedo later: `indirect`)
 // with A_s = pi R^2 / N x bounce_strength, cos_s = max(N_s . -r, 0) (back-facing senders give
 // nothing), cos_r = max(N . r, 0), r the unit vector from P to S_i at distance d.
-// L_env is the environment in world direction w_i through environmentRadiance() (exact for the
-// procedural sky and constant environments; for an equirect map its SH9 low-frequency part).
+// L_env is the environment in world direction w_i as environmentRadiance() gives it (exact for
+// the procedural sky and constant environments; for an equirect map its SH9 low-frequency
+// part, irradiance / pi, summed through the open samples' moments: SH9 is quadratic in the
+// direction), specialized to the environment's kind.
 // Writes the raw terms with what the blur needs (ssdo_common.glsl).
 layout(local_size_x = 32, local_size_y = 16) in;
 
 layout(constant_id = 0) const int kSamples = 12;  // 1..gi::ssdo::kMaxSamples: the loop unrolls
 layout(constant_id = 1) const bool kBounce = true;
+// The environment's kind (FrameUniforms.skyHorizon.w: 0 sky, 1 constant, 2 equirect map):
+// evaluating all three per sample (llvmpipe runs every branch) would cost most of the pass.
+layout(constant_id = 2) const int kEnvironmentKind = 0;
 
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 #include "ssdo_common.glsl"
@@ -37,6 +42,25 @@ const float kSlideMinK = 1e-4;
 vec3 clipToPixels(vec3 v, float p00, float p11, float p20, float p21, vec2 halfSize) {
   float w = -v.z;
   return vec3((vec2(p00 * v.x + p20 * v.z, p11 * v.y + p21 * v.z) + w) * halfSize, w);
+}
+
+// Sum over the open samples of the SH9 irradiance / pi (environmentIrradianceOverPi, without
+// its per-direction clamp at 0: the sum is clamped) from the samples' count and moments in the
+// tangent frame F (columns T', B', N in world space): sum d = F m1, sum d d^T = F S F^T.
+vec3 shFromMoments(float count, vec3 m1, vec3 m2, vec3 m2x, mat3 F) {
+  mat3 S = mat3(m2.x, m2x.x, m2x.y, m2x.x, m2.y, m2x.z, m2x.y, m2x.z, m2.z);
+  mat3 D = F * S * transpose(F);  // D[j][i] = sum d_i d_j
+  vec3 d = F * m1;
+  vec3 e = frame.irradianceSH[0].rgb * (0.282095 * count) +
+           frame.irradianceSH[1].rgb * (0.488603 * d.y) +
+           frame.irradianceSH[2].rgb * (0.488603 * d.z) +
+           frame.irradianceSH[3].rgb * (0.488603 * d.x) +
+           frame.irradianceSH[4].rgb * (1.092548 * D[1][0]) +
+           frame.irradianceSH[5].rgb * (1.092548 * D[2][1]) +
+           frame.irradianceSH[6].rgb * (0.315392 * (3.0 * D[2][2] - count)) +
+           frame.irradianceSH[7].rgb * (1.092548 * D[2][0]) +
+           frame.irradianceSH[8].rgb * (0.546274 * (D[0][0] - D[1][1]));
+  return max(e, vec3(0.0)) * (1.0 / 3.14159265358979);
 }
 
 void main() {
@@ -67,7 +91,7 @@ void main() {
   vec3 T = vec3(1.0 + sg * N.x * N.x * a, sg * b, -sg * N.x);
   vec3 B = vec3(b, sg + N.y * N.y * a, -N.y);
   mat3 toWorld = mat3(frame.invView);
-  vec3 Tw = toWorld * T, Bw = toWorld * B, Nw = toWorld * N;
+  vec3 Tw = toWorld * T, Bw = toWorld * B, Nw = toWorld * N;  // world frame of the samples
 
   float R = ssdo.params.x;
   vec2 halfSize = 0.5 * vec2(size);
@@ -87,7 +111,13 @@ void main() {
   float bias = ssdo.params.y;
   float dMin2 = ssdo.params.w;
   int base = ((p.y & 3) * 4 + (p.x & 3)) * 32;
+  // Sky: the radiance depends on the world direction's y only, y = up . (T' kx + B' ky + N kz).
+  vec3 up = vec3(Tw.y, Bw.y, Nw.y);
+  vec3 skyZenith = frame.skyZenith.rgb * frame.skyZenith.w,
+       skyHorizon = frame.skyHorizon.rgb * frame.skyZenith.w,
+       skyGround = frame.skyGround.rgb * frame.skyZenith.w;
   vec3 direct = vec3(0.0), bounce = vec3(0.0);
+  vec3 m1 = vec3(0.0), m2 = vec3(0.0), m2x = vec3(0.0);  // kind 2: sums of k, k_i^2, k_i k_j
   for (int i = 0; i < kSamples; ++i) {
     int f = base + i;
     uint code = ssdo.samples[f >> 2][f & 3];
@@ -113,8 +143,21 @@ void main() {
     float diff = iS - iQ, prod = iS * iQ;
     bool blocked = valid && diff > max(bias * prod, kDepthResolution * iS) && diff < R * prod;
 
-    vec3 dirWorld = Tw * kx + Bw * ky + Nw * kz;
-    direct += blocked ? vec3(0.0) : environmentRadiance(frame, dirWorld);
+    if (kEnvironmentKind == 1) {
+      direct.x += blocked ? 0.0 : 1.0;  // constant: count the open directions
+    } else if (kEnvironmentKind == 2) {
+      // SH9 (a quadratic polynomial of the direction): the open directions' moments suffice.
+      vec3 k = vec3(kx, ky, kz);
+      float open = blocked ? 0.0 : 1.0;
+      direct.x += open;
+      m1 += open * k;
+      m2 += open * k * k;
+      m2x += open * vec3(kx * ky, kx * kz, ky * kz);
+    } else {
+      float y = clamp(dot(up, vec3(kx, ky, kz)), -1.0, 1.0);
+      vec3 sky = mix(skyHorizon, y >= 0.0 ? skyZenith : skyGround, sqrt(abs(y)));
+      direct += blocked ? vec3(0.0) : sky;
+    }
     if (kBounce) {
       vec3 S = ssdoViewPosition(vec2(t) + 0.5, max(iS, 1e-30), invSize, p00, p11, p20, p21);
       vec3 d = S - P;
@@ -128,6 +171,8 @@ void main() {
       bounce += blocked ? Ls * (cosS * cosR / max(d2, dMin2)) : vec3(0.0);
     }
   }
+  if (kEnvironmentKind == 1) direct = direct.x * frame.skyGround.rgb * frame.skyZenith.w;
+  if (kEnvironmentKind == 2) direct = shFromMoments(direct.x, m1, m2, m2x, mat3(Tw, Bw, Nw));
   direct *= 1.0 / float(kSamples);
   bounce *= ssdo.params.z;
   imageStore(outRaw, p,

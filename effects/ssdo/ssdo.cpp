@@ -5,6 +5,7 @@
 // "ambient" (alpha 1: replaces the engine's environment x AO term) and "indirect" (added).
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -145,9 +146,12 @@ class SsdoEffect : public gi::Effect {
         },
         [this, io, values = &settings, frame, nearest, ubo, c = &ctx](gi::PassContext& pc) {
           upload(*values);
-          // Light types can change without a graph rebuild: the specialized pipeline follows.
+          // Light types and the environment's kind can change without a graph rebuild: the
+          // specialized pipelines follow (built here, before the dispatches that use them).
           const auto masks = lightMasks(c->lights());
           if (masks != surfaceMasks_) buildSurface(*c, masks);
+          const uint32_t kind = environmentKind(c->frame());
+          if (kind != environmentKind_) buildSsdo(*c, kind);
           gi::vk::DescriptorWriter w;
           w.buffer(0, ubo, frame)
               .buffer(1, ubo, uniforms_.handle())
@@ -227,6 +231,20 @@ class SsdoEffect : public gi::Effect {
   }
 
  private:
+  static uint32_t environmentKind(const gi::FrameUniforms& f) {
+    return uint32_t(std::clamp(int(std::lround(f.skyHorizon.w)), 0, 2));
+  }
+
+  void buildSsdo(gi::EffectContext& ctx, uint32_t kind) {
+    const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
+               tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+               img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+    ssdo_ = gi::vk::Pipeline::compute(ctx.vulkan(), {std::begin(ssdo_comp), std::end(ssdo_comp)},
+                                      {{0, ubo}, {1, ubo}, {2, tex}, {3, img}}, 0,
+                                      {samples_, bounce_ ? 1u : 0u, kind});
+    environmentKind_ = kind;
+  }
+
   void buildSurface(gi::EffectContext& ctx, std::array<uint32_t, 2> masks) {
     const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
                tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
@@ -286,6 +304,7 @@ class SsdoEffect : public gi::Effect {
   gi::vk::Pipeline surface_, ssdo_, blurX_, resolve_;
   gi::vk::Buffer uniforms_;
   bool bounce_ = true;
+  uint32_t samples_ = 12, environmentKind_ = 0;
   std::array<uint32_t, 2> surfaceMasks_{7, 7};
   std::optional<std::array<double, 5>> uploaded_;
 };

@@ -22,6 +22,14 @@ uint packNormal(vec3 n) {
   vec2 e = n.z >= 0.0 ? n.xy : (1.0 - abs(n.yx)) * ssdoSignNotZero(n.xy);
   return packSnorm2x16(e);
 }
+// The octahedral decode without normalization (length in [1/sqrt(3), 1]).
+vec3 unpackNormalUnnormalized(uint p) {
+  vec2 e = unpackSnorm2x16(p);
+  vec3 n = vec3(e, 1.0 - abs(e.x) - abs(e.y));
+  float t = max(-n.z, 0.0);
+  n.xy -= t * ssdoSignNotZero(n.xy);
+  return n;
+}
 vec3 unpackNormal(uint p) {
   vec2 e = unpackSnorm2x16(p);
   vec3 n = vec3(e, 1.0 - abs(e.x) - abs(e.y));
@@ -47,9 +55,25 @@ uint packRgb9e5(vec3 c) {
   return q.r | (q.g << 9) | (q.b << 18) | (uint(clamp(e, 0, 31)) << 27);
 }
 vec3 unpackRgb9e5(uint p) {
-  return vec3(uvec3(p, p >> 9, p >> 18) & 511u) * exp2(float(int(p >> 27) - 24));
+  // 2^(e - 24) built from its bits (e - 24 + 127 in [103, 134]: a normal float): no exp2.
+  float scale = uintBitsToFloat(((p >> 27) + 103u) << 23);
+  return vec3(uvec3(p, p >> 9, p >> 18) & 511u) * scale;
 }
 
+// environmentIrradianceOverPi (common.glsl) reading `frame` in place: the common.glsl helpers
+// take FrameUniforms by value, and uniform-block reads inside the sample loop cost llvmpipe
+// dearly (the sky through them was 2/3 of the SSDO pass; hoisted out of the loop, a tenth).
+vec3 ssdoIrradianceOverPi(vec3 n) {
+  float x = n.x, y = n.y, z = n.z;
+  vec3 e = frame.irradianceSH[0].rgb * 0.282095 + frame.irradianceSH[1].rgb * (0.488603 * y) +
+           frame.irradianceSH[2].rgb * (0.488603 * z) + frame.irradianceSH[3].rgb * (0.488603 * x) +
+           frame.irradianceSH[4].rgb * (1.092548 * x * y) +
+           frame.irradianceSH[5].rgb * (1.092548 * y * z) +
+           frame.irradianceSH[6].rgb * (0.315392 * (3.0 * z * z - 1.0)) +
+           frame.irradianceSH[7].rgb * (1.092548 * x * z) +
+           frame.irradianceSH[8].rgb * (0.546274 * (x * x - y * y));
+  return max(e, vec3(0.0)) * (1.0 / 3.14159265358979);
+}
 // View-space position of pixel-centre coordinates `pix` (pixels) at inverse view distance `iz`
 // (> 0), for the perspective projection's non-zero terms.
 vec3 ssdoViewPosition(vec2 pix, float iz, vec2 invSize, float p00, float p11, float p20,

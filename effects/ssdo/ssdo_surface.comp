@@ -66,7 +66,7 @@ void main() {
     vec3 nWorld = mat3(frame.invView) * n;
     radiance = texelFetch(gEmission, p, 0).rgb +
                diffuse * (irradiance * (1.0 / 3.14159265358979) +
-                          environmentIrradianceOverPi(frame, nWorld));
+                          ssdoIrradianceOverPi(nWorld));
     // Guard: half floats overflow to inf above 65504; non-finite inputs read 0.
     radiance = geometry ? clamp(radiance, vec3(0.0), vec3(65000.0)) : vec3(0.0);
     radiance = vec3(isnan(radiance.r) ? 0.0 : radiance.r, isnan(radiance.g) ? 0.0 : radiance.g,
