@@ -333,6 +333,27 @@ TEST_F(SsdoTest, PassListFollowsBounceAndBlurAndBounceOffKeepsTheDirectionalTerm
   EXPECT_GT(maxOn, 0.0f);
 }
 
+// Sender shadows: without them a sender's radiance can only grow (its lights are no longer
+// shadowed), so the bounce grows or stays everywhere (the sum is monotone in L_s and the blur
+// weights do not depend on it), and strictly somewhere in the default scene's shadowed room.
+TEST_F(SsdoTest, SenderShadowsOnlyRemoveBounceLight) {
+  const Scene scene = makeDefaultScene();
+  const Result on = render(scene, {"ssdo.sender_shadows=true"});
+  const Result off = render(scene, {"ssdo.sender_shadows=false"});
+  ASSERT_TRUE(finite(on.indirect));
+  ASSERT_TRUE(finite(off.indirect));
+  double gained = 0.0;
+  for (size_t i = 0; i < on.indirect.pixels.size(); ++i) {
+    if (i % 4 == 3) continue;
+    const float a = on.indirect.pixels[i], b = off.indirect.pixels[i];
+    // rgb9e5 (2^-9 of the largest channel) and half rounding, per term and after the blur.
+    ASSERT_GE(b, a - 0.01f * std::max(a, 1e-3f)) << "component " << i;
+    gained += b - a;
+  }
+  std::printf("indirect gained without sender shadows: %.3f (sum over components)\n", gained);
+  EXPECT_GT(gained, 1.0) << "the room's shadowed senders must matter";
+}
+
 // The sample table: every pixel phase has its set, the 16 sets together are one stratified
 // set (each of the 16 N azimuth strata holds one sample), and the packing round-trips.
 TEST(SsdoSamples, SetsPartitionOneStratifiedSet) {

@@ -85,6 +85,10 @@ class SsdoEffect : public gi::Effect {
         gi::SettingDesc::length("distance_clamp", 0.1, 1e-6, 1e9,
                                 "bounce guard: the sender distance d is clamped to at least "
                                 "this (1 / max(d^2, d_min^2))"),
+        {"sender_shadows", SettingType::Bool, 1, 0, 1,
+         "shadow maps in the senders' direct light (off: senders in shadow glow, but the "
+         "surface pass costs about a third: the point lights' per-pixel cube-face lookup)",
+         true},
         {"blur_radius", SettingType::Int, 2, 0, gi::ssdo::kMaxBlurRadius,
          "geometry-aware blur radius in pixels (0: none; even radii cancel the 4x4 pattern)", true},
     };
@@ -97,6 +101,7 @@ class SsdoEffect : public gi::Effect {
                tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
                img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
     bounce_ = settings.flag("bounce");
+    senderShadows_ = settings.flag("sender_shadows");
     buildSurface(ctx, lightMasks(ctx.lights()));
     ssdo_ = gi::vk::Pipeline::compute(
         vk, {std::begin(ssdo_comp), std::end(ssdo_comp)}, {{0, ubo}, {1, ubo}, {2, tex}, {3, img}},
@@ -262,7 +267,7 @@ class SsdoEffect : public gi::Effect {
          {8, ubo},
          {9, tex},
          {10, img}},
-        0, {bounce_ ? 1u : 0u, masks[0], masks[1]});
+        0, {bounce_ ? 1u : 0u, masks[0], senderShadows_ ? masks[1] : 0u});
     surfaceMasks_ = masks;
   }
 
@@ -303,7 +308,7 @@ class SsdoEffect : public gi::Effect {
 
   gi::vk::Pipeline surface_, ssdo_, blurX_, resolve_;
   gi::vk::Buffer uniforms_;
-  bool bounce_ = true;
+  bool bounce_ = true, senderShadows_ = true;
   uint32_t samples_ = 12, environmentKind_ = 0;
   std::array<uint32_t, 2> surfaceMasks_{7, 7};
   std::optional<std::array<double, 5>> uploaded_;
