@@ -1,0 +1,319 @@
+// Screen-space directional occlusion with one indirect bounce (Ritschel, Grosch, Seidel 2009;
+// seed 000; README.md). Four dispatches: per pixel what a tap reads (1/z, normal, sender
+// radiance: ssdo_surface.comp), the samples (ssdo.comp), a geometry-aware separable blur whose
+// y half multiplies by the diffuse albedo (ssdo_blur_x.comp, ssdo_resolve.comp). Publishes
+// "ambient" (alpha 1: replaces the engine's environment x AO term) and "indirect" (added).
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "gi/effect.h"
+#include "gi/effect_registry.h"
+#include "gi/lights.h"
+#include "gi/vk/pipeline.h"
+#include "gi/vk/resources.h"
+#include "ssdo.comp.h"          // const uint32_t ssdo_comp[]
+#include "ssdo_blur_x.comp.h"   // const uint32_t ssdo_blur_x_comp[]
+#include "ssdo_resolve.comp.h"  // const uint32_t ssdo_resolve_comp[]
+#include "ssdo_samples.h"
+#include "ssdo_surface.comp.h"  // const uint32_t ssdo_surface_comp[]
+
+namespace {
+
+namespace res = gi::resources;
+using gi::SettingType;
+
+// Surface and raw texels pack four 32-bit words each (ssdo_common.glsl): one fetch per tap.
+constexpr VkFormat kPackedFormat = VK_FORMAT_R32G32B32A32_UINT;
+constexpr VkFormat kOutFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
+constexpr uint32_t kGroupX = 32, kGroupY = 16;  // local_size of every SSDO shader
+
+uint32_t groupsOf(uint32_t n, uint32_t size) {
+  return (n + size - 1) / size;
+}
+
+// Bit masks of the light types present and of those with shadow maps (1 directional, 2 point,
+// 4 spot), as the lighting pass's specialization constants.
+std::array<uint32_t, 2> lightMasks(const std::vector<gi::LightInfo>& lights) {
+  std::array<uint32_t, 2> m{0, 0};
+  for (const gi::LightInfo& l : lights) {
+    const uint32_t bit = 1u << uint32_t(l.type);
+    m[0] |= bit;
+    if (l.shadowLayer >= 0) m[1] |= bit;
+  }
+  return m;
+}
+
+class SsdoEffect : public gi::Effect {
+ public:
+  gi::EffectInfo info() const override {
+    gi::EffectInfo i;
+    i.name = "ssdo";
+    i.version = "1.0";
+    i.description =
+        "screen-space directional occlusion of the environment with one indirect bounce "
+        "(Ritschel et al. 2009; 16 interleaved sample sets, geometry-aware blur)";
+    i.stage = gi::EffectStage::BeforeLighting;
+    i.reads = {res::kDepth,    res::kNormal, res::kAlbedo,      res::kMaterial,
+               res::kEmission, res::kLights, res::kShadowViews, res::kShadowMaps};
+    i.writes = {res::kAmbient, res::kIndirect};
+    i.debugView = res::kAmbient;
+    i.estimates = gi::GroundTruth::IndirectLight;
+    return i;
+  }
+
+  std::vector<gi::SettingDesc> settings() const override {
+    return {
+        gi::SettingDesc::length("radius", 0.5, 1e-6, 1e9,
+                                "world-space length r_max of the sample steps (and the range "
+                                "beyond which an occluder is ignored)"),
+        {"samples", SettingType::Int, 12, 1, gi::ssdo::kMaxSamples,
+         "samples N per pixel (a specialization constant: the loop unrolls)", true},
+        {"pattern_sets", SettingType::Int, 16, 1, gi::ssdo::kPhases,
+         "M precomputed sample sets spread over the 4x4 pixel pattern (16: every phase its "
+         "own set; the blur averages them)",
+         false},
+        {"bounce", SettingType::Bool, 1, 0, 1,
+         "one indirect bounce from the occluding samples (off: directional occlusion only, "
+         "\"indirect\" is 0)",
+         true},
+        {"bounce_strength", SettingType::Float, 1.0, 0.0, 16.0,
+         "scales the sender area A_s = pi r_max^2 / N", false},
+        gi::SettingDesc::length("distance_clamp", 0.1, 1e-6, 1e9,
+                                "bounce guard: the sender distance d is clamped to at least "
+                                "this (1 / max(d^2, d_min^2))"),
+        {"sender_shadows", SettingType::Bool, 1, 0, 1,
+         "shadow maps in the senders' direct light (off: senders in shadow glow, but the "
+         "surface pass costs about a third: the point lights' per-pixel cube-face lookup)",
+         true},
+        {"blur_radius", SettingType::Int, 2, 0, gi::ssdo::kMaxBlurRadius,
+         "geometry-aware blur radius in pixels (0: none; even radii cancel the 4x4 pattern)", true},
+    };
+  }
+
+  void prepare(gi::EffectContext& ctx, const gi::SettingValues& settings) override {
+    gi::vk::Context& vk = ctx.vulkan();
+    vk.requireWorkgroup(kGroupX, kGroupY, "ssdo");
+    const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
+               tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+               img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+    bounce_ = settings.flag("bounce");
+    senderShadows_ = settings.flag("sender_shadows");
+    buildSurface(ctx, lightMasks(ctx.lights()));
+    ssdo_ = gi::vk::Pipeline::compute(
+        vk, {std::begin(ssdo_comp), std::end(ssdo_comp)}, {{0, ubo}, {1, ubo}, {2, tex}, {3, img}},
+        0,
+        {uint32_t(std::clamp(settings.integer("samples"), 1, gi::ssdo::kMaxSamples)),
+         bounce_ ? 1u : 0u});
+    const std::vector<uint32_t> radius = {
+        uint32_t(std::clamp(settings.integer("blur_radius"), 0, gi::ssdo::kMaxBlurRadius))};
+    blurX_ =
+        gi::vk::Pipeline::compute(vk, {std::begin(ssdo_blur_x_comp), std::end(ssdo_blur_x_comp)},
+                                  {{0, ubo}, {1, ubo}, {2, tex}, {3, img}}, 0, radius);
+    resolve_ = gi::vk::Pipeline::compute(
+        vk, {std::begin(ssdo_resolve_comp), std::end(ssdo_resolve_comp)},
+        {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, tex}, {5, img}, {6, img}}, 0, radius);
+    if (!uniforms_)
+      uniforms_ =
+          gi::vk::Buffer(vk, sizeof(gi::ssdo::Uniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true);
+  }
+
+  void addPasses(gi::FrameGraph& graph, gi::EffectContext& ctx,
+                 const gi::SettingValues& settings) override {
+    struct Io {
+      gi::TextureHandle depth, normal, albedo, material, emission, shadowMaps;
+      gi::BufferHandle lights, shadowViews;
+      gi::TextureHandle surface, raw, half, ambient, indirect;
+    };
+    auto io = std::make_shared<Io>();
+    gi::Blackboard& bb = graph.blackboard();
+    const int blurRadius = settings.integer("blur_radius");  // changesGraph: fixed per graph
+    const VkBuffer frame = ctx.frameUniforms();
+    const VkSampler nearest = ctx.nearestSampler();
+    const VkDescriptorType ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
+
+    graph.addPass(
+        "ssdo_surface",
+        [&](gi::PassBuilder& b) {
+          io->depth = b.read(bb.texture(res::kDepth));
+          io->normal = b.read(bb.texture(res::kNormal));
+          io->albedo = b.read(bb.texture(res::kAlbedo));
+          io->material = b.read(bb.texture(res::kMaterial));
+          io->emission = b.read(bb.texture(res::kEmission));
+          io->lights = b.read(bb.buffer(res::kLights));
+          io->shadowViews = b.read(bb.buffer(res::kShadowViews));
+          io->shadowMaps = b.read(bb.texture(res::kShadowMaps));
+          io->surface = b.write(b.create("ssdo_surface", gi::TextureDesc{kPackedFormat}),
+                                gi::TextureUsage::StorageWrite);
+        },
+        [this, io, values = &settings, frame, nearest, ubo, c = &ctx](gi::PassContext& pc) {
+          upload(*values);
+          // Light types and the environment's kind can change without a graph rebuild: the
+          // specialized pipelines follow (built here, before the dispatches that use them).
+          const auto masks = lightMasks(c->lights());
+          if (masks != surfaceMasks_) buildSurface(*c, masks);
+          const uint32_t kind = environmentKind(c->frame());
+          if (kind != environmentKind_) buildSsdo(*c, kind);
+          gi::vk::DescriptorWriter w;
+          w.buffer(0, ubo, frame)
+              .buffer(1, ubo, uniforms_.handle())
+              .sampled(2, pc.view(io->depth), nearest)
+              .sampled(3, pc.view(io->normal), nearest)
+              .sampled(4, pc.view(io->albedo), nearest)
+              .sampled(5, pc.view(io->material), nearest)
+              .sampled(6, pc.view(io->emission), nearest)
+              .buffer(7, ubo, pc.buffer(io->lights))
+              .buffer(8, ubo, pc.buffer(io->shadowViews))
+              .sampled(9, pc.view(io->shadowMaps), nearest)
+              .storageImage(10, pc.view(io->surface));
+          const VkExtent2D e = pc.extent(io->surface);
+          dispatch(pc, surface_, w, e);
+        });
+
+    graph.addPass(
+        "ssdo",
+        [&](gi::PassBuilder& b) {
+          io->surface = b.read(io->surface);
+          io->raw = b.write(b.create("ssdo_raw", gi::TextureDesc{kPackedFormat}),
+                            gi::TextureUsage::StorageWrite);
+        },
+        [this, io, frame, nearest, ubo](gi::PassContext& pc) {
+          gi::vk::DescriptorWriter w;
+          w.buffer(0, ubo, frame)
+              .buffer(1, ubo, uniforms_.handle())
+              .sampled(2, pc.view(io->surface), nearest)
+              .storageImage(3, pc.view(io->raw));
+          dispatch(pc, ssdo_, w, pc.extent(io->raw));
+        });
+
+    // Blur along x into `half`, then along y with the albedo into the outputs (radius 0: only
+    // the albedo, pass "ssdo_resolve").
+    graph.addPass(
+        blurRadius > 0 ? "ssdo_blur" : "ssdo_resolve",
+        [&](gi::PassBuilder& b) {
+          io->raw = b.read(io->raw);
+          io->albedo = b.read(bb.texture(res::kAlbedo));
+          io->material = b.read(bb.texture(res::kMaterial));
+          if (blurRadius > 0)
+            io->half = b.write(b.create("ssdo_blur_x", gi::TextureDesc{kPackedFormat}),
+                               gi::TextureUsage::StorageWrite);
+          io->ambient = b.write(b.create(res::kAmbient, gi::TextureDesc{kOutFormat}),
+                                gi::TextureUsage::StorageWrite);
+          io->indirect = b.write(b.create(res::kIndirect, gi::TextureDesc{kOutFormat}),
+                                 gi::TextureUsage::StorageWrite);
+        },
+        [this, io, frame, nearest, ubo, blurRadius](gi::PassContext& pc) {
+          const VkExtent2D e = pc.extent(io->ambient);
+          VkImageView in = pc.view(io->raw);
+          VkImageLayout inLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+          if (blurRadius > 0) {
+            gi::vk::DescriptorWriter w;
+            w.buffer(0, ubo, frame)
+                .buffer(1, ubo, uniforms_.handle())
+                .sampled(2, in, nearest, inLayout)
+                .storageImage(3, pc.view(io->half));
+            dispatch(pc, blurX_, w, e);
+            // The y dispatch reads what the x dispatch wrote (the image stays GENERAL).
+            imageBarrier(pc.cmd(), pc.image(io->half));
+            in = pc.view(io->half);
+            inLayout = VK_IMAGE_LAYOUT_GENERAL;
+          }
+          gi::vk::DescriptorWriter w;
+          w.buffer(0, ubo, frame)
+              .buffer(1, ubo, uniforms_.handle())
+              .sampled(2, in, nearest, inLayout)
+              .sampled(3, pc.view(io->albedo), nearest)
+              .sampled(4, pc.view(io->material), nearest)
+              .storageImage(5, pc.view(io->ambient))
+              .storageImage(6, pc.view(io->indirect));
+          dispatch(pc, resolve_, w, e);
+        });
+    bb.put(res::kAmbient, io->ambient);
+    bb.put(res::kIndirect, io->indirect);
+  }
+
+ private:
+  static uint32_t environmentKind(const gi::FrameUniforms& f) {
+    return uint32_t(std::clamp(int(std::lround(f.skyHorizon.w)), 0, 2));
+  }
+
+  void buildSsdo(gi::EffectContext& ctx, uint32_t kind) {
+    const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
+               tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+               img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+    ssdo_ = gi::vk::Pipeline::compute(ctx.vulkan(), {std::begin(ssdo_comp), std::end(ssdo_comp)},
+                                      {{0, ubo}, {1, ubo}, {2, tex}, {3, img}}, 0,
+                                      {samples_, bounce_ ? 1u : 0u, kind});
+    environmentKind_ = kind;
+  }
+
+  void buildSurface(gi::EffectContext& ctx, std::array<uint32_t, 2> masks) {
+    const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
+               tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+               img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+    surface_ = gi::vk::Pipeline::compute(
+        ctx.vulkan(), {std::begin(ssdo_surface_comp), std::end(ssdo_surface_comp)},
+        {{0, ubo},
+         {1, ubo},
+         {2, tex},
+         {3, tex},
+         {4, tex},
+         {5, tex},
+         {6, tex},
+         {7, ubo},
+         {8, ubo},
+         {9, tex},
+         {10, img}},
+        0, {bounce_ ? 1u : 0u, masks[0], senderShadows_ ? masks[1] : 0u});
+    surfaceMasks_ = masks;
+  }
+
+  // Host-visible, written while recording: the renderer waits for each frame before it records
+  // the next. Rebuilt only when a setting changed since the last upload.
+  void upload(const gi::SettingValues& s) {
+    const std::array<double, 5> key = {s.number("radius"), double(s.integer("samples")),
+                                       double(s.integer("pattern_sets")),
+                                       s.number("bounce_strength"), s.number("distance_clamp")};
+    if (key == uploaded_) return;
+    const gi::ssdo::Uniforms u =
+        gi::ssdo::makeUniforms(key[0], int(key[1]), int(key[2]), key[3], key[4]);
+    uniforms_.write(&u, sizeof u);
+    uploaded_ = key;
+  }
+
+  static void dispatch(gi::PassContext& pc, const gi::vk::Pipeline& p, gi::vk::DescriptorWriter& w,
+                       VkExtent2D e) {
+    pc.descriptors().bind(pc.cmd(), p, w);
+    vkCmdDispatch(pc.cmd(), groupsOf(e.width, kGroupX), groupsOf(e.height, kGroupY), 1);
+  }
+
+  // Compute write -> compute sampled read of a storage image that stays in GENERAL.
+  static void imageBarrier(VkCommandBuffer cmd, VkImage image) {
+    VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
+    b.srcStageMask = b.dstStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+    b.srcAccessMask = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
+    b.dstAccessMask = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT;
+    b.oldLayout = b.newLayout = VK_IMAGE_LAYOUT_GENERAL;
+    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    b.image = image;
+    b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+    VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+    dep.imageMemoryBarrierCount = 1;
+    dep.pImageMemoryBarriers = &b;
+    vkCmdPipelineBarrier2(cmd, &dep);
+  }
+
+  gi::vk::Pipeline surface_, ssdo_, blurX_, resolve_;
+  gi::vk::Buffer uniforms_;
+  bool bounce_ = true, senderShadows_ = true;
+  uint32_t samples_ = 12, environmentKind_ = 0;
+  std::array<uint32_t, 2> surfaceMasks_{7, 7};
+  std::optional<std::array<double, 5>> uploaded_;
+};
+
+}  // namespace
+
+GI_EFFECT_MODULE(SsdoEffect)

@@ -1,0 +1,62 @@
+// Geometry-aware (cross-bilateral) blur of the raw SSDO terms along one axis, included by
+// ssdo_blur_x.comp (writes the packed texel again) and ssdo_resolve.comp (y axis, then x
+// diffuse albedo: writes `ambient` and `indirect`). One fetch per tap: the raw texel carries
+// both terms, 1 / view distance and the normal (ssdo_common.glsl).
+// Weights: a box of width 2 radius with half-weight ends, so for even radii every phase of the
+// 4x4 sample-set pattern gets the same weight and the pattern cancels on flat regions (as in
+// effects/ssao). Edge stopping: a neighbour gets weight 0 when its view distance differs by
+// more than the tolerance from the centre's tangent plane extended to it (depth
+// discontinuities, creases) or its normal differs by more than acos(min cosine).
+//
+// Include after defining GI_BLUR_AXIS (0: x, 1: y) and declaring the outputs.
+layout(local_size_x = 32, local_size_y = 16) in;
+
+layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
+#include "ssdo_common.glsl"
+layout(set = 0, binding = 2) uniform usampler2D inRaw;
+layout(constant_id = 0) const int kRadius = 2;  // 0..gi::ssdo::kMaxBlurRadius: the loop unrolls
+
+// The blurred terms of pixel p; `centre` is its raw texel.
+void ssdoBlur(ivec2 p, ivec2 size, uvec4 centre, out vec3 direct, out vec3 bounce) {
+  const ivec2 axis = GI_BLUR_AXIS == 0 ? ivec2(1, 0) : ivec2(0, 1);
+  mat4 proj = frame.proj;
+  float p00 = abs(proj[0][0]) > 1e-30 ? proj[0][0] : 1e-30;
+  float p11 = abs(proj[1][1]) > 1e-30 ? proj[1][1] : 1e-30;
+  float p20 = proj[2][0], p21 = proj[2][1];
+  vec2 invSize = frame.viewport.zw;
+  float ic = uintBitsToFloat(centre.z);
+  vec3 N = unpackNormal(centre.w);
+  // The centre's tangent plane predicts 1/z along the axis: 1/z is affine in screen space on a
+  // plane, d(1/z)/dpixel = (1/z) N.xy dD / (N.D) for the view ray D (z = -1) (effects/ssao).
+  // Guard: a grazing plane (N.D near 0) predicts a constant.
+  vec2 ndc = (vec2(p) + 0.5) * 2.0 * invSize - 1.0;
+  vec3 D = vec3((ndc.x + p20) / p00, (ndc.y + p21) / p11, -1.0);
+  float nd = dot(N, D);
+  vec2 dD = 2.0 * invSize / vec2(p00, p11);
+  vec2 slopes = nd < -1e-4 * length(D) ? ic * N.xy * dD / nd : vec2(0.0);
+  float slope = GI_BLUR_AXIS == 0 ? slopes.x : slopes.y;
+  float tol = ssdo.blur.x, minCos2 = ssdo.blur.y * ssdo.blur.y;
+  direct = unpackRgb9e5(centre.x);
+  bounce = unpackRgb9e5(centre.y);
+  float weights = 1.0;
+  for (int o = -kRadius; o <= kRadius; ++o) {
+    if (o == 0) continue;
+    ivec2 q = p + o * axis;
+    bool inside = q.x >= 0 && q.y >= 0 && q.x < size.x && q.y < size.y;
+    uvec4 t = texelFetch(inRaw, clamp(q, ivec2(0), size - 1), 0);
+    float iq = uintBitsToFloat(t.z);  // sky: 0, rejected
+    float pred = ic + slope * float(o);
+    // |1/iq - 1/pred| < tol without a division (iq, pred > 0); the normals within acos(min
+    // cosine), without normalizing the neighbour's: (N.n)^2 > c^2 |n|^2.
+    vec3 n = unpackNormalUnnormalized(t.w);
+    float c = dot(N, n);
+    bool same = inside && pred > 0.0 && iq > 0.0 && abs(pred - iq) < tol * iq * pred &&
+                c > 0.0 && c * c > minCos2 * dot(n, n);
+    float w = same ? (abs(o) == kRadius ? 0.5 : 1.0) : 0.0;
+    direct += w * unpackRgb9e5(t.x);
+    bounce += w * unpackRgb9e5(t.y);
+    weights += w;
+  }
+  direct /= weights;  // weights >= 1: the centre always counts
+  bounce /= weights;
+}

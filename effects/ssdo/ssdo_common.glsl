@@ -1,0 +1,86 @@
+// Shared by the SSDO shaders: the parameter block (C++ mirror: gi::ssdo::Uniforms in
+// ssdo_samples.h) and the packings that keep every per-tap read to one texelFetch.
+//
+// "ssdo_surface" texel (RGBA32UI), written by ssdo_surface.comp, read once per tap by ssdo.comp:
+//   x 1 / view distance (float bits; 0: sky or no geometry), y view normal (octahedral,
+//   snorm 16x2), z, w the sender's outgoing radiance (half rg, half b).
+// Raw / x-blurred texel (RGBA32UI), written by ssdo.comp and the x blur, read by the blur:
+//   x directional term (rgb9e5), y bounce term (rgb9e5), z 1 / view distance, w view normal.
+#ifndef SSDO_COMMON_GLSL
+#define SSDO_COMMON_GLSL
+
+layout(set = 0, binding = 1, std140) uniform SsdoParams {
+  vec4 params;      // R, bias (world), bounce scale A_s / pi, d_min^2
+  vec4 blur;        // plane tolerance (world), min normal cosine
+  uvec4 samples[128];  // [phase][i] at flat phase * 32 + i (gi::ssdo::pack)
+} ssdo;
+
+vec2 ssdoSignNotZero(vec2 v) { return vec2(v.x >= 0.0 ? 1.0 : -1.0, v.y >= 0.0 ? 1.0 : -1.0); }
+
+uint packNormal(vec3 n) {
+  n /= max(abs(n.x) + abs(n.y) + abs(n.z), 1e-30);
+  vec2 e = n.z >= 0.0 ? n.xy : (1.0 - abs(n.yx)) * ssdoSignNotZero(n.xy);
+  return packSnorm2x16(e);
+}
+// The octahedral decode without normalization (length in [1/sqrt(3), 1]).
+vec3 unpackNormalUnnormalized(uint p) {
+  vec2 e = unpackSnorm2x16(p);
+  vec3 n = vec3(e, 1.0 - abs(e.x) - abs(e.y));
+  float t = max(-n.z, 0.0);
+  n.xy -= t * ssdoSignNotZero(n.xy);
+  return n;
+}
+vec3 unpackNormal(uint p) {
+  vec2 e = unpackSnorm2x16(p);
+  vec3 n = vec3(e, 1.0 - abs(e.x) - abs(e.y));
+  float t = max(-n.z, 0.0);
+  n.xy -= t * ssdoSignNotZero(n.xy);
+  return safeNormalize(n, vec3(0.0, 0.0, 1.0));
+}
+
+// Shared-exponent RGB (9-bit mantissas, 5-bit exponent; as VK_FORMAT_E5B9G9R9): non-negative,
+// at most 65408; relative error 2^-9 of the largest channel. Guard: NaN and negatives read 0.
+const float kRgb9e5Max = 65408.0;
+uint packRgb9e5(vec3 c) {
+  c = vec3(c.r > 0.0 ? min(c.r, kRgb9e5Max) : 0.0, c.g > 0.0 ? min(c.g, kRgb9e5Max) : 0.0,
+           c.b > 0.0 ? min(c.b, kRgb9e5Max) : 0.0);
+  float m = max(c.r, max(c.g, c.b));
+  int e = max(-16, int(floor(log2(max(m, 1e-30))))) + 16;  // biased shared exponent, >= 0
+  float denom = exp2(float(e - 24));
+  if (floor(m / denom + 0.5) >= 512.0) {
+    denom *= 2.0;
+    e += 1;
+  }
+  uvec3 q = uvec3(min(floor(c / denom + 0.5), vec3(511.0)));
+  return q.r | (q.g << 9) | (q.b << 18) | (uint(clamp(e, 0, 31)) << 27);
+}
+vec3 unpackRgb9e5(uint p) {
+  // 2^(e - 24) built from its bits (e - 24 + 127 in [103, 134]: a normal float): no exp2.
+  float scale = uintBitsToFloat(((p >> 27) + 103u) << 23);
+  return vec3(uvec3(p, p >> 9, p >> 18) & 511u) * scale;
+}
+
+// environmentIrradianceOverPi (common.glsl) reading `frame` in place: the common.glsl helpers
+// take FrameUniforms by value, and uniform-block reads inside the sample loop cost llvmpipe
+// dearly (the sky through them was 2/3 of the SSDO pass; hoisted out of the loop, a tenth).
+vec3 ssdoIrradianceOverPi(vec3 n) {
+  float x = n.x, y = n.y, z = n.z;
+  vec3 e = frame.irradianceSH[0].rgb * 0.282095 + frame.irradianceSH[1].rgb * (0.488603 * y) +
+           frame.irradianceSH[2].rgb * (0.488603 * z) + frame.irradianceSH[3].rgb * (0.488603 * x) +
+           frame.irradianceSH[4].rgb * (1.092548 * x * y) +
+           frame.irradianceSH[5].rgb * (1.092548 * y * z) +
+           frame.irradianceSH[6].rgb * (0.315392 * (3.0 * z * z - 1.0)) +
+           frame.irradianceSH[7].rgb * (1.092548 * x * z) +
+           frame.irradianceSH[8].rgb * (0.546274 * (x * x - y * y));
+  return max(e, vec3(0.0)) * (1.0 / 3.14159265358979);
+}
+// View-space position of pixel-centre coordinates `pix` (pixels) at inverse view distance `iz`
+// (> 0), for the perspective projection's non-zero terms.
+vec3 ssdoViewPosition(vec2 pix, float iz, vec2 invSize, float p00, float p11, float p20,
+                      float p21) {
+  vec2 ndc = pix * 2.0 * invSize - 1.0;
+  float d = 1.0 / iz;
+  return vec3((ndc.x + p20) * d / p00, (ndc.y + p21) * d / p11, -d);
+}
+
+#endif

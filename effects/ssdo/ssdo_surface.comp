@@ -1,0 +1,78 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#include "common.glsl"
+
+// Per pixel, once: what every SSDO tap reads at the pixel it lands on, in one texel
+// (ssdo_common.glsl): 1 / view distance, the view normal and, with the bounce, the pixel's
+// outgoing radiance as a sender. The lit image of this frame does not exist yet (SSDO runs
+// before lighting) and the previous frame's is not kept, so the sender radiance is this
+// frame's direct-light estimate: emission + diffuse albedo x (the lights through lightIncident
+// and shadowFactor, 1-tap shadow test, / pi + the engine's unoccluded environment irradiance
+// / pi). Lambertian senders: no specular.
+layout(local_size_x = 32, local_size_y = 16) in;
+
+layout(constant_id = 0) const bool kBounce = true;
+layout(constant_id = 1) const int kLightTypes = 7;   // bit mask: 1 directional, 2 point, 4 spot
+layout(constant_id = 2) const int kShadowTypes = 7;  // the same for shadowed lights
+#define GI_LIGHT_TYPES kLightTypes
+#define GI_SHADOW_TYPES kShadowTypes
+#define GI_PCF_RADIUS 0
+
+layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
+#include "ssdo_common.glsl"
+layout(set = 0, binding = 2) uniform sampler2D gDepth;
+layout(set = 0, binding = 3) uniform sampler2D gNormal;
+layout(set = 0, binding = 4) uniform sampler2D gAlbedo;
+layout(set = 0, binding = 5) uniform sampler2D gMaterial;
+layout(set = 0, binding = 6) uniform sampler2D gEmission;
+#define GI_LIGHTS_SET 0
+#define GI_LIGHTS_BINDING 7
+#define GI_SHADOW_VIEWS_BINDING 8
+#define GI_SHADOW_MAPS_BINDING 9
+#include "lights.glsl"
+layout(set = 0, binding = 10, rgba32ui) uniform writeonly uimage2D outSurface;
+
+void main() {
+  ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+  ivec2 size = ivec2(frame.viewport.xy);
+  if (p.x >= size.x || p.y >= size.y) return;
+
+  float depth = texelFetch(gDepth, p, 0).r;
+  vec4 normalTexel = texelFetch(gNormal, p, 0);
+  float p22 = frame.proj[2][2], p32 = frame.proj[3][2];
+  // Reverse-Z depth to 1 / view distance: (d + P22) / P32 (affine in d). Guards: sky and
+  // pixels without geometry read 0 (never an occluder); a degenerate projection gives 0.
+  float iz = abs(p32) > 1e-30 ? (depth + p22) / p32 : 0.0;
+  bool geometry = !isSky(depth) && normalTexel.w > 0.5 && iz > 0.0 && !isinf(iz);
+  iz = geometry ? iz : 0.0;
+  vec3 n = safeNormalize(normalTexel.xyz, vec3(0.0, 0.0, 1.0));
+
+  vec3 radiance = vec3(0.0);
+  if (kBounce) {
+    vec2 uv = (vec2(p) + 0.5) * frame.viewport.zw;
+    vec3 pos = viewPositionFromDepth(frame.invProj, uv, depth);
+    vec3 albedo = texelFetch(gAlbedo, p, 0).rgb;
+    float metallic = texelFetch(gMaterial, p, 0).g;
+    vec3 diffuse = albedo * (1.0 - metallic);
+    vec3 irradiance = vec3(0.0);
+    int count = lightCount();
+    for (int i = 0; i < count; ++i) {
+      Light light = lights[i];
+      vec3 l;
+      vec3 incident = lightIncident(light, pos, l);
+      float ndl = max(dot(n, l), 0.0);
+      irradiance += incident * ndl * shadowFactor(light, pos, ndl);
+    }
+    vec3 nWorld = mat3(frame.invView) * n;
+    radiance = texelFetch(gEmission, p, 0).rgb +
+               diffuse * (irradiance * (1.0 / 3.14159265358979) +
+                          ssdoIrradianceOverPi(nWorld));
+    // Guard: half floats overflow to inf above 65504; non-finite inputs read 0.
+    radiance = geometry ? clamp(radiance, vec3(0.0), vec3(65000.0)) : vec3(0.0);
+    radiance = vec3(isnan(radiance.r) ? 0.0 : radiance.r, isnan(radiance.g) ? 0.0 : radiance.g,
+                    isnan(radiance.b) ? 0.0 : radiance.b);
+  }
+  imageStore(outSurface, p,
+             uvec4(floatBitsToUint(iz), packNormal(n), packHalf2x16(radiance.rg),
+                   packHalf2x16(vec2(radiance.b, 0.0))));
+}

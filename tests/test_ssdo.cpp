@@ -1,0 +1,411 @@
+// The SSDO plugin (effects/ssdo) on analytic scenes: the directional term of an open plane
+// under a constant environment is albedo x radiance; next to a box under a two-colour sky the
+// shadow takes the colour of the unblocked sky where SSAO's shadow is grey; the bounce tints a
+// white floor with a yellow emissive wall's colour, fading with distance, and a back-facing
+// platform's top gives nothing; everything stays finite at grazing angles, extreme clip planes, sky
+// pixels and touching occluders; the pass list follows the bounce and blur settings.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <string>
+
+#include "../effects/ssdo/ssdo_samples.h"
+#include "gi/effect_config.h"
+#include "gi/renderer.h"
+#include "gi/scene_io.h"
+#include "quad_scene.h"
+#include "test_support.h"
+#include "vulkan_fixture.h"
+
+namespace gi {
+namespace {
+
+constexpr uint32_t kW = 160, kH = 120;
+
+using test::finite;
+
+class SsdoTest : public test::VulkanTest {
+ protected:
+  void SetUp() override {
+    VulkanTest::SetUp();
+    registry.scanDirectory(test::binPath("plugins"));
+    ASSERT_TRUE(registry.has("ssdo")) << "ssdo plugin missing from " << test::binPath("plugins");
+  }
+  struct Result {
+    ImageRGBA32F ambient, indirect, lit, depth;
+    CameraView camera;
+    int w = 0, h = 0;
+    glm::vec3 px(const ImageRGBA32F& img, int x, int y) const {
+      const float* p = &img.pixels[(size_t(y) * w + x) * 4];
+      return {p[0], p[1], p[2]};
+    }
+    float depthAt(int x, int y) const { return depth.pixels[(size_t(y) * w + x) * 4]; }
+    bool sky(int x, int y) const { return depthAt(x, y) <= 0.0f; }
+    glm::vec3 worldAt(int x, int y) const {
+      glm::vec4 v = glm::inverse(camera.proj) *
+                    glm::vec4((x + 0.5f) / w * 2 - 1, (y + 0.5f) / h * 2 - 1, depthAt(x, y), 1.0f);
+      return glm::vec3(glm::inverse(camera.view) * glm::vec4(glm::vec3(v) / v.w, 1.0f));
+    }
+  };
+  RenderSettings settingsFor(const Scene& scene, const std::string& effect,
+                             const std::vector<std::string>& sets) {
+    EffectOverrides cli;
+    cli.effects = effect.empty() ? std::vector<std::string>{} : std::vector<std::string>{effect};
+    cli.sets = sets;
+    RenderSettings rs;
+    rs.width = kW;
+    rs.height = kH;
+    rs.effects = resolveEffects(scene, nullptr, cli, registry);
+    return rs;
+  }
+  // Renders one frame; `ambient` and `indirect` are read only when SSDO ran.
+  Result render(const Scene& scene, const std::vector<std::string>& sets,
+                const std::string& effect = "ssdo") {
+    Renderer r(ctx(), scene, settingsFor(scene, effect, sets), &registry);
+    r.renderFrame();
+    Result res;
+    if (effect == "ssdo") {
+      res.ambient = r.readTarget("ambient");
+      res.indirect = r.readTarget("indirect");
+    }
+    res.lit = r.readTarget("lit");
+    res.depth = r.readTarget("depth");
+    res.camera = r.camera();
+    res.w = int(kW);
+    res.h = int(kH);
+    return res;
+  }
+  // JSON scenes: a scene without lights gets a default sun, so each names one of intensity 0
+  // (the environment and emission are then the only light).
+  Scene jsonScene(const std::string& name, const std::string& json) {
+    const std::string path = ::testing::TempDir() + "/ssdo_" + name + ".json";
+    {
+      std::ofstream f(path);
+      f << json;
+    }
+    return loadSceneJson(path);
+  }
+  // Mean of `img` over the pixels whose world position satisfies `pick`; `count` the pixels.
+  template <class Pick>
+  glm::dvec3 mean(const Result& r, const ImageRGBA32F& img, Pick pick, int* count = nullptr) {
+    glm::dvec3 sum(0.0);
+    int n = 0;
+    for (int y = 0; y < r.h; ++y)
+      for (int x = 0; x < r.w; ++x)
+        if (!r.sky(x, y) && pick(r.worldAt(x, y))) {
+          sum += glm::dvec3(r.px(img, x, y));
+          ++n;
+        }
+    if (count) *count = n;
+    return n > 0 ? sum / double(n) : sum;
+  }
+  EffectRegistry registry;
+};
+
+// An open plane under a constant environment: nothing is blocked, so the directional term is
+// (1/N) sum L = L exactly and ambient = albedo x L, which is also the engine's own environment
+// term (its SH9 is exact for a constant environment). Tolerance 1%: rgb9e5 (2^-9) and half
+// float rounding, the albedo's 8-bit sRGB quantization.
+TEST_F(SsdoTest, OpenPlaneUnderAConstantEnvironmentIsAlbedoTimesRadiance) {
+  const Scene s = jsonScene("plane", R"({
+      "models": [ { "primitive": "plane", "size": 40, "material": { "base_color": [0.5, 0.5, 0.5] } } ],
+      "lights": [ { "type": "directional", "intensity": 0, "casts_shadows": false } ],
+      "camera": { "position": [0, 2, 3], "target": [0, 0, 0] },
+      "environment": { "type": "constant", "color": [0.6, 0.4, 0.2], "intensity": 1.5 } })");
+  const Result ssdo = render(s, {});
+  const Result none = render(s, {}, "");
+  const glm::vec3 expected = 0.5f * 1.5f * glm::vec3(0.6f, 0.4f, 0.2f);
+  int checked = 0;
+  for (int y = 0; y < ssdo.h; ++y)
+    for (int x = 0; x < ssdo.w; ++x) {
+      if (ssdo.sky(x, y)) continue;
+      ++checked;
+      const glm::vec3 a = ssdo.px(ssdo.ambient, x, y), engine = none.px(none.lit, x, y);
+      for (int c = 0; c < 3; ++c) {
+        ASSERT_NEAR(a[c], expected[c], 0.01f * expected[c]) << x << "," << y << " channel " << c;
+        ASSERT_NEAR(ssdo.px(ssdo.lit, x, y)[c], engine[c], 0.01f * engine[c]) << x << "," << y;
+      }
+      ASSERT_EQ(ssdo.px(ssdo.indirect, x, y), glm::vec3(0.0f)) << "no occluder, no bounce";
+    }
+  EXPECT_GT(checked, int(kW * kH) / 3);
+}
+
+// The same under a constant equirect map (environment kind 2, whose samples the shader sums
+// through the SH9's moments): the SH of a constant map is that constant, so ambient = albedo x
+// L again. Tolerance 2%: the map's RGBE quantization and the SH projection's quadrature.
+TEST_F(SsdoTest, OpenPlaneUnderAConstantMapIsAlbedoTimesRadiance) {
+  const std::string dir = ::testing::TempDir();
+  {
+    std::ofstream out(dir + "/ssdo_flat.hdr", std::ios::binary);
+    out << "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 8 +X 16\n";
+    const unsigned char px[4] = {128, 96, 64, 128};  // (0.5, 0.375, 0.25)
+    for (int i = 0; i < 16 * 8; ++i) out.write(reinterpret_cast<const char*>(px), 4);
+  }
+  const Scene s = jsonScene("map", R"({
+      "models": [ { "primitive": "plane", "size": 40, "material": { "base_color": [0.5, 0.5, 0.5] } } ],
+      "lights": [ { "type": "directional", "intensity": 0, "casts_shadows": false } ],
+      "camera": { "position": [0, 2, 3], "target": [0, 0, 0] },
+      "environment": { "type": "map", "file": ")" +
+                                       dir + R"(/ssdo_flat.hdr" } })");
+  const Result r = render(s, {});
+  const glm::vec3 expected = 0.5f * glm::vec3(0.5f, 0.375f, 0.25f);
+  int checked = 0;
+  for (int y = 0; y < r.h; ++y)
+    for (int x = 0; x < r.w; ++x) {
+      if (r.sky(x, y)) continue;
+      ++checked;
+      for (int c = 0; c < 3; ++c)
+        ASSERT_NEAR(r.px(r.ambient, x, y)[c], expected[c], 0.02f * expected[c]) << x << "," << y;
+    }
+  EXPECT_GT(checked, int(kW * kH) / 3);
+}
+
+// Open planes (floor, and a wall facing the camera) under the procedural sky: SSDO integrates
+// the sky per direction, the engine uses its SH9 irradiance, which approximates the same
+// integral to a few percent (gi/environment.h). Tolerance 2.5% of the brightest channel.
+TEST_F(SsdoTest, OpenPlanesUnderTheSkyMatchTheEnginesEnvironmentTerm) {
+  for (const char* rotation : {"[0, 0, 0]", "[90, 0, 0]"}) {
+    const Scene s = jsonScene("sky", std::string(R"({
+      "models": [ { "primitive": "plane", "size": 400, "rotation": )") +
+                                         rotation + R"(,
+                    "material": { "base_color": [0.8, 0.8, 0.8] } } ],
+      "lights": [ { "type": "directional", "intensity": 0, "casts_shadows": false } ],
+      "camera": { "position": [0.5, 2, 3], "target": [0, 0, 0] },
+      "environment": { "type": "sky", "intensity": 1, "zenith_color": [0.2, 0.4, 1.0],
+                       "horizon_color": [1.0, 0.8, 0.6], "ground_color": [0.3, 0.25, 0.2] } })");
+    const Result ssdo = render(s, {"ssdo.bounce=false"});
+    const Result none = render(s, {}, "");
+    int checked = 0;
+    double worst = 0.0;
+    // Not within the blur radius of the border: there the blur cannot average all 16 sets.
+    for (int y = 2; y < ssdo.h - 2; ++y)
+      for (int x = 2; x < ssdo.w - 2; ++x) {
+        if (ssdo.sky(x, y)) continue;
+        ++checked;
+        const glm::vec3 a = ssdo.px(ssdo.lit, x, y), e = none.px(none.lit, x, y);
+        const float scale = std::max({e.r, e.g, e.b});
+        for (int c = 0; c < 3; ++c) worst = std::max(worst, double(std::abs(a[c] - e[c]) / scale));
+      }
+    std::printf("plane rotation %s: worst relative difference %.4f\n", rotation, worst);
+    EXPECT_GT(checked, int(kW * kH) / 4) << rotation;
+    EXPECT_LT(worst, 0.025) << rotation;  // measured 0.013 (floor), 0.001 (wall)
+  }
+}
+
+// A box on a floor under a sky whose zenith is red and whose horizon and ground are blue. Next
+// to the box the blocked directions are mostly low (toward the box's wall at small elevation
+// more of the step reaches it), i.e. bluish: SSDO's shadow there turns redder than the open
+// floor; SSAO scales the whole environment term, so its shadow keeps the open floor's hue.
+TEST_F(SsdoTest, ShadowNextToABoxTakesTheColourOfTheUnblockedSky) {
+  const Scene s = jsonScene("box", R"({
+      "models": [
+        { "primitive": "plane", "size": 40, "material": { "base_color": [0.8, 0.8, 0.8] } },
+        { "primitive": "box", "size": 2, "translation": [0, 1, 0],
+          "material": { "base_color": [0.8, 0.8, 0.8] } } ],
+      "lights": [ { "type": "directional", "intensity": 0, "casts_shadows": false } ],
+      "camera": { "position": [0, 3, 5], "target": [0, 0, 1] },
+      "environment": { "type": "sky", "intensity": 1, "zenith_color": [1, 0, 0],
+                       "horizon_color": [0, 0, 1], "ground_color": [0, 0, 1] } })");
+  auto floor = [](glm::vec3 p) { return std::abs(p.y) < 1e-3f && std::abs(p.x) < 0.6f; };
+  auto near = [&](glm::vec3 p) { return floor(p) && p.z > 1.02f && p.z < 1.15f; };
+  auto far = [&](glm::vec3 p) { return floor(p) && p.z > 2.5f && p.z < 3.5f; };
+  auto redness = [](glm::dvec3 c) { return c.r / (c.r + c.b); };
+  const Result ssdo = render(s, {"ssdo.bounce=false", "ssdo.radius=0.5"});
+  const Result ssao = render(s, {"ssao.radius=0.5"}, "ssao");
+  int nNear = 0, nFar = 0;
+  const glm::dvec3 dNear = mean(ssdo, ssdo.lit, near, &nNear),
+                   dFar = mean(ssdo, ssdo.lit, far, &nFar);
+  const glm::dvec3 aNear = mean(ssao, ssao.lit, near), aFar = mean(ssao, ssao.lit, far);
+  ASSERT_GT(nNear, 20);
+  ASSERT_GT(nFar, 20);
+  std::printf("redness r/(r+b): ssdo near %.4f far %.4f; ssao near %.4f far %.4f\n", redness(dNear),
+              redness(dFar), redness(aNear), redness(aFar));
+  std::printf("luminance near/far: ssdo %.3f ssao %.3f\n", (dNear.r + dNear.b) / (dFar.r + dFar.b),
+              (aNear.r + aNear.b) / (aFar.r + aFar.b));
+  // Both darken next to the box.
+  EXPECT_LT(dNear.r + dNear.b, 0.9 * (dFar.r + dFar.b));
+  EXPECT_LT(aNear.r + aNear.b, 0.9 * (aFar.r + aFar.b));
+  // SSAO: grey shadow (same hue within rounding); SSDO: coloured, toward the open sky (red).
+  EXPECT_NEAR(redness(aNear), redness(aFar), 0.003);  // measured 1e-4
+  EXPECT_GT(redness(dNear), redness(dFar) + 0.02);    // measured +0.039
+}
+
+// A white floor and a yellow emissive wall (x = 0) under a black environment: the floor's
+// indirect light is yellow, strongest next to the wall, fading with distance and 0 beyond the
+// radius. Back-facing senders are rejected: the G-buffer turns every normal toward the camera,
+// so the case is a surface facing away from the receiver, not from the camera.
+TEST_F(SsdoTest, BounceFromAYellowWallFadesAndBackFacingSendersGiveNothing) {
+  auto scene = [&](const char* name, int rotationZ) {
+    return jsonScene(name, std::string(R"({
+      "models": [
+        { "primitive": "plane", "size": 40, "material": { "base_color": [1, 1, 1] } },
+        { "primitive": "plane", "size": 2, "translation": [0, 1, 0], "rotation": [0, 0, )") +
+                               std::to_string(rotationZ) + R"(],
+          "material": { "base_color": [1, 1, 0], "emission": [1, 1, 0] } } ],
+      "lights": [ { "type": "directional", "intensity": 0, "casts_shadows": false } ],
+      "camera": { "position": [3, 2.5, 0], "target": [0.5, 0, 0] },
+      "environment": { "type": "constant", "color": [0, 0, 0] } })");
+  };
+  auto band = [](float lo, float hi) {
+    return [lo, hi](glm::vec3 p) {
+      return std::abs(p.y) < 1e-3f && std::abs(p.z) < 0.5f && p.x > lo && p.x < hi;
+    };
+  };
+  const Result front = render(scene("front", -90), {"ssdo.radius=0.5"});
+  const glm::dvec3 near = mean(front, front.indirect, band(0.02f, 0.12f));
+  const glm::dvec3 mid = mean(front, front.indirect, band(0.25f, 0.35f));
+  const glm::dvec3 far = mean(front, front.indirect, band(0.8f, 2.0f));
+  std::printf("floor indirect near %.4f %.4f %.4f mid %.4f far %.4f\n", near.r, near.g, near.b,
+              mid.r, far.r);
+  EXPECT_GT(near.r, 0.02);
+  EXPECT_NEAR(near.g, near.r, 0.01 * near.r);  // yellow: r = g (white floor, yellow sender)
+  EXPECT_LT(near.b, 1e-6);
+  EXPECT_GT(near.r, 1.5 * mid.r);
+  EXPECT_GT(mid.r, 0.0);
+  EXPECT_EQ(far.r, 0.0) << "no sample reaches the wall from beyond the radius";
+  // The floor's lit image carries the tint: red and green above blue near the wall.
+  const glm::dvec3 lit = mean(front, front.lit, band(0.02f, 0.12f));
+  EXPECT_GT(lit.r, lit.b + 0.02);
+
+  // A yellow emissive platform (y = 0.2, x < 0) facing up: the floor's samples under its edge
+  // are blocked by its top, whose normal (+y) faces away from the floor below (cos_s = 0).
+  const Scene platform = jsonScene("back", R"({
+      "models": [
+        { "primitive": "plane", "size": 40, "material": { "base_color": [1, 1, 1] } },
+        { "primitive": "plane", "size": 4, "translation": [-2, 0.2, 0],
+          "material": { "base_color": [1, 1, 0], "emission": [1, 1, 0] } } ],
+      "lights": [ { "type": "directional", "intensity": 0, "casts_shadows": false } ],
+      "camera": { "position": [3, 2.5, 0], "target": [0.5, 0, 0] },
+      "environment": { "type": "constant", "color": [1, 1, 1] } })");
+  const Result back = render(platform, {"ssdo.radius=0.5"});
+  int n = 0;
+  const glm::dvec3 backNear = mean(back, back.indirect, band(0.02f, 0.12f), &n);
+  ASSERT_GT(n, 20);
+  EXPECT_EQ(backNear, glm::dvec3(0.0)) << "a back-facing sender must give no energy";
+  // ... although samples there are blocked: the directional term is below the open floor's.
+  const glm::dvec3 openAmbient = mean(back, back.ambient, band(1.0f, 2.0f));
+  const glm::dvec3 nearAmbient = mean(back, back.ambient, band(0.02f, 0.12f));
+  EXPECT_LT(nearAmbient.r, 0.97 * openAmbient.r);
+}
+
+// The bounce's distance clamp: an occluder touching the receiver (the wall-floor corner,
+// d -> 0) stays finite even at the smallest clamp, and each sender's term is bounded by
+// L_s x bounce scale / d_min^2 (so the pixel by N times that, times the albedo).
+TEST_F(SsdoTest, TouchingOccludersStayFiniteAndBoundedByTheDistanceClamp) {
+  const Scene s = jsonScene("touch", R"({
+      "models": [
+        { "primitive": "plane", "size": 40, "material": { "base_color": [1, 1, 1] } },
+        { "primitive": "plane", "size": 2, "translation": [0, 1, 0], "rotation": [0, 0, -90],
+          "material": { "base_color": [1, 1, 0], "emission": [1, 1, 0] } } ],
+      "lights": [ { "type": "directional", "intensity": 0, "casts_shadows": false } ],
+      "camera": { "position": [3, 2.5, 0], "target": [0.5, 0, 0] },
+      "environment": { "type": "constant", "color": [0, 0, 0] } })");
+  for (double clamp : {1e-6, 0.02, 0.1}) {
+    const std::string c = "ssdo.distance_clamp=" + std::to_string(clamp);
+    const Result r = render(s, {"ssdo.radius=0.5", "ssdo.samples=12", "ssdo.bounce_strength=1", c,
+                                "ssdo.blur_radius=0"});
+    ASSERT_TRUE(finite(r.indirect)) << c;
+    ASSERT_TRUE(finite(r.lit)) << c;
+    // Sender radiance 1 (the wall's emission), A_s / pi = R^2 / N; at most N senders.
+    const double bound = 12.0 * (0.25 / 12.0) / (clamp * clamp);
+    float maxFloor = 0.0f;
+    for (int y = 0; y < r.h; ++y)
+      for (int x = 0; x < r.w; ++x)
+        if (!r.sky(x, y) && std::abs(r.worldAt(x, y).y) < 1e-3f)
+          maxFloor = std::max(maxFloor, r.px(r.indirect, x, y).r);
+    std::printf("%s: max floor indirect %.4f (bound %.4g)\n", c.c_str(), maxFloor, bound);
+    EXPECT_LE(maxFloor, std::min(bound * 1.01, 65000.0)) << c;
+  }
+}
+
+TEST_F(SsdoTest, NoNaNAtGrazingAnglesExtremeClipPlanesAndSky) {
+  using test::cornerQuads;
+  struct Case {
+    glm::vec3 eye, target;
+    float znear, zfar;
+  };
+  // Grazing: the eye 1e-3 above the floor; extreme planes; looking up into the sky.
+  for (const Case& k : {Case{{6, 1e-3f, 0.5f}, {0, 0, 0.5f}, 0.05f, 100.0f},
+                        Case{{2.5f, 1.6f, 0}, {0, 0, 0}, 1e-4f, 1e5f},
+                        Case{{2.5f, 0.3f, 0}, {0, 3, 0}, 1e-4f, 1e5f}}) {
+    const Scene s = test::quadScene(cornerQuads(), k.eye, k.target, 1.0f, k.znear, k.zfar);
+    for (const char* bounce : {"ssdo.bounce=true", "ssdo.bounce=false"}) {
+      const Result r = render(s, {bounce, "ssdo.distance_clamp=1e-6"});
+      EXPECT_TRUE(finite(r.ambient)) << bounce << " near " << k.znear;
+      EXPECT_TRUE(finite(r.indirect)) << bounce << " near " << k.znear;
+      EXPECT_TRUE(finite(r.lit)) << bounce << " near " << k.znear;
+      for (size_t i = 0; i < r.ambient.pixels.size(); ++i) ASSERT_GE(r.ambient.pixels[i], 0.0f);
+    }
+  }
+}
+
+TEST_F(SsdoTest, PassListFollowsBounceAndBlurAndBounceOffKeepsTheDirectionalTerm) {
+  const Scene scene = test::cornerScene();  // no lights: no shadow pass
+  auto passes = [&](const std::vector<std::string>& sets) {
+    Renderer r(ctx(), scene, settingsFor(scene, "ssdo", sets), &registry);
+    r.renderFrame();
+    return std::make_pair(r.passNames(),
+                          std::make_pair(r.readTarget("ambient"), r.readTarget("indirect")));
+  };
+  const auto on = passes({"ssdo.bounce=true"});
+  const auto off = passes({"ssdo.bounce=false"});
+  const auto resolveOnly = passes({"ssdo.blur_radius=0"});
+  const std::vector<std::string> blurred = {"gbuffer",   "ssdo_surface", "ssdo",
+                                            "ssdo_blur", "lighting",     "tonemap"};
+  EXPECT_EQ(on.first, blurred);
+  EXPECT_EQ(off.first, blurred);
+  EXPECT_EQ(resolveOnly.first, (std::vector<std::string>{"gbuffer", "ssdo_surface", "ssdo",
+                                                         "ssdo_resolve", "lighting", "tonemap"}));
+  // The bounce changes nothing in the directional term; off, "indirect" is 0 everywhere.
+  EXPECT_EQ(on.second.first.pixels, off.second.first.pixels);
+  for (float v : off.second.second.pixels) ASSERT_EQ(v, v == 1.0f ? 1.0f : 0.0f);
+  float maxOn = 0.0f;
+  for (float v : on.second.second.pixels) maxOn = std::max(maxOn, v);
+  EXPECT_GT(maxOn, 0.0f);
+}
+
+// Sender shadows: without them a sender's radiance can only grow (its lights are no longer
+// shadowed), so the bounce grows or stays everywhere (the sum is monotone in L_s and the blur
+// weights do not depend on it), and strictly somewhere in the default scene's shadowed room.
+TEST_F(SsdoTest, SenderShadowsOnlyRemoveBounceLight) {
+  const Scene scene = makeDefaultScene();
+  const Result on = render(scene, {"ssdo.sender_shadows=true"});
+  const Result off = render(scene, {"ssdo.sender_shadows=false"});
+  ASSERT_TRUE(finite(on.indirect));
+  ASSERT_TRUE(finite(off.indirect));
+  double gained = 0.0;
+  for (size_t i = 0; i < on.indirect.pixels.size(); ++i) {
+    if (i % 4 == 3) continue;
+    const float a = on.indirect.pixels[i], b = off.indirect.pixels[i];
+    // rgb9e5 (2^-9 of the largest channel) and half rounding, per term and after the blur.
+    ASSERT_GE(b, a - 0.01f * std::max(a, 1e-3f)) << "component " << i;
+    gained += b - a;
+  }
+  std::printf("indirect gained without sender shadows: %.3f (sum over components)\n", gained);
+  EXPECT_GT(gained, 1.0) << "the room's shadowed senders must matter";
+}
+
+// The sample table: every pixel phase has its set, the 16 sets together are one stratified
+// set (each of the 16 N azimuth strata holds one sample), and the packing round-trips.
+TEST(SsdoSamples, SetsPartitionOneStratifiedSet) {
+  const int n = 8, m = 16;
+  std::vector<int> strata(size_t(n * m), 0);
+  for (int phase = 0; phase < 16; ++phase)
+    for (int i = 0; i < n; ++i) {
+      const ssdo::Sample s = ssdo::sampleAt(phase & 3, phase >> 2, i, n, m);
+      EXPECT_NEAR(s.x * s.x + s.y * s.y + s.z * s.z, 1.0f, 2e-3f);
+      EXPECT_GT(s.s, 0.0f);
+      EXPECT_LE(s.s, 1.0f);
+      double phi = std::atan2(double(s.y), double(s.x));
+      if (phi < 0) phi += 2 * M_PI;
+      ++strata[size_t(std::min(int(phi / (2 * M_PI) * n * m), n * m - 1))];
+    }
+  for (int k = 0; k < n * m; ++k) EXPECT_EQ(strata[size_t(k)], 1) << "stratum " << k;
+  const ssdo::Uniforms u = ssdo::makeUniforms(0.5, n, m, 1.0, 0.1);
+  EXPECT_FLOAT_EQ(u.bounceScale, 0.25f / n);
+  EXPECT_FLOAT_EQ(u.distanceClamp2, 0.01f);
+}
+
+}  // namespace
+}  // namespace gi
