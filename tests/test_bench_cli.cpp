@@ -153,6 +153,26 @@ TEST(BenchCli, DeclaredQuantityFollowsTheSweptRadius) {
   EXPECT_EQ(entries, 4u) << "AO and obscurance(linear) at two radii";
 }
 
+// Several effects on one scene against the same target: one chart with every effect as a
+// series (the methods side by side), before the per-effect charts.
+TEST(BenchCli, SeveralEffectsShareOneChartPerScene) {
+  const bool hasGtao = fs::exists(test::binPath("plugins/gi_effect_gtao.so"));
+  if (!hasSsao() || !hasGtao) GTEST_SKIP() << "the ssao and gtao plugins are not built";
+  const std::string dir = test::makeTempDir("bench-all");
+  const std::string out = dir + "/out";
+  auto r = test::runCommand(bench("--quick --reps 2 --effects ssao,gtao --cache '" + dir +
+                                  "/cache' --out '" + out + "'"));
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  const std::string report = readAll(out + "/report.md");
+  const size_t all = report.find("plots/default_all.png"), one = report.find("plots/default_ssao");
+  ASSERT_NE(all, std::string::npos) << report;
+  EXPECT_LT(all, one) << "the combined chart comes first";
+  const std::string svg = readAll(out + "/plots/default_all.svg");
+  EXPECT_NE(svg.find("ssao"), std::string::npos);
+  EXPECT_NE(svg.find("gtao"), std::string::npos);
+  EXPECT_GT(fs::file_size(out + "/plots/default_all.png"), 1000u);
+}
+
 TEST(BenchCli, BadInputFailsBeforeRendering) {
   const std::string dir = test::makeTempDir("bench-bad");
   const std::string out = dir + "/out";

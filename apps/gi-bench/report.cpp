@@ -216,7 +216,8 @@ std::string xmlEscape(const std::string& s) {
 
 // Rows of one scene and effect as a plot: series by `Row::series`, points in swept-value
 // order, labelled by the swept setting ("ssao.samples=16"), error bars from the intervals.
-Plot buildPlot(const std::string& title, const std::vector<const Row*>& rows) {
+Plot buildPlot(const std::string& title, const std::vector<const Row*>& rows,
+               bool seriesByEffect = false) {
   Plot p;
   p.title = title;
   const bool effectTime = !rows.empty() && rows.front()->effectMs > 0.0;
@@ -234,6 +235,25 @@ Plot buildPlot(const std::string& title, const std::vector<const Row*>& rows) {
                                   : r->gridKey + "=" + fmt(r->gridValue);
     return pt;
   };
+  if (seriesByEffect) {  // one series per effect, points in time order: methods side by side
+    std::map<std::string, size_t> index;
+    for (const Row* r : rows) {
+      if (!index.count(r->effect)) {
+        index[r->effect] = p.series.size();
+        p.series.push_back({r->effect, {}});
+      }
+    }
+    for (auto& [effect, i] : index) {
+      std::vector<const Row*> pts;
+      for (const Row* r : rows)
+        if (r->effect == effect) pts.push_back(r);
+      std::stable_sort(pts.begin(), pts.end(),
+                       [](const Row* a, const Row* b) { return plotTime(*a) < plotTime(*b); });
+      for (const Row* r : pts) p.series[i].points.push_back(point(r));
+    }
+    for (size_t i : front) p.front.push_back(point(rows[i]));
+    return p;
+  }
   std::map<std::string, size_t> index;
   for (const Row* r : rows) {
     if (!index.count(r->series)) {
@@ -490,17 +510,38 @@ void writeResults(const std::string& dir, const std::vector<Row>& rows, const Ru
     groups[key].push_back(&r);
   }
   std::vector<std::pair<std::string, std::string>> plots;
+  auto write = [&](const std::string& file, const Plot& plot) {
+    writeFileAtomic((fs::path(dir) / (file + ".svg")).string(), svgPlot(plot));
+    const std::string png = (fs::path(dir) / (file + ".png")).string();
+    writePng(png + ".partial", rasterPlot(plot));
+    fs::rename(png + ".partial", png);
+    plots.emplace_back(plot.title, file);
+  };
+  // A scene swept with several effects first gets one chart of all of them against the same
+  // target: which method buys the most accuracy per millisecond.
+  std::map<std::string, std::vector<const Row*>> byScene;
+  std::vector<std::string> sceneOrder;
+  for (const Row& r : rows) {
+    if (!byScene.count(r.scene)) sceneOrder.push_back(r.scene);
+    byScene[r.scene].push_back(&r);
+  }
+  for (const std::string& scene : sceneOrder) {
+    const std::vector<const Row*>& g = byScene[scene];
+    std::set<std::string> effects, targets;
+    for (const Row* r : g) effects.insert(r->effect), targets.insert(r->reference);
+    if (effects.size() < 2 || targets.size() != 1) continue;
+    const std::string stem = fs::path(scene).stem().string();
+    write("plots/" + fileSafe(stem) + "_all",
+          buildPlot(
+              stem + ": every effect (" + g.front()->compared + " vs " + g.front()->reference + ")",
+              g, true));
+  }
   for (const auto& key : order) {
     const std::string stem = fs::path(key.first).stem().string();
     const std::string file = "plots/" + fileSafe(stem) + "_" + fileSafe(key.second);
     const std::string title = stem + ": " + key.second + " (" + groups[key].front()->compared +
                               " vs " + groups[key].front()->reference + ")";
-    const Plot plot = buildPlot(title, groups[key]);
-    writeFileAtomic((fs::path(dir) / (file + ".svg")).string(), svgPlot(plot));
-    const std::string png = (fs::path(dir) / (file + ".png")).string();
-    writePng(png + ".partial", rasterPlot(plot));
-    fs::rename(png + ".partial", png);
-    plots.emplace_back(title, file);
+    write(file, buildPlot(title, groups[key]));
   }
   writeFileAtomic((fs::path(dir) / "results.csv").string(), csv(rows));
   writeFileAtomic((fs::path(dir) / "results.json").string(), json(rows, info));
