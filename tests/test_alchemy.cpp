@@ -3,9 +3,11 @@
 // falls monotonically with intensity and contrast and rises with epsilon, epsilon keeps
 // zero-distance occluders finite, the cross-bilateral filter does not cross depth edges, the
 // guard band gives the edge pixels what a wider view sees, and nothing is NaN at grazing angles,
-// extreme clip planes or sky pixels.
+// extreme clip planes or sky pixels; and, on the CPU, what the estimator converges to on a crease
+// (the screen-disk integral, not the hemisphere integral the effect declares).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -352,6 +354,105 @@ TEST_F(AlchemyTest, PassesAndLiveSettings) {
   EXPECT_EQ(r.passNames(),
             (std::vector<std::string>{"alchemy_guard_band", "alchemy", "alchemy_blur"}));
   EXPECT_TRUE(finite(r.readTarget("ao")));
+}
+
+// What eq. 10's sum converges to (README "What the estimator's expectation really is"): on a
+// 90-degree crease seen from afar (nearly orthographic, all on the CPU), the estimator's
+// I = 1 - A matches the screen-disk integral
+//   I_disk = (sigma / (pi r)) int_0^r int_0^2pi max(0, v.n) H(r - |v|) / (v.v + eps) dphi drho
+// (taps uniform in radius and angle) within 5 %, and differs from the hemisphere integral that
+// the effect declares, (sigma / pi) int_Gamma t / (t^2 + eps) cos(theta) dw, by 25 % or more, in
+// either direction depending on the view.
+struct Crease {
+  // Floor z = 0 (normal +z) for x <= d, wall x = d (normal -x) for z >= 0; the camera looks at
+  // the origin from distance 40 at elevation `elev`, facing the wall.
+  double d;
+  glm::dvec3 eye, fwd, right{0, -1, 0}, up;
+  Crease(double dist, double elevDeg) : d(dist) {
+    const double e = elevDeg * 3.14159265358979 / 180.0;
+    fwd = {std::cos(e), 0, -std::sin(e)};
+    up = {std::sin(e), 0, std::cos(e)};
+    eye = -40.0 * fwd;
+  }
+  // First hit along o + t dir (t > 0); false for none. n: world normal at the hit.
+  bool hit(glm::dvec3 o, glm::dvec3 dir, glm::dvec3& p, glm::dvec3& n) const {
+    double best = 1e30;
+    if (dir.z < 0) {
+      const double t = -o.z / dir.z;
+      if (t > 1e-9 && o.x + t * dir.x <= d) best = t, n = {0, 0, 1};
+    }
+    if (dir.x > 0) {
+      const double t = (d - o.x) / dir.x;
+      if (t > 1e-9 && t < best && o.z + t * dir.z >= 0) best = t, n = {-1, 0, 0};
+    }
+    p = o + best * dir;
+    return best < 1e30;
+  }
+  glm::dvec3 toView(glm::dvec3 w) const { return {dot(w, right), dot(w, up), -dot(w, fwd)}; }
+};
+
+TEST(AlchemyExpectation, IsTheScreenDiskIntegralNotTheDeclaredHemisphereIntegral) {
+  const int w = 256, h = 256, samples = 64;
+  const double r = 0.5, sigma = 0.2, eps = 1e-4, pi = 3.14159265358979;
+  glm::mat4 proj(0.0f);             // reverse-Z, infinite far: depth = near / distance
+  proj[0][0] = proj[1][1] = 50.0f;  // 1.6 world units across at distance 40
+  proj[2][3] = -1.0f;
+  proj[3][2] = 0.1f;
+  struct Case {
+    double d, elev;
+  };
+  for (const Case& c : {Case{0.1, 45}, Case{0.4, 20}, Case{0.05, 70}}) {
+    const Crease k(c.d, c.elev);
+    std::vector<float> depth(size_t(w) * h, 0.0f);
+    std::vector<glm::vec3> normal(depth.size());
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const double nx = (x + 0.5) * 2.0 / w - 1.0, ny = (y + 0.5) * 2.0 / h - 1.0;
+        glm::dvec3 p, n;
+        if (!k.hit(k.eye, nx / 50.0 * k.right + ny / 50.0 * k.up + k.fwd, p, n)) continue;
+        depth[size_t(y) * w + x] = float(0.1 / dot(p - k.eye, k.fwd));
+        normal[size_t(y) * w + x] = glm::vec3(k.toView(n));
+      }
+    // The estimator at pixel (128, 128) (on the floor), over 4 tap rotations (band 0..3 reads
+    // the same pixel with the rotation of pixel (128 - b, 128 - b)).
+    const alchemy::DepthView in{depth.data(), normal.data(), w, h, proj};
+    const alchemy::Uniforms u = alchemy::makeUniforms(r, 0.0, sigma, 1.0, eps, samples);
+    double est = 0.0;
+    for (int b = 0; b < 4; ++b)
+      est += (1.0 - alchemy::estimate(in, 128 - b, 128 - b, b, u, samples)) / 4;
+    // The same pixel's point C, and the two integrals by the midpoint rule.
+    glm::dvec3 cw, cn;
+    const double pc = 0.5 * 2.0 / w;  // pixel 128's centre in NDC
+    ASSERT_TRUE(k.hit(k.eye, pc / 50.0 * k.right + pc / 50.0 * k.up + k.fwd, cw, cn));
+    ASSERT_EQ(cn.z, 1.0) << "C must lie on the floor";
+    const int nr = 400, na = 400;
+    double disk = 0.0, hemi = 0.0;
+    for (int i = 0; i < nr; ++i)
+      for (int j = 0; j < na; ++j) {
+        const double rho = (i + 0.5) / nr * r, phi = (j + 0.5) / na * 2 * pi;
+        glm::dvec3 p, n;
+        const glm::dvec3 target = cw + rho * (std::cos(phi) * k.right + std::sin(phi) * k.up);
+        if (k.hit(k.eye, target - k.eye, p, n)) {
+          const glm::dvec3 v = p - cw;
+          if (dot(v, v) < r * r) disk += std::max(0.0, v.z) / (dot(v, v) + eps);
+        }
+        const double th = (i + 0.5) / nr * pi / 2;  // hemisphere direction around +z
+        const glm::dvec3 dir(std::sin(th) * std::cos(phi), std::sin(th) * std::sin(phi),
+                             std::cos(th));
+        if (k.hit(cw, dir, p, n)) {
+          const double t = length(p - cw);
+          if (t < r) hemi += t / (t * t + eps) * std::cos(th) * std::sin(th);
+        }
+      }
+    disk *= sigma / (pi * r) * (r / nr) * (2 * pi / na);
+    hemi *= sigma / pi * (pi / 2 / nr) * (2 * pi / na);
+    std::printf(
+        "crease d %.2f elevation %.0f: estimator I %.4f, screen-disk integral %.4f, "
+        "declared hemisphere integral %.4f\n",
+        c.d, c.elev, est, disk, hemi);
+    EXPECT_NEAR(est, disk, 0.05 * disk);
+    EXPECT_GT(std::abs(est / hemi - 1.0), 0.25);
+  }
 }
 
 }  // namespace

@@ -61,7 +61,9 @@ class AlchemyEffect : public gi::Effect {
 
   // The Alchemy integral of eq. 10 (README "What it estimates"): sigma = intensity, u = 0,
   // epsilon, k = contrast, within r; the bias beta is a depth-precision concession, not part
-  // of the quantity.
+  // of the quantity. The estimator does not converge to it: its taps are uniform on a screen
+  // disk, not in direction, so it estimates a view-dependent disk integral (README "What the
+  // estimator's expectation really is"; test_alchemy's AlchemyExpectation measures the gap).
   gi::EstimatedQuantity estimatedQuantity(const gi::SettingValues& s) const override {
     gi::EstimatedQuantity q;
     q.kind = gi::EstimatedQuantity::Kind::Alchemy;
