@@ -173,6 +173,27 @@ TEST(BenchCli, SeveralEffectsShareOneChartPerScene) {
   EXPECT_GT(fs::file_size(out + "/plots/default_all.png"), 1000u);
 }
 
+// Several presets: the report gets the platform-profile table (a column per preset, the
+// settings each preset gives the effect, its time and both errors).
+TEST(BenchCli, PresetsFormAPlatformProfileTable) {
+  if (!fs::exists(test::binPath("plugins/gi_effect_gtao.so")))
+    GTEST_SKIP() << "the gtao plugin is not built";
+  const std::string dir = test::makeTempDir("bench-profiles");
+  const std::string out = dir + "/out";
+  auto r = test::runCommand(bench("--quick --reps 2 --effects gtao --presets low,medium --cache '" +
+                                  dir + "/cache' --out '" + out + "'"));
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  const std::string report = readAll(out + "/report.md");
+  const size_t table = report.find("## Platform profiles");
+  ASSERT_NE(table, std::string::npos) << report;
+  EXPECT_NE(report.find("| effect | | low | medium |", table), std::string::npos) << report;
+  EXPECT_NE(report.find("| gtao | settings | blur_radius 2, interleave true, slices 1", table),
+            std::string::npos)
+      << "the low preset's gtao settings (assets/presets/low.json)\n"
+      << report;
+  EXPECT_NE(report.find("| gtao | NRMSE vs declared |", table), std::string::npos);
+}
+
 TEST(BenchCli, BadInputFailsBeforeRendering) {
   const std::string dir = test::makeTempDir("bench-bad");
   const std::string out = dir + "/out";

@@ -21,6 +21,7 @@ struct Row {
   std::string scene, effect, preset;  // effect "none": engine only
   std::string params;                 // grid settings, "ssao.samples=16 ssao.radius=0.5"
   std::string series;                 // preset + grid settings other than the first grid key
+  std::string presetSettings;         // what the preset sets for these effects: "samples 12, ..."
   std::string gridKey;                // first grid key ("" without --grid)
   double gridValue = 0.0;             // its value in this configuration
   unsigned width = 0, height = 0;

@@ -843,6 +843,13 @@ int runSweep(const Options& o) {
     r.effect = c.effectLabel;
     r.preset = c.preset;
     r.params = c.params;
+    if (c.presetPtr)
+      for (const std::string& e : c.effectSet) {
+        auto it = c.presetPtr->effects.find(e);
+        if (it == c.presetPtr->effects.end()) continue;
+        for (const auto& [key, value] : it->second.items())
+          r.presetSettings += (r.presetSettings.empty() ? "" : ", ") + key + " " + value.dump();
+      }
     r.series = c.series;
     r.gridKey = c.gridKey;
     r.gridValue = c.gridValue;

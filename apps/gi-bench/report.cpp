@@ -9,6 +9,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <tuple>
 
 #include <nlohmann/json.hpp>
 
@@ -440,6 +441,53 @@ std::string splitSection(const std::vector<Row>& rows) {
   return o.str();
 }
 
+// With several presets and no grid: one table per scene shaped like seed 003's Table 1, a
+// column per preset (platform profile), for each effect the settings its preset sets, its time
+// and its errors against the target and against its declared quantity.
+std::string profileTable(const std::vector<Row>& rows) {
+  std::vector<std::string> presets, scenes, effects;
+  auto addUnique = [](std::vector<std::string>& v, const std::string& s) {
+    if (std::find(v.begin(), v.end(), s) == v.end()) v.push_back(s);
+  };
+  std::map<std::tuple<std::string, std::string, std::string>, const Row*> cell;
+  for (const Row& r : rows) {
+    if (!r.params.empty()) continue;
+    addUnique(presets, r.preset);
+    addUnique(scenes, r.scene);
+    addUnique(effects, r.effect);
+    cell[{r.scene, r.effect, r.preset}] = &r;
+  }
+  if (presets.size() < 2) return "";
+  std::ostringstream o;
+  o << "\n## Platform profiles\n\nOne column per preset (a platform profile, after seed 003's "
+       "Table 1): the settings the preset gives each effect, the effect's GPU time [interval] "
+       "and its NRMSE against the target and against its declared quantity.\n";
+  for (const std::string& scene : scenes) {
+    o << "\n### " << scene << "\n\n| effect | |";
+    for (const std::string& p : presets) o << " " << p << " |";
+    o << "\n|---|---|";
+    for (size_t i = 0; i < presets.size(); ++i) o << "---|";
+    o << "\n";
+    for (const std::string& e : effects) {
+      auto line = [&](const char* what, auto text) {
+        o << "| " << e << " | " << what << " |";
+        for (const std::string& p : presets) {
+          auto it = cell.find({scene, e, p});
+          o << " " << (it == cell.end() ? std::string("-") : text(*it->second)) << " |";
+        }
+        o << "\n";
+      };
+      line("settings", [](const Row& r) {
+        return r.presetSettings.empty() ? std::string("defaults") : r.presetSettings;
+      });
+      line("effect ms", [](const Row& r) { return withInterval(r.effectCi, 3); });
+      line("NRMSE vs target", [](const Row& r) { return fmt(r.nrmse, 3); });
+      line("NRMSE vs declared", [](const Row& r) { return fmt(r.declaredNrmse, 3); });
+    }
+  }
+  return o.str();
+}
+
 std::string markdown(const std::vector<Row>& rows, const RunInfo& info,
                      const std::vector<std::pair<std::string, std::string>>& plots) {
   std::ostringstream o;
@@ -489,6 +537,7 @@ std::string markdown(const std::vector<Row>& rows, const RunInfo& info,
       << " | " << fmt(r.declaredNrmse, 4) << " | " << fmt(r.declaredSsim, 4) << " |\n";
   }
   if (anySplit(rows)) o << splitSection(rows);
+  o << profileTable(rows);
   if (!plots.empty()) {
     o << "\n## Error against time\n\n";
     // The PNG shows in any viewer; the SVG beside it has tooltips and scales.
