@@ -33,10 +33,6 @@ constexpr VkFormat kAOFormat = VK_FORMAT_R16_SFLOAT;
 // Workgroup size of the shaders (local_size_x/y there): 32x16 measured fastest on llvmpipe.
 constexpr uint32_t kGroupX = 32, kGroupY = 16;
 
-uint32_t groupsOf(uint32_t n, uint32_t size) {
-  return (n + size - 1) / size;
-}
-
 template <size_t N>
 std::vector<uint32_t> words(const uint32_t (&code)[N]) {
   return {code, code + N};
@@ -216,7 +212,7 @@ class AlchemyEffect : public gi::Effect {
               .sampled(3, pc.view(io->normal), nearest)
               .storageImage(4, pc.view(io->raw));
           const VkExtent2D e = pc.extent(io->raw);
-          dispatch(pc, ao_, w, groupsOf(e.width, kGroupX), groupsOf(e.height, kGroupY));
+          pc.dispatch(ao_, w, e, kGroupX, kGroupY);
         });
 
     io->ao = io->raw;
@@ -239,7 +235,7 @@ class AlchemyEffect : public gi::Effect {
               w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms_.handle())
                   .sampled(1, in, nearest, inLayout)
                   .storageImage(2, out);
-              dispatch(pc, p, w, groupsOf(e.width, kGroupX), groupsOf(e.height, kGroupY));
+              pc.dispatch(p, w, e, kGroupX, kGroupY);
             };
             axis(blurX_, pc.view(io->raw), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
                  pc.view(io->half));
@@ -264,12 +260,6 @@ class AlchemyEffect : public gi::Effect {
         gi::alchemy::makeUniforms(key[0], key[1], key[2], key[3], key[4], int(key[5]));
     uniforms_.write(&u, sizeof u);
     uploaded_ = key;
-  }
-
-  static void dispatch(gi::PassContext& pc, const gi::vk::Pipeline& p, gi::vk::DescriptorWriter& w,
-                       uint32_t x, uint32_t y) {
-    pc.descriptors().bind(pc.cmd(), p, w);
-    vkCmdDispatch(pc.cmd(), x, y, 1);
   }
 
   gi::vk::Pipeline ao_, blurX_, blurY_;

@@ -28,10 +28,6 @@ constexpr const char* kBentNormal = "gtao_bent_normal";
 constexpr VkFormat kBentFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 constexpr uint32_t kGroupX = 32, kGroupY = 16;  // local_size of both shaders (32x16: llvmpipe)
 
-uint32_t groupsOf(uint32_t n, uint32_t size) {
-  return (n + size - 1) / size;
-}
-
 class GtaoEffect : public gi::Effect {
  public:
   gi::EffectInfo info() const override {
@@ -158,7 +154,7 @@ class GtaoEffect : public gi::Effect {
               .storageImage(5, pc.view(io->raw))
               .storageImage(6, bentNormals ? pc.view(io->bent) : unusedBent_.view());
           const VkExtent2D e = pc.extent(io->raw);
-          dispatch(pc, gtao_, w, groupsOf(e.width, kGroupX), groupsOf(e.height, kGroupY));
+          pc.dispatch(gtao_, w, e, kGroupX, kGroupY);
         });
 
     io->ao = io->raw;
@@ -204,12 +200,6 @@ class GtaoEffect : public gi::Effect {
     dep.pImageMemoryBarriers = &b;
     vkCmdPipelineBarrier2(cmd, &dep);
     unusedBentReady_ = true;
-  }
-
-  static void dispatch(gi::PassContext& pc, const gi::vk::Pipeline& p, gi::vk::DescriptorWriter& w,
-                       uint32_t x, uint32_t y) {
-    pc.descriptors().bind(pc.cmd(), p, w);
-    vkCmdDispatch(pc.cmd(), x, y, 1);
   }
 
   gi::vk::Pipeline gtao_;

@@ -23,10 +23,6 @@ using gi::SettingType;
 
 constexpr uint32_t kGroupX = 32, kGroupY = 16;  // local_size of both shaders (32x16: llvmpipe)
 
-uint32_t groupsOf(uint32_t n, uint32_t size) {
-  return (n + size - 1) / size;
-}
-
 class HbaoEffect : public gi::Effect {
  public:
   gi::EffectInfo info() const override {
@@ -118,7 +114,7 @@ class HbaoEffect : public gi::Effect {
               .sampled(3, pc.view(io->normal), nearest)
               .storageImage(4, pc.view(io->raw));
           const VkExtent2D e = pc.extent(io->raw);
-          dispatch(pc, hbao_, w, groupsOf(e.width, kGroupX), groupsOf(e.height, kGroupY));
+          pc.dispatch(hbao_, w, e, kGroupX, kGroupY);
         });
 
     io->ao = io->raw;
@@ -140,12 +136,6 @@ class HbaoEffect : public gi::Effect {
     const gi::hbao::Uniforms u = gi::hbao::makeUniforms(key[0], key[1], key[2] != 0.0, int(key[3]));
     uniforms_.write(&u, sizeof u);
     uploaded_ = key;
-  }
-
-  static void dispatch(gi::PassContext& pc, const gi::vk::Pipeline& p, gi::vk::DescriptorWriter& w,
-                       uint32_t x, uint32_t y) {
-    pc.descriptors().bind(pc.cmd(), p, w);
-    vkCmdDispatch(pc.cmd(), x, y, 1);
   }
 
   gi::vk::Pipeline hbao_;

@@ -31,10 +31,6 @@ constexpr VkFormat kSumsFormat = VK_FORMAT_R32G32B32A32_UINT;
 constexpr uint32_t kGroupX = 32, kGroupY = 16;  // 32x16: llvmpipe's fastest
 constexpr int kFilterRadius = 2;                // [.5 1 1 1 .5]: the 4x4 box
 
-uint32_t groupsOf(uint32_t n, uint32_t size) {
-  return (n + size - 1) / size;
-}
-
 std::vector<uint32_t> words(const uint32_t* begin, const uint32_t* end) {
   return {begin, end};
 }
@@ -163,7 +159,7 @@ class ObscuranceEffect : public gi::Effect {
               .sampled(5, pc.view(io->emission), nearest)
               .storageImage(6, pc.view(io->sums));
           const VkExtent2D e = pc.extent(io->sums);
-          dispatch(pc, main_, w, groupsOf(e.width, kGroupX), groupsOf(e.height, kGroupY));
+          pc.dispatch(main_, w, e, kGroupX, kGroupY);
         });
 
     // Filter along x into `half`, then along y with the division into "ao"; without the filter
@@ -188,7 +184,7 @@ class ObscuranceEffect : public gi::Effect {
                 .buffer(1, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms_.handle())
                 .sampled(2, in, nearest, inLayout)
                 .storageImage(3, out);
-            dispatch(pc, p, w, groupsOf(e.width, kGroupX), groupsOf(e.height, kGroupY));
+            pc.dispatch(p, w, e, kGroupX, kGroupY);
           };
           if (!filter) {
             axis(resolve_, pc.view(io->sums), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
@@ -217,12 +213,6 @@ class ObscuranceEffect : public gi::Effect {
         obs::makeUniforms(key[0], key[1], obs::Membership(int(key[2])), int(key[3]), key[4] != 0.0);
     uniforms_.write(&u, sizeof u);
     uploaded_ = key;
-  }
-
-  static void dispatch(gi::PassContext& pc, const gi::vk::Pipeline& p, gi::vk::DescriptorWriter& w,
-                       uint32_t x, uint32_t y) {
-    pc.descriptors().bind(pc.cmd(), p, w);
-    vkCmdDispatch(pc.cmd(), x, y, 1);
   }
 
   gi::vk::Pipeline main_, filterX_, resolve_;

@@ -26,10 +26,6 @@ using gi::SettingType;
 // 640x360 (a quarter of the 64-tap pass); 32x16 measured fastest (32x32 loses cache locality).
 constexpr uint32_t kGroupX = 32, kGroupY = 16;
 
-uint32_t groupsOf(uint32_t n, uint32_t size) {
-  return (n + size - 1) / size;
-}
-
 class SsaoEffect : public gi::Effect {
  public:
   gi::EffectInfo info() const override {
@@ -124,7 +120,7 @@ class SsaoEffect : public gi::Effect {
               .sampled(3, pc.view(io->normal), nearest)
               .storageImage(4, pc.view(io->raw));
           const VkExtent2D e = pc.extent(io->raw);
-          dispatch(pc, ssao_, w, groupsOf(e.width, kGroupX), groupsOf(e.height, kGroupY));
+          pc.dispatch(ssao_, w, e, kGroupX, kGroupY);
         });
 
     gi::TextureHandle ao = io->raw;
@@ -151,12 +147,6 @@ class SsaoEffect : public gi::Effect {
         gi::ssao::makeUniforms(key[0], key[1], key[2], int(key[3]), int(key[4]), key[5] != 0.0);
     uniforms_.write(&u, sizeof u);
     uploaded_ = key;
-  }
-
-  static void dispatch(gi::PassContext& pc, const gi::vk::Pipeline& p, gi::vk::DescriptorWriter& w,
-                       uint32_t x, uint32_t y) {
-    pc.descriptors().bind(pc.cmd(), p, w);
-    vkCmdDispatch(pc.cmd(), x, y, 1);
   }
 
   gi::vk::Pipeline ssao_;

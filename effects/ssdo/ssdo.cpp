@@ -31,10 +31,6 @@ constexpr VkFormat kPackedFormat = VK_FORMAT_R32G32B32A32_UINT;
 constexpr VkFormat kOutFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 constexpr uint32_t kGroupX = 32, kGroupY = 16;  // local_size of every SSDO shader
 
-uint32_t groupsOf(uint32_t n, uint32_t size) {
-  return (n + size - 1) / size;
-}
-
 // Bit masks of the light types present and of those with shadow maps (1 directional, 2 point,
 // 4 spot), as the lighting pass's specialization constants.
 std::array<uint32_t, 2> lightMasks(const std::vector<gi::LightInfo>& lights) {
@@ -170,7 +166,7 @@ class SsdoEffect : public gi::Effect {
               .sampled(9, pc.view(io->shadowMaps), nearest)
               .storageImage(10, pc.view(io->surface));
           const VkExtent2D e = pc.extent(io->surface);
-          dispatch(pc, surface_, w, e);
+          pc.dispatch(surface_, w, e, kGroupX, kGroupY);
         });
 
     graph.addPass(
@@ -186,7 +182,7 @@ class SsdoEffect : public gi::Effect {
               .buffer(1, ubo, uniforms_.handle())
               .sampled(2, pc.view(io->surface), nearest)
               .storageImage(3, pc.view(io->raw));
-          dispatch(pc, ssdo_, w, pc.extent(io->raw));
+          pc.dispatch(ssdo_, w, pc.extent(io->raw), kGroupX, kGroupY);
         });
 
     // Blur along x into `half`, then along y with the albedo into the outputs (radius 0: only
@@ -215,7 +211,7 @@ class SsdoEffect : public gi::Effect {
                 .buffer(1, ubo, uniforms_.handle())
                 .sampled(2, in, nearest, inLayout)
                 .storageImage(3, pc.view(io->half));
-            dispatch(pc, blurX_, w, e);
+            pc.dispatch(blurX_, w, e, kGroupX, kGroupY);
             // The y dispatch reads what the x dispatch wrote (the image stays GENERAL).
             imageBarrier(pc.cmd(), pc.image(io->half));
             in = pc.view(io->half);
@@ -229,7 +225,7 @@ class SsdoEffect : public gi::Effect {
               .sampled(4, pc.view(io->material), nearest)
               .storageImage(5, pc.view(io->ambient))
               .storageImage(6, pc.view(io->indirect));
-          dispatch(pc, resolve_, w, e);
+          pc.dispatch(resolve_, w, e, kGroupX, kGroupY);
         });
     bb.put(res::kAmbient, io->ambient);
     bb.put(res::kIndirect, io->indirect);
@@ -282,12 +278,6 @@ class SsdoEffect : public gi::Effect {
         gi::ssdo::makeUniforms(key[0], int(key[1]), int(key[2]), key[3], key[4]);
     uniforms_.write(&u, sizeof u);
     uploaded_ = key;
-  }
-
-  static void dispatch(gi::PassContext& pc, const gi::vk::Pipeline& p, gi::vk::DescriptorWriter& w,
-                       VkExtent2D e) {
-    pc.descriptors().bind(pc.cmd(), p, w);
-    vkCmdDispatch(pc.cmd(), groupsOf(e.width, kGroupX), groupsOf(e.height, kGroupY), 1);
   }
 
   // Compute write -> compute sampled read of a storage image that stays in GENERAL.

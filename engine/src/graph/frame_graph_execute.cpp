@@ -3,6 +3,7 @@
 
 #include "frame_graph_internal.h"
 #include "gi/vk/gpu_timer.h"
+#include "gi/vk/pipeline.h"
 
 namespace gi {
 
@@ -224,6 +225,13 @@ void FrameGraph::execute(VkCommandBuffer cmd, vk::DescriptorArena& descriptors, 
       for (const Access& a : p->accesses)
         if (a.write && resources_[a.resource]->persistent)
           resources_[a.resource]->owned->written = true;
+}
+
+void PassContext::dispatch(const vk::Pipeline& pipeline, vk::DescriptorWriter& writer,
+                           VkExtent2D extent, uint32_t groupX, uint32_t groupY) const {
+  descriptors_->bind(cmd_, pipeline, writer);
+  vkCmdDispatch(cmd_, (extent.width + groupX - 1) / groupX, (extent.height + groupY - 1) / groupY,
+                1);
 }
 
 VkImage PassContext::image(TextureHandle h) const {

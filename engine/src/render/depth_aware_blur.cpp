@@ -10,10 +10,6 @@ namespace {
 
 constexpr uint32_t kGroupX = 32, kGroupY = 16;  // depth_aware_blur_pass.glsl
 
-uint32_t groupsOf(uint32_t n, uint32_t size) {
-  return (n + size - 1) / size;
-}
-
 }  // namespace
 
 void DepthAwareBlur::prepare(EffectContext& ctx, int radius) {
@@ -55,9 +51,8 @@ TextureHandle DepthAwareBlur::addPass(FrameGraph& graph, EffectContext& ctx,
                         VkImageView out) {
           vk::DescriptorWriter w;
           w.sampled(0, in, nearest, inLayout).storageImage(1, out);
-          pc.descriptors().bind(pc.cmd(), p, w);
           vkCmdPushConstants(pc.cmd(), p.layout(), VK_SHADER_STAGE_ALL, 0, sizeof tol, &tol);
-          vkCmdDispatch(pc.cmd(), groupsOf(e.width, kGroupX), groupsOf(e.height, kGroupY), 1);
+          pc.dispatch(p, w, e, kGroupX, kGroupY);
         };
         axis(x_, pc.view(io->packed), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, pc.view(io->half));
         vk::storageWriteToSampledRead(pc.cmd(), pc.image(io->half));

@@ -25,6 +25,8 @@
 namespace gi::vk {
 class GpuTimer;
 class DescriptorArena;
+class DescriptorWriter;
+class Pipeline;
 }  // namespace gi::vk
 
 namespace gi {
@@ -54,6 +56,10 @@ class PassContext {
   // StorageWrite of all mips, generating mip i from mip i-1 with imageLoad/imageStore): makes
   // the pass's shader writes to `sub` so far visible to its later shader reads and writes.
   void barrier(TextureHandle h, const Subresource& sub) const;
+  // Binds `pipeline` with `writer`'s descriptors and dispatches enough groupX x groupY
+  // workgroups to cover `extent` (a compute pass's usual recording).
+  void dispatch(const vk::Pipeline& pipeline, vk::DescriptorWriter& writer, VkExtent2D extent,
+                uint32_t groupX, uint32_t groupY) const;
 
  private:
   friend class FrameGraph;

@@ -43,9 +43,6 @@ std::unique_ptr<Effect> makeFloorPass(EngineState& state);
 // Workgroup of the engine's full-screen compute passes (lighting, tonemap): llvmpipe
 // pays a fixed cost per workgroup, so large groups are faster there (measured for SSAO).
 inline constexpr uint32_t kScreenGroupX = 32, kScreenGroupY = 16;
-inline uint32_t screenGroups(uint32_t n, uint32_t size) {
-  return (n + size - 1) / size;
-}
 
 // The shape tonemap and floor share: a compute shader with (0) the frame uniforms, (1) one
 // sampled input and (2) one storage output, dispatched over the output in groupX x groupY

@@ -18,9 +18,7 @@ void recordImageFilter(PassContext& pc, const vk::Pipeline& pipeline, VkBuffer f
   w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame)
       .sampled(1, pc.view(in), sampler)
       .storageImage(2, pc.view(out));
-  pc.descriptors().bind(pc.cmd(), pipeline, w);
-  const VkExtent2D e = pc.extent(out);
-  vkCmdDispatch(pc.cmd(), screenGroups(e.width, groupX), screenGroups(e.height, groupY), 1);
+  pc.dispatch(pipeline, w, pc.extent(out), groupX, groupY);
 }
 
 }  // namespace gi

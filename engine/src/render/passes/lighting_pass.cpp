@@ -80,9 +80,7 @@ class LightingPass final : public Effect {
               .sampled(11, pc.view(io->ambient), linear)
               .sampled(12, pc.view(io->indirect), linear)
               .sampled(13, pc.view(io->environment), s_.scene.linearRepeat());
-          pc.descriptors().bind(pc.cmd(), pipeline, w);
-          vkCmdDispatch(pc.cmd(), screenGroups(e.width, kScreenGroupX),
-                        screenGroups(e.height, kScreenGroupY), 1);
+          pc.dispatch(pipeline, w, e, kScreenGroupX, kScreenGroupY);
         });
     bb.put(res::kLit, io->lit);
   }
