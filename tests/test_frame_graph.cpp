@@ -133,57 +133,62 @@ TEST_F(FrameGraphTest, SizeClassesResolve) {
 }
 
 // A chain t1 -> t2 -> t3 -> output: t1 and t3 never live at the same time, so they alias.
+// The aliasing tests' passes: transfer clears and copies of whole single-mip images.
+void clearTo(PassContext& pc, TextureHandle t, float v) {
+  VkClearColorValue c{{v, v, v, 1.0f}};
+  VkImageSubresourceRange range{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+  vkCmdClearColorImage(pc.cmd(), pc.image(t), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &c, 1, &range);
+}
+void copyImage(PassContext& pc, TextureHandle from, TextureHandle to) {
+  VkImageCopy region{};
+  region.srcSubresource = region.dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+  region.extent = {pc.extent(from).width, pc.extent(from).height, 1};
+  vkCmdCopyImage(pc.cmd(), pc.image(from), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, pc.image(to),
+                 VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+}
+// An RGBA8 image for the graph to import as its output.
+vk::Image transferImage(vk::Context& ctx, VkExtent2D size) {
+  vk::ImageDesc d;
+  d.width = size.width;
+  d.height = size.height;
+  d.usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
+            VK_IMAGE_USAGE_SAMPLED_BIT;
+  return vk::Image(ctx, d);
+}
+
 TEST_F(FrameGraphTest, AliasesMemoryAndProducesCorrectPixels) {
   const VkExtent2D size{32, 16};
   FrameGraph g(ctx(), size);
-  vk::ImageDesc od;
-  od.width = size.width;
-  od.height = size.height;
-  od.usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
-             VK_IMAGE_USAGE_SAMPLED_BIT;
-  vk::Image outImage(ctx(), od);
+  vk::Image outImage = transferImage(ctx(), size);
   TextureHandle out =
       g.importTexture("output", outImage.handle(), outImage.view(), rgba8(),
                       VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
   TextureHandle t1, t2, t3;
-  auto clear = [](PassContext& pc, TextureHandle t, float v) {
-    VkClearColorValue c{{v, v, v, 1.0f}};
-    VkImageSubresourceRange range{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-    vkCmdClearColorImage(pc.cmd(), pc.image(t), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &c, 1,
-                         &range);
-  };
-  auto copy = [](PassContext& pc, TextureHandle from, TextureHandle to) {
-    VkImageCopy region{};
-    region.srcSubresource = region.dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-    region.extent = {pc.extent(from).width, pc.extent(from).height, 1};
-    vkCmdCopyImage(pc.cmd(), pc.image(from), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, pc.image(to),
-                   VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
-  };
   g.addPass(
       "clear_t1",
       [&](PassBuilder& pb) { t1 = pb.write(pb.create("t1", rgba8()), TextureUsage::TransferDst); },
-      [&](PassContext& pc) { clear(pc, t1, 0.25f); });
+      [&](PassContext& pc) { clearTo(pc, t1, 0.25f); });
   g.addPass(
       "t1_to_t2",
       [&](PassBuilder& pb) {
         pb.read(t1, TextureUsage::TransferSrc);
         t2 = pb.write(pb.create("t2", rgba8()), TextureUsage::TransferDst);
       },
-      [&](PassContext& pc) { copy(pc, t1, t2); });
+      [&](PassContext& pc) { copyImage(pc, t1, t2); });
   g.addPass(
       "t2_to_t3",
       [&](PassBuilder& pb) {
         pb.read(t2, TextureUsage::TransferSrc);
         t3 = pb.write(pb.create("t3", rgba8()), TextureUsage::TransferDst);
       },
-      [&](PassContext& pc) { copy(pc, t2, t3); });
+      [&](PassContext& pc) { copyImage(pc, t2, t3); });
   g.addPass(
       "t3_to_output",
       [&](PassBuilder& pb) {
         pb.read(t3, TextureUsage::TransferSrc);
         out = pb.write(out, TextureUsage::TransferDst);
       },
-      [&](PassContext& pc) { copy(pc, t3, out); });
+      [&](PassContext& pc) { copyImage(pc, t3, out); });
   g.markOutput(out);
   g.compile();
   EXPECT_EQ(g.stats().transientTextures, 3u);
@@ -216,29 +221,11 @@ TEST_F(FrameGraphTest, AliasesMemoryAndProducesCorrectPixels) {
 TEST_F(FrameGraphTest, AliasedFirstWriteWaitsForTheEarlierOccupantsWrites) {
   const VkExtent2D size{32, 16};
   FrameGraph g(ctx(), size);
-  vk::ImageDesc od;
-  od.width = size.width;
-  od.height = size.height;
-  od.usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
-             VK_IMAGE_USAGE_SAMPLED_BIT;
-  vk::Image outImage(ctx(), od);
+  vk::Image outImage = transferImage(ctx(), size);
   TextureHandle out =
       g.importTexture("output", outImage.handle(), outImage.view(), rgba8(),
                       VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
   TextureHandle t1, t2, t3;
-  auto clear = [](PassContext& pc, TextureHandle t, float v) {
-    VkClearColorValue c{{v, v, v, 1.0f}};
-    VkImageSubresourceRange range{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-    vkCmdClearColorImage(pc.cmd(), pc.image(t), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &c, 1,
-                         &range);
-  };
-  auto copy = [](PassContext& pc, TextureHandle from, TextureHandle to) {
-    VkImageCopy region{};
-    region.srcSubresource = region.dstSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-    region.extent = {pc.extent(from).width, pc.extent(from).height, 1};
-    vkCmdCopyImage(pc.cmd(), pc.image(from), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, pc.image(to),
-                   VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
-  };
   g.addPass(
       "write_t1_and_t2",
       [&](PassBuilder& pb) {
@@ -246,8 +233,8 @@ TEST_F(FrameGraphTest, AliasedFirstWriteWaitsForTheEarlierOccupantsWrites) {
         t2 = pb.write(pb.create("t2", rgba8()), TextureUsage::TransferDst);
       },
       [&](PassContext& pc) {
-        clear(pc, t1, 1.0f);
-        clear(pc, t2, 0.25f);
+        clearTo(pc, t1, 1.0f);
+        clearTo(pc, t2, 0.25f);
       });
   g.addPass(
       "t2_to_t3",
@@ -255,14 +242,14 @@ TEST_F(FrameGraphTest, AliasedFirstWriteWaitsForTheEarlierOccupantsWrites) {
         pb.read(t2, TextureUsage::TransferSrc);
         t3 = pb.write(pb.create("t3", rgba8()), TextureUsage::TransferDst);
       },
-      [&](PassContext& pc) { copy(pc, t2, t3); });
+      [&](PassContext& pc) { copyImage(pc, t2, t3); });
   g.addPass(
       "t3_to_output",
       [&](PassBuilder& pb) {
         pb.read(t3, TextureUsage::TransferSrc);
         out = pb.write(out, TextureUsage::TransferDst);
       },
-      [&](PassContext& pc) { copy(pc, t3, out); });
+      [&](PassContext& pc) { copyImage(pc, t3, out); });
   g.markOutput(out);
   g.compile();
   ASSERT_LT(g.stats().transientBytesAllocated, g.stats().transientBytesRequested)
