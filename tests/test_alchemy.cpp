@@ -217,43 +217,17 @@ TEST_F(AlchemyTest, FilterDoesNotCrossDepthEdges) {
   // 90 degrees, opening towards the camera): the pages are dark up to their silhouettes, the
   // wall around them must stay at 1 (no occlusion from 3 units away: eq. 9's Heaviside; no
   // filtering across the depth edge).
-  const glm::mat4 at = glm::translate(glm::mat4(1.0f), glm::vec3(0, 0, 3));
-  const glm::mat4 left = at *
-                         glm::rotate(glm::mat4(1.0f), glm::radians(-45.0f), glm::vec3(0, 1, 0)) *
-                         glm::translate(glm::mat4(1.0f), glm::vec3(0.2f, 0, 0));
-  const glm::mat4 right = at *
-                          glm::rotate(glm::mat4(1.0f), glm::radians(45.0f), glm::vec3(0, 1, 0)) *
-                          glm::translate(glm::mat4(1.0f), glm::vec3(-0.2f, 0, 0));
-  Scene s = quadScene({{glm::mat4(1.0f), 10.0f}, {left, 0.2f}, {right, 0.2f}}, glm::vec3(0, 0, 6),
-                      glm::vec3(0));
+  Scene s = quadScene(test::openBookQuads(), test::kOpenBookEye, glm::vec3(0));
   for (const char* blur :
        {"alchemy.blur_radius=0", "alchemy.blur_radius=2", "alchemy.blur_radius=8"}) {
     Result r = render(s, {"alchemy.samples=16", "alchemy.intensity=2", blur});
-    auto onWall = [&](int x, int y) { return std::abs(r.worldAt(x, y).z) < 1e-3f; };
-    auto nearOther = [&](int x, int y, bool wall) {  // a pixel of the other kind within 3 px
-      for (int j = -3; j <= 3; ++j)
-        for (int i = -3; i <= 3; ++i)
-          if (onWall(x + i, y + j) != wall) return true;
-      return false;
-    };
-    int wallNearEdge = 0, pageNearEdge = 0;
-    float darkestPage = 1.0f;
-    for (int y = 3; y < r.h - 3; ++y)
-      for (int x = 3; x < r.w - 3; ++x) {
-        const bool wall = onWall(x, y);
-        if (!nearOther(x, y, wall)) continue;
-        if (!wall) {
-          ++pageNearEdge;
-          darkestPage = std::min(darkestPage, r.at(x, y));
-          continue;
-        }
-        ++wallNearEdge;
-        ASSERT_GT(r.at(x, y), 0.99f) << blur << " wall pixel " << x << "," << y << " darkened";
-      }
-    std::printf("%s: darkest page pixel next to the wall %.3f\n", blur, darkestPage);
-    EXPECT_GT(wallNearEdge, 50) << blur;
-    ASSERT_GT(pageNearEdge, 50) << blur;
-    EXPECT_LT(darkestPage, 0.85f) << blur << ": the pages must be dark for the test to bite";
+    const test::BookOutline o = test::bookOutline(r);
+    for (const auto& [px, v] : o.wall)
+      ASSERT_GT(v, 0.99f) << blur << " wall pixel " << px.x << "," << px.y << " darkened";
+    std::printf("%s: darkest page pixel next to the wall %.3f\n", blur, o.darkestPage);
+    EXPECT_GT(o.wall.size(), 50u) << blur;
+    ASSERT_GT(o.pages, 50) << blur;
+    EXPECT_LT(o.darkestPage, 0.85f) << blur << ": the pages must be dark for the test to bite";
   }
 }
 

@@ -377,38 +377,16 @@ TEST_F(ObscuranceTest, NoFalseSilhouetteShadowAndNoFilterAcrossDepthEdges) {
   // degrees opening towards the camera: dark inside, up to its silhouettes. Wall pixels around
   // the silhouettes must not darken: not by the book as an occluder (0 < z - z* < R) and not
   // by filtering the book's values into them (depth-aware filter).
-  const glm::mat4 at = translation({0, 0, 3});
-  const glm::mat4 left = at * rotation(-45, {0, 1, 0}) * translation({0.2f, 0, 0});
-  const glm::mat4 right = at * rotation(45, {0, 1, 0}) * translation({-0.2f, 0, 0});
-  Scene s = quadScene({{glm::mat4(1.0f), 10.0f}, {left, 0.2f}, {right, 0.2f}}, glm::vec3(0, 0, 6),
-                      glm::vec3(0));
+  Scene s = quadScene(test::openBookQuads(), test::kOpenBookEye, glm::vec3(0));
   for (const char* filter : {"obscurance.filter=false", "obscurance.filter=true"}) {
     Result r = render(s, {"obscurance.radius=0.5", "obscurance.membership=step", filter});
-    auto onWall = [&](int x, int y) { return std::abs(r.worldAt(x, y).z) < 1e-3f; };
-    auto nearOther = [&](int x, int y, bool wall) {
-      for (int j = -3; j <= 3; ++j)
-        for (int i = -3; i <= 3; ++i)
-          if (onWall(x + i, y + j) != wall) return true;
-      return false;
-    };
-    int wallNearEdge = 0, pageNearEdge = 0;
-    float darkestPage = 1.0f;
-    for (int y = 3; y < r.h - 3; ++y)
-      for (int x = 3; x < r.w - 3; ++x) {
-        const bool wall = onWall(x, y);
-        if (!nearOther(x, y, wall)) continue;
-        if (!wall) {
-          ++pageNearEdge;
-          darkestPage = std::min(darkestPage, r.at(x, y));
-          continue;
-        }
-        ++wallNearEdge;
-        ASSERT_GT(r.at(x, y), 0.99f) << filter << " wall pixel " << x << "," << y << " darkened";
-      }
-    std::printf("%s: darkest book pixel next to the wall %.3f\n", filter, darkestPage);
-    EXPECT_GT(wallNearEdge, 50) << filter;
-    ASSERT_GT(pageNearEdge, 50) << filter;
-    EXPECT_LT(darkestPage, 0.95f) << filter << ": the book must be dark for the test to bite";
+    const test::BookOutline o = test::bookOutline(r);
+    for (const auto& [px, v] : o.wall)
+      ASSERT_GT(v, 0.99f) << filter << " wall pixel " << px.x << "," << px.y << " darkened";
+    std::printf("%s: darkest book pixel next to the wall %.3f\n", filter, o.darkestPage);
+    EXPECT_GT(o.wall.size(), 50u) << filter;
+    ASSERT_GT(o.pages, 50) << filter;
+    EXPECT_LT(o.darkestPage, 0.95f) << filter << ": the book must be dark for the test to bite";
   }
 }
 

@@ -3,6 +3,7 @@
 // helpers on rendered images.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
 #include <vector>
@@ -67,6 +68,52 @@ inline Quads cornerQuads() {
 inline Scene cornerScene(float scale = 1.0f, float yfov = glm::radians(60.0f)) {
   return quadScene(cornerQuads(), glm::vec3(2.5f, 1.6f, 0.0f), glm::vec3(0.0f), scale, 0.05f,
                    100.0f, yfov);
+}
+
+// The depth-discontinuity case: a wall at z = 0 and, 3 units in front of it, an open book (two
+// 0.4-wide quads meeting at 90 degrees, opening toward a camera at z = 6): dark inside, up to
+// its outline, while nothing darkens the wall 3 units behind.
+inline Quads openBookQuads() {
+  const glm::mat4 at = glm::translate(glm::mat4(1.0f), glm::vec3(0, 0, 3));
+  const glm::mat4 left = at *
+                         glm::rotate(glm::mat4(1.0f), glm::radians(-45.0f), glm::vec3(0, 1, 0)) *
+                         glm::translate(glm::mat4(1.0f), glm::vec3(0.2f, 0, 0));
+  const glm::mat4 right = at *
+                          glm::rotate(glm::mat4(1.0f), glm::radians(45.0f), glm::vec3(0, 1, 0)) *
+                          glm::translate(glm::mat4(1.0f), glm::vec3(-0.2f, 0, 0));
+  return {{glm::mat4(1.0f), 10.0f}, {left, 0.2f}, {right, 0.2f}};
+}
+inline const glm::vec3 kOpenBookEye(0, 0, 6);
+
+// The pixels of an open-book image within 3 px of a pixel of the other kind (wall vs book),
+// away from the border: each wall pixel with its value, and the book pixels' count and darkest
+// value. `r` has w, h, at(x, y) and worldAt(x, y).
+struct BookOutline {
+  std::vector<std::pair<glm::ivec2, float>> wall;
+  int pages = 0;
+  float darkestPage = 1.0f;
+};
+BookOutline bookOutline(const auto& r) {
+  auto onWall = [&](int x, int y) { return std::abs(r.worldAt(x, y).z) < 1e-3f; };
+  auto nearOther = [&](int x, int y, bool wall) {
+    for (int j = -3; j <= 3; ++j)
+      for (int i = -3; i <= 3; ++i)
+        if (onWall(x + i, y + j) != wall) return true;
+    return false;
+  };
+  BookOutline o;
+  for (int y = 3; y < r.h - 3; ++y)
+    for (int x = 3; x < r.w - 3; ++x) {
+      const bool wall = onWall(x, y);
+      if (!nearOther(x, y, wall)) continue;
+      if (wall) {
+        o.wall.push_back({{x, y}, r.at(x, y)});
+      } else {
+        ++o.pages;
+        o.darkestPage = std::min(o.darkestPage, r.at(x, y));
+      }
+    }
+  return o;
 }
 
 inline bool finite(const ImageRGBA32F& img) {
