@@ -73,7 +73,7 @@ class GtaoEffect : public gi::Effect {
          "Jimenez et al. multi-bounce fit: AO' = max(AO, ((a AO + b) AO + c) AO) from the albedo "
          "(reads the albedo G-buffer)",
          true},
-        {"blur_radius", SettingType::Int, 2, 0, gi::gtao::kMaxBlurRadius,
+        {"blur_radius", SettingType::Int, 2, 0, gi::DepthAwareBlur::kMaxRadius,
          "depth-aware denoise radius in pixels (0: no blur pass; even radii cancel the 4x4 "
          "interleave pattern exactly)",
          true},

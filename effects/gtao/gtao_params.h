@@ -23,7 +23,7 @@
 
 namespace gi::gtao {
 
-inline constexpr int kMaxSlices = 16, kMaxSteps = 32, kMaxBlurRadius = 8;
+inline constexpr int kMaxSlices = 16, kMaxSteps = 32;
 // Blur: neighbours whose depth differs from the centre's tangent plane by more than this
 // fraction of the radius get no weight (the edge-stopping threshold).
 inline constexpr float kBlurDepthTolerance = 0.25f;

@@ -55,7 +55,7 @@ class HbaoEffect : public gi::Effect {
          "degrees added to the tangent angle: horizons below it do not occlude (hides "
          "tessellation and depth-precision self-occlusion)",
          false},
-        {"blur_radius", SettingType::Int, 2, 0, gi::hbao::kMaxBlurRadius,
+        {"blur_radius", SettingType::Int, 2, 0, gi::DepthAwareBlur::kMaxRadius,
          "depth-aware blur radius in pixels (0: no blur pass; even radii cancel the 4x4 "
          "interleave pattern exactly)",
          true},

@@ -18,7 +18,7 @@
 
 namespace gi::hbao {
 
-inline constexpr int kMaxDirections = 32, kMaxSteps = 32, kMaxBlurRadius = 8;
+inline constexpr int kMaxDirections = 32, kMaxSteps = 32;
 inline constexpr float kBlurDepthTolerance = 0.25f;  // fraction of the radius
 
 // std140 mirror of the `HbaoParams` uniform block in hbao.comp.

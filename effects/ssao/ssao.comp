@@ -14,8 +14,8 @@ layout(local_size_x = 32, local_size_y = 16) in;
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 // Keep in sync with gi::ssao::Uniforms (ssao_kernel.h).
 layout(set = 0, binding = 1) uniform SsaoParams {
-  vec4 params;   // radius, bias (world), intensity, blur depth tolerance (world)
-  ivec4 counts;  // samples, blur radius
+  vec4 params;   // radius, bias (world), intensity, 0
+  ivec4 counts;  // samples, 0, 0, 0
   vec4 rotation[16];
   uvec4 kernel[16];  // tap i: kernel[i / 4][i % 4], 11/11/10 bits (gi::ssao::packTap)
 } ssao;

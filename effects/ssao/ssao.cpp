@@ -64,7 +64,7 @@ class SsaoEffect : public gi::Effect {
          "an occluder must be this far in front of a tap, as a fraction of the radius", false},
         {"intensity", SettingType::Float, 1.0, 0.0, 4.0,
          "AO = 1 - intensity x occluded fraction (clamped to [0, 1])", false},
-        {"blur_radius", SettingType::Int, 2, 0, gi::ssao::kMaxBlurRadius,
+        {"blur_radius", SettingType::Int, 2, 0, gi::DepthAwareBlur::kMaxRadius,
          "depth-aware blur radius in pixels (0: no blur pass; even radii cancel the 4x4 "
          "interleave pattern exactly)",
          true},
@@ -136,15 +136,12 @@ class SsaoEffect : public gi::Effect {
   // records the next, so the GPU is not reading it. (Frames in flight would need one per frame.)
   // The kernel and rotations are rebuilt only when a setting changed since the last upload.
   void upload(const gi::SettingValues& s) {
-    const std::array<double, 6> key = {s.number("radius"),
-                                       s.number("bias"),
-                                       s.number("intensity"),
+    const std::array<double, 5> key = {s.number("radius"), s.number("bias"), s.number("intensity"),
                                        double(s.integer("samples")),
-                                       double(s.integer("blur_radius")),
                                        s.flag("interleave") ? 1.0 : 0.0};
     if (key == uploaded_) return;
     const gi::ssao::Uniforms u =
-        gi::ssao::makeUniforms(key[0], key[1], key[2], int(key[3]), int(key[4]), key[5] != 0.0);
+        gi::ssao::makeUniforms(key[0], key[1], key[2], int(key[3]), key[4] != 0.0);
     uniforms_.write(&u, sizeof u);
     uploaded_ = key;
   }
@@ -152,7 +149,7 @@ class SsaoEffect : public gi::Effect {
   gi::vk::Pipeline ssao_;
   gi::DepthAwareBlur blur_;
   gi::vk::Buffer uniforms_;
-  std::optional<std::array<double, 6>> uploaded_;  // the settings uniforms_ holds
+  std::optional<std::array<double, 5>> uploaded_;  // the settings uniforms_ holds
 };
 
 }  // namespace

@@ -35,20 +35,18 @@
 namespace gi::ssao {
 
 inline constexpr int kMaxSamples = 64;
-inline constexpr int kMaxBlurRadius = 8;
 // Blur: neighbours whose depth differs from the centre's tangent plane by more than this
 // fraction of the radius get no weight (the edge-stopping threshold).
 inline constexpr float kBlurDepthTolerance = 0.25f;
 
-// std140 mirror of the `SsaoParams` uniform block in ssao.comp and ssao_blur.comp.
+// std140 mirror of the `SsaoParams` uniform block in ssao.comp.
 struct Uniforms {
-  float radius;         // R, world units
-  float bias;           // absolute, world units (setting bias x R)
-  float intensity;      // AO = 1 - intensity x occluded fraction
-  float blurTolerance;  // absolute, world units (kBlurDepthTolerance x R)
-  int32_t samples;      // taps used, 1..kMaxSamples
-  int32_t blurRadius;   // 0..kMaxBlurRadius
-  int32_t pad[2];
+  float radius;     // R, world units
+  float bias;       // absolute, world units (setting bias x R)
+  float intensity;  // AO = 1 - intensity x occluded fraction
+  float pad0;
+  int32_t samples;  // taps used, 1..kMaxSamples
+  int32_t pad[3];
   float rotation[16][4];                // cos, sin of each 4x4 phase's kernel rotation, 0, 0
   uint32_t kernel[kMaxSamples / 4][4];  // tap i at [i / 4][i % 4], packed by packTap()
 };
@@ -114,15 +112,13 @@ inline double rotationAngle(int x, int y, int n, bool interleave) {
 }
 
 inline Uniforms makeUniforms(double radius, double bias, double intensity, int samples,
-                             int blurRadius, bool interleave) {
+                             bool interleave) {
   Uniforms u{};
   const int n = samples < 1 ? 1 : samples > kMaxSamples ? kMaxSamples : samples;
   u.radius = float(radius);
   u.bias = float(bias * radius);
   u.intensity = float(intensity);
-  u.blurTolerance = float(kBlurDepthTolerance * radius);
   u.samples = n;
-  u.blurRadius = blurRadius;
   for (int e = 0; e < 16; ++e) {
     const double a = rotationAngle(e & 3, e >> 2, n, interleave);
     u.rotation[e][0] = float(std::cos(a));
