@@ -66,8 +66,9 @@ class SsdoEffect : public gi::Effect {
         gi::SettingDesc::length("radius", 0.5, 1e-6, 1e9,
                                 "world-space length r_max of the sample steps (and the range "
                                 "beyond which an occluder is ignored)"),
-        {"samples", SettingType::Int, 12, 1, gi::ssdo::kMaxSamples,
-         "samples N per pixel (a specialization constant: the loop unrolls)", true},
+        gi::SettingDesc::samples(
+            "samples", 12, 1, gi::ssdo::kMaxSamples,
+            "samples N per pixel (a specialization constant: the loop unrolls)", true),
         {"pattern_sets", SettingType::Int, 16, 1, gi::ssdo::kPhases,
          "M precomputed sample sets spread over the 4x4 pixel pattern (16: every phase its "
          "own set; the blur averages them)",

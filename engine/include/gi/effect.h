@@ -19,7 +19,7 @@
 
 // Bumped whenever this header, settings.h, frame_graph.h or the shader interface change in a
 // way that breaks compiled modules; the registry refuses modules built against another value.
-#define GI_EFFECT_ABI_VERSION 5u
+#define GI_EFFECT_ABI_VERSION 6u
 
 namespace gi {
 
