@@ -150,6 +150,14 @@ TEST(BenchCli, DeclaredQuantityFollowsTheSweptRadius) {
   EXPECT_EQ(j["results"][1]["declared"].get<std::string>().rfind("obscurance linear r=0.6", 0), 0u);
   EXPECT_EQ(j["results"][1]["reference"].get<std::string>().rfind("ao r=0.6", 0), 0u);
   EXPECT_NE(j["results"][0]["declared_nrmse"], j["results"][1]["declared_nrmse"]);
+  // Obscurance is not AO: the error against AO is split into that gap and the estimator's.
+  for (const auto& row : j["results"]) {
+    ASSERT_TRUE(row.contains("quantity_gap")) << row.dump();
+    EXPECT_GT(row["quantity_gap"]["gap_nrmse"].get<double>(), 0.0);
+    EXPECT_TRUE(std::isfinite(row["quantity_gap"]["gap_share"].get<double>()));
+  }
+  EXPECT_NE(readAll(out + "/report.md").find("## The declared quantity against the target"),
+            std::string::npos);
   size_t entries = 0;
   for (const auto& e : fs::directory_iterator(cache)) entries += e.path().extension() == ".json";
   EXPECT_EQ(entries, 4u) << "AO and obscurance(linear) at two radii";

@@ -624,6 +624,25 @@ Scores score(const Measurement& m, const ReferenceSpec& spec, const Reference& r
   return s;
 }
 
+// The part of the error against the target that the declared quantity's own distance from it
+// explains (metrics.h QuantityGap); nullopt when the effect declares its target.
+std::optional<gi::bench::QuantityGap> gapOf(const Measurement& m, const Comparison& cmp,
+                                            const Reference& target, const Reference& declared,
+                                            const Options& o) {
+  if (cmp.declared == cmp.target ||
+      gi::bench::isAoLike(cmp.declared.quantity) != gi::bench::isAoLike(cmp.target.quantity))
+    return std::nullopt;
+  const size_t n = size_t(o.width) * size_t(o.height);
+  std::vector<unsigned char> mask(n);
+  for (size_t i = 0; i < n; ++i)  // as score(): geometry in the target and in the frame
+    mask[i] = target.depth.pixels[i * 4 + 2] > 0.5f && m.depth.pixels[i * 4] > 0.0f;
+  const int w = int(o.width), h = int(o.height),
+            c = gi::bench::isAoLike(cmp.target.quantity) ? 0 : -1;
+  return gi::bench::quantityGap(gi::bench::channel(w, h, m.out.pixels, c),
+                                gi::bench::channel(w, h, target.value.pixels, c),
+                                gi::bench::channel(w, h, declared.value.pixels, c), mask);
+}
+
 std::string formatDouble(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%g", v);
@@ -820,11 +839,12 @@ std::map<ReferenceKey, Reference> computeReferences(const Options& o, const Setu
 
 void checkFinite(const Row& r) {
   const Row::AoSplit& s = r.split;
-  for (double v : {r.totalMs,        r.effectMs,       r.floorMs,         r.wallMs,
-                   r.totalCi.lo,     r.totalCi.hi,     r.nrmse,           r.ssim,
-                   r.declaredNrmse,  r.declaredSsim,   s.limitNrmse,      s.offscreenNrmse,
-                   s.hiddenNrmse,    s.estimatorNrmse, s.visibleFraction, s.offscreenFraction,
-                   s.hiddenFraction, s.shareOffscreen, s.shareHidden,     s.shareEstimator})
+  for (double v : {r.totalMs,         r.effectMs,          r.floorMs,        r.wallMs,
+                   r.totalCi.lo,      r.totalCi.hi,        r.nrmse,          r.ssim,
+                   r.declaredNrmse,   r.declaredSsim,      r.gapNrmse,       r.gapShare,
+                   s.limitNrmse,      s.offscreenNrmse,    s.hiddenNrmse,    s.estimatorNrmse,
+                   s.visibleFraction, s.offscreenFraction, s.hiddenFraction, s.shareOffscreen,
+                   s.shareHidden,     s.shareEstimator})
     if (!std::isfinite(v))
       throw gi::Error(gi::ErrorKind::NonFinite, r.scene,
                       "non-finite measurement for " + r.effect + " " + r.params);
@@ -853,6 +873,7 @@ int runSweep(const Options& o) {
     jobs.push_back({&s.scenes[c.scene].scene, &c.effects, &c.engine, c.comparison.resource});
   ProgressBar bar(o.progress, "configurations", configs.size());
   std::vector<Scores> vsTargets(configs.size()), vsDeclareds(configs.size());
+  std::vector<std::optional<gi::bench::QuantityGap>> gaps(configs.size());
   const std::vector<Measurement> measured =
       measureAll(ctx, s.registry, jobs, o, true, [&](size_t i, const Measurement& m) {
         const Config& c = configs[i];
@@ -860,6 +881,8 @@ int runSweep(const Options& o) {
             score(m, c.comparison.target, refs.at(ReferenceKey{c.scene, c.comparison.target}), o);
         vsDeclareds[i] = score(m, c.comparison.declared,
                                refs.at(ReferenceKey{c.scene, c.comparison.declared}), o);
+        gaps[i] = gapOf(m, c.comparison, refs.at(ReferenceKey{c.scene, c.comparison.target}),
+                        refs.at(ReferenceKey{c.scene, c.comparison.declared}), o);
         bar.step(s.scenes[c.scene].name + " " + c.effectLabel + " " + c.params);
       });
   std::vector<Row> rows;
@@ -910,6 +933,11 @@ int runSweep(const Options& o) {
     r.declared = referenceLabel(c.comparison.declared, declared.spp);
     r.declaredStdError = declared.meanStdError;
     r.declaredNrmse = vsDeclared.metrics.nrmse;
+    if (gaps[i]) {
+      r.gapPresent = true;
+      r.gapNrmse = gaps[i]->gapNrmse;
+      r.gapShare = gaps[i]->gapShare;
+    }
     r.declaredSsim = vsDeclared.metrics.ssim;
     checkFinite(r);
     rows.push_back(std::move(r));
