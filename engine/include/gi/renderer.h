@@ -4,6 +4,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -106,6 +107,10 @@ class Renderer {
   ImageRGBA32F readTarget(const std::string& name);  // any produced resource as float RGBA
   std::vector<std::string> viewNames() const;        // resources that can be viewed / read
   const CameraView& camera() const;
+  // A free camera (gi-demo's) in place of the scene's: `view` (rigid), `position`, `yfov`,
+  // `znear`, `zfar` are kept; `proj` is rebuilt for the output's aspect (also on resize).
+  // nullopt returns to the scene's camera. Lights and shadow views are re-planned for it.
+  void setCameraOverride(const std::optional<CameraView>& camera);
   // The tonemapped RGBA8 image; after renderFrame() it is in VK_IMAGE_LAYOUT_GENERAL and all
   // writes are complete (a presenter copies it into a swapchain image).
   VkImage outputImage() const;
