@@ -105,6 +105,35 @@ TEST(Demo, WalkedCameraPathChangesTheScreenshots) {
   // 6 frames at 1/30 s and 2 m/s: 0.4 m forward; the camera stays above the floor.
   const auto camera = listsAfter(r.output, "camera");
   ASSERT_EQ(camera.size(), 1u) << r.output;
+  // The UI's own cost is measured: its render pass has a GPU time, its building a CPU time.
+  const size_t ui = r.output.find("UI GPU ");
+  ASSERT_NE(ui, std::string::npos) << r.output;
+  EXPECT_GT(std::stod(r.output.substr(ui + 7)), 0.0) << r.output;
+  const size_t uiCpu = r.output.find("UI CPU ");
+  ASSERT_NE(uiCpu, std::string::npos) << r.output;
+  EXPECT_GT(std::stod(r.output.substr(uiCpu + 7)), 0.0) << r.output;
+}
+
+TEST(Demo, EveryViewOfTheSelectorShows) {
+  REQUIRE_DEMO();
+  const std::string dir = test::makeTempDir("demo_views");
+  const std::string args = " --scene default --effects ssao --paused" + kSize + " --script ";
+  auto list = runDemo(args + writeScript(dir, "frames 1\nprint views\n"));
+  ASSERT_EQ(list.exitCode, 0) << list.output;
+  const auto views = listsAfter(list.output, "views");
+  ASSERT_EQ(views.size(), 1u) << list.output;
+  for (const char* expected : {"normal", "depth", "albedo", "ao", "shadow_maps"})
+    EXPECT_TRUE(views[0].count(expected)) << expected << " missing:\n" << list.output;
+  std::string script = "frames 1\nprint memory\n";
+  for (const std::string& v : views[0]) script += "view " + v + "\nframes 1\n";
+  script += "view output\nframes 1\nprint memory\n";
+  auto r = runDemo(args + writeScript(dir, script));
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_EQ(r.output.find("validation"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("cannot show"), std::string::npos) << r.output;
+  const auto memory = listsAfter(r.output, "device memory");
+  ASSERT_EQ(memory.size(), 2u) << r.output;
+  EXPECT_EQ(memory[0], memory[1]) << r.output;
 }
 
 TEST(Demo, EffectSwitchAndGraphSettingMatchHeadlessRender) {

@@ -187,7 +187,18 @@ void App::frame() {
     state_.screenshot = false;
   }
   // The panel may have changed the view or the effects: show what the renderer holds now.
-  if (controller_->view() == gi::resources::kOutput) {
+  // A resource that cannot be previewed sends the view back to the output, with the reason.
+  std::optional<gi::ImageRGBA8> image;
+  if (controller_->view() != gi::resources::kOutput) {
+    try {
+      image = controller_->image();
+    } catch (const std::exception& e) {
+      state_.message = "cannot show '" + controller_->view() + "': " + e.what();
+      if (!script_.empty()) std::fprintf(stderr, "gi-demo: %s\n", state_.message.c_str());
+      controller_->setView(gi::resources::kOutput);
+    }
+  }
+  if (!image) {
     if (preview_) {  // back from another view: its image goes (memory back to where it was)
       vkDeviceWaitIdle(ctx_->device());
       preview_.reset();
@@ -195,20 +206,19 @@ void App::frame() {
     presenter_->present(renderer.outputImage(), renderer.outputExtent(), VK_IMAGE_LAYOUT_GENERAL,
                         ImGui::GetDrawData());
   } else {
-    const gi::ImageRGBA8 image = controller_->image();
-    if (!preview_ || preview_.desc().width != uint32_t(image.width) ||
-        preview_.desc().height != uint32_t(image.height)) {
+    if (!preview_ || preview_.desc().width != uint32_t(image->width) ||
+        preview_.desc().height != uint32_t(image->height)) {
       gi::vk::ImageDesc d;
-      d.width = uint32_t(image.width);
-      d.height = uint32_t(image.height);
+      d.width = uint32_t(image->width);
+      d.height = uint32_t(image->height);
       d.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT |
                 VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
       vkDeviceWaitIdle(ctx_->device());  // the previous preview may still be read
       preview_ = gi::vk::Image(*ctx_, d);
     }
     vkDeviceWaitIdle(ctx_->device());
-    gi::vk::uploadImage(*ctx_, preview_, image.pixels.data(), image.pixels.size());
-    presenter_->present(preview_.handle(), {uint32_t(image.width), uint32_t(image.height)},
+    gi::vk::uploadImage(*ctx_, preview_, image->pixels.data(), image->pixels.size());
+    presenter_->present(preview_.handle(), {uint32_t(image->width), uint32_t(image->height)},
                         VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, ImGui::GetDrawData());
   }
   stats_.uiGpuMs = presenter_->uiGpuMs();
@@ -335,6 +345,10 @@ void App::execute(const ScriptStep& s) {
     for (const std::string& p : renderer.passNames()) executed += " " + p;
     for (const std::string& p : renderer.culledPassNames()) culled += " " + p;
     std::printf("passes:%s\nculled:%s\n", executed.c_str(), culled.c_str());
+  } else if (s.args[0] == "views") {
+    std::string views;
+    for (const std::string& v : renderer.viewNames()) views += " " + v;
+    std::printf("views:%s\n", views.c_str());
   } else if (s.args[0] == "timings") {
     printTimings();
   } else if (s.args[0] == "memory") {

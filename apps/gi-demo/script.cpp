@@ -61,8 +61,8 @@ std::vector<ScriptStep> loadScript(const std::string& path) {
         (s.verb == "pause" && s.args[0] != "on" && s.args[0] != "off"))
       fail(path, line, s.verb + ": expected on or off");
     if (s.verb == "print" && s.args[0] != "passes" && s.args[0] != "timings" &&
-        s.args[0] != "memory" && s.args[0] != "camera")
-      fail(path, line, "print: expected passes, timings, memory or camera");
+        s.args[0] != "memory" && s.args[0] != "camera" && s.args[0] != "views")
+      fail(path, line, "print: expected passes, views, timings, memory or camera");
     steps.push_back(std::move(s));
   }
   return steps;

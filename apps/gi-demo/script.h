@@ -13,7 +13,7 @@
 //   step                     advance the stopped clock by one frame's time
 //   time T                   set the clock
 //   screenshot PATH          write the rendered image (without the panel) as PNG
-//   print passes|timings|memory|camera   print to stdout
+//   print passes|views|timings|memory|camera   print to stdout (views: what `view` takes)
 #pragma once
 
 #include <string>

@@ -105,7 +105,7 @@ class Renderer {
 
   ImageRGBA8 readOutput();                           // tonemapped 8-bit image (view "output")
   ImageRGBA32F readTarget(const std::string& name);  // any produced resource as float RGBA
-  std::vector<std::string> viewNames() const;        // resources that can be viewed / read
+  std::vector<std::string> viewNames() const;        // images that can be viewed / read
   const CameraView& camera() const;
   // A free camera (gi-demo's) in place of the scene's: `view` (rigid), `position`, `yfov`,
   // `znear`, `zfar` are kept; `proj` is rebuilt for the output's aspect (also on resize).

@@ -791,7 +791,11 @@ ImageRGBA32F Renderer::readTarget(const std::string& name) {
   return texelsToFloat(readTexels(impl_->ctx, t), t, name);
 }
 std::vector<std::string> Renderer::viewNames() const {
-  return impl_->graph.blackboard().names();
+  // Images only: a buffer (lights, sampling tables) can be neither shown nor read back.
+  std::vector<std::string> names;
+  for (const std::string& n : impl_->graph.blackboard().names())
+    if (impl_->graph.blackboard().texture(n).valid()) names.push_back(n);
+  return names;
 }
 VkImage Renderer::outputImage() const {
   return impl_->output.handle();
