@@ -222,6 +222,7 @@ void App::frame() {
                         VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, ImGui::GetDrawData());
   }
   stats_.uiGpuMs = presenter_->uiGpuMs();
+  stats_.uiCpuMs += presenter_->uiRecordMs();
 
   const double frameMs = ms(std::chrono::steady_clock::now() - start);
   stats_.frameMs.push_back(float(frameMs));

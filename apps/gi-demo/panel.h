@@ -16,7 +16,7 @@ namespace demo {
 struct FrameStats {
   std::deque<float> frameMs;           // wall time of recent frames (the graph)
   std::vector<gi::PassTiming> passes;  // GPU time of each pass, last frame
-  double uiCpuMs = 0.0;                // building and recording the panel, last frame
+  double uiCpuMs = 0.0;                // building the panel + recording its draw lists, last frame
   double uiGpuMs = -1.0;               // the ImGui render pass, last finished frame
   uint64_t deviceBytes = 0;
 };

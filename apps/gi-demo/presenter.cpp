@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <limits>
 
 #include "gi/errors.h"
@@ -341,7 +342,10 @@ void Presenter::record(VkImage source, VkExtent2D extent, VkImageLayout layout, 
   rp.framebuffer = framebuffers_[index];
   rp.renderArea.extent = extent_;
   vkCmdBeginRenderPass(cmd_, &rp, VK_SUBPASS_CONTENTS_INLINE);
+  const auto start = std::chrono::steady_clock::now();
   if (ui) ImGui_ImplVulkan_RenderDrawData(ui, cmd_);
+  uiRecordMs_ =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   vkCmdEndRenderPass(cmd_);
   vkCmdWriteTimestamp2(cmd_, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT, queries_, 1);
   check(vkEndCommandBuffer(cmd_), "vkEndCommandBuffer");

@@ -29,6 +29,8 @@ class Presenter {
   bool present(VkImage source, VkExtent2D extent, VkImageLayout layout, ImDrawData* ui);
   // GPU time of the ImGui pass of the last finished frame (ms), -1 before the first one.
   double uiGpuMs() const { return uiGpuMs_; }
+  // CPU time of recording the ImGui draw lists (vertex upload included), last frame (ms).
+  double uiRecordMs() const { return uiRecordMs_; }
   VkExtent2D extent() const { return extent_; }
 
  private:
@@ -57,7 +59,7 @@ class Presenter {
   VkSemaphore imageAcquired_ = VK_NULL_HANDLE;
   VkQueryPool queries_ = VK_NULL_HANDLE;
   bool queriesPending_ = false, outOfDate_ = false, imguiReady_ = false;
-  double uiGpuMs_ = -1.0;
+  double uiGpuMs_ = -1.0, uiRecordMs_ = 0.0;
 };
 
 }  // namespace demo
