@@ -89,7 +89,8 @@ TEST(Demo, WalkedCameraPathChangesTheScreenshots) {
                                              "screenshot " +
                                              dir +
                                              "/c.png\n"
-                                             "print camera\n");
+                                             "print camera\n"
+                                             "print timings\n");
   auto r = runDemo(" --scene default" + kSize + " --script " + script);
   ASSERT_EQ(r.exitCode, 0) << r.output;
   EXPECT_EQ(r.output.find("validation"), std::string::npos) << r.output;
@@ -228,6 +229,34 @@ TEST(Demo, DemoSceneRuns) {
   const auto passes = listsAfter(r.output, "passes");
   ASSERT_EQ(passes.size(), 1u);
   EXPECT_TRUE(passes[0].count("skinning")) << "the Fox and CesiumMan are skinned:\n" << r.output;
+}
+
+// Accuracy on demand: the last frame of SSAO against the CPU reference of the quantity it
+// declares, at the same camera (a walked one) and size.
+TEST(Demo, AccuracyCheckComparesTheFrameWithTheReference) {
+  REQUIRE_DEMO();
+  const std::string dir = test::makeTempDir("demo_accuracy");
+  const std::string script = writeScript(dir,
+                                         "key w 3\n"
+                                         "frames 1\n"
+                                         "accuracy ssao 16\n");
+  auto r = runDemo(" --scene default --effects ssao --paused" + kSize + " --script " + script);
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_EQ(r.output.find("validation"), std::string::npos) << r.output;
+  const size_t at = r.output.find("accuracy: ssao nrmse ");
+  ASSERT_NE(at, std::string::npos) << r.output;
+  std::istringstream words(r.output.substr(at + 21));
+  double nrmse = -1;
+  std::string key;
+  size_t pixels = 0;
+  uint32_t spp = 0;
+  words >> nrmse >> key >> pixels >> key >> spp;
+  // The room fills most of the 160x120 view; SSAO follows its declared quantity closely but
+  // not exactly (taps, blur, 16 reference samples).
+  EXPECT_GT(pixels, 160u * 120u / 2) << r.output;
+  EXPECT_EQ(spp, 16u) << r.output;
+  EXPECT_GT(nrmse, 0.0) << r.output;
+  EXPECT_LT(nrmse, 0.5) << r.output;
 }
 
 TEST(Demo, BadScriptFailsWithOneLineBeforeAnyWindow) {

@@ -134,6 +134,12 @@ void App::handleKeys() {
   if (ImGui::IsKeyPressed(GLFW_KEY_P, false)) state_.paused = !state_.paused;
   if (ImGui::IsKeyPressed(GLFW_KEY_N)) state_.stepOnce = true;
   if (ImGui::IsKeyPressed(GLFW_KEY_F2, false)) state_.screenshot = true;
+  if (ImGui::IsKeyPressed(GLFW_KEY_R, false))
+    for (const std::string& e : controller_->effects())
+      if (controller_->enabled(e)) {
+        state_.accuracyRequest = e;
+        break;
+      }
   if (ImGui::IsKeyPressed(GLFW_KEY_F1, false)) state_.help = !state_.help;
   if (ImGui::IsKeyPressed(GLFW_KEY_TAB, false)) state_.panel = !state_.panel;
   if (ImGui::IsKeyPressed(GLFW_KEY_ESCAPE, false))
@@ -175,11 +181,17 @@ void App::frame() {
   ImGui_ImplGlfw_NewFrame();
   ImGui::NewFrame();
   if (script_.empty()) handleKeys();
-  drawPanel(*controller_, stats_, state_, *camera_);
+  drawPanel(*controller_, stats_, state_, *camera_, accuracy_);
   drawHelp(state_);
   ImGui::Render();
   stats_.uiCpuMs = ms(std::chrono::steady_clock::now() - uiStart);
 
+  // An accuracy check compares with the frame just rendered (same clock and camera).
+  if (!state_.accuracyRequest.empty()) {
+    startAccuracy(state_.accuracyRequest, uint32_t(state_.accuracySpp));
+    state_.accuracyRequest.clear();
+  }
+  accuracy_.poll();
   if (state_.screenshot) {
     std::ostringstream name;
     name << options_.outDir << "/gi-demo-" << ++screenshots_ << ".png";
@@ -189,7 +201,9 @@ void App::frame() {
   // The panel may have changed the view or the effects: show what the renderer holds now.
   // A resource that cannot be previewed sends the view back to the output, with the reason.
   std::optional<gi::ImageRGBA8> image;
-  if (controller_->view() != gi::resources::kOutput) {
+  if (state_.showError && accuracy_.result()) {
+    image = accuracy_.result()->error;
+  } else if (controller_->view() != gi::resources::kOutput) {
     try {
       image = controller_->image();
     } catch (const std::exception& e) {
@@ -256,6 +270,26 @@ void App::resizeWindow(int width, int height) {
   throw gi::Error(
       gi::ErrorKind::Unsupported, options_.script,
       "the window did not take the size " + std::to_string(width) + "x" + std::to_string(height));
+}
+
+void App::startAccuracy(const std::string& effect, uint32_t spp) {
+  try {
+    // The frame holds one image per resource: with two writers of the same output, the
+    // comparison would not be of this effect's.
+    for (const std::string& other : controller_->effects()) {
+      if (other == effect || !controller_->enabled(other)) continue;
+      for (const std::string& w : registry_.info(other).writes)
+        for (const std::string& mine : registry_.info(effect).writes)
+          if (w == mine)
+            throw gi::Error(gi::ErrorKind::Usage, "",
+                            other + " also writes '" + w + "': switch it off to check " + effect);
+    }
+    accuracy_.start(controller_->renderer(), scene_, state_.time, registry_, effect,
+                    controller_->settings(effect), spp);
+    state_.message = "accuracy check of " + effect + " started";
+  } catch (const std::exception& e) {
+    state_.message = std::string("accuracy: ") + e.what();
+  }
 }
 
 void App::printTimings() {
@@ -339,6 +373,16 @@ void App::execute(const ScriptStep& s) {
     state_.stepOnce = true;
   } else if (s.verb == "time") {
     state_.time = number(0);
+  } else if (s.verb == "accuracy") {
+    startAccuracy(s.args[0], uint32_t(number(1)));
+    accuracy_.wait();
+    const auto& r = accuracy_.result();
+    if (!accuracy_.error().empty() || !r || r->effect != s.args[0])
+      throw gi::Error(gi::ErrorKind::Usage, path,
+                      "line " + std::to_string(s.line) + ": " +
+                          (accuracy_.error().empty() ? state_.message : accuracy_.error()));
+    std::printf("accuracy: %s nrmse %.6f pixels %zu spp %u seconds %.2f quantity %s\n",
+                r->effect.c_str(), r->nrmse, r->pixels, r->spp, r->seconds, r->quantity.c_str());
   } else if (s.verb == "screenshot") {
     screenshot(s.args[0]);
   } else if (s.args[0] == "passes") {

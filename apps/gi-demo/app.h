@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "accuracy.h"
 #include "controller.h"
 #include "free_camera.h"
 #include "gi/vk/resources.h"
@@ -46,6 +47,7 @@ class App {
   void screenshot(const std::string& path);
   void resizeWindow(int width, int height);
   void printTimings();
+  void startAccuracy(const std::string& effect, uint32_t spp);
 
   AppOptions options_;
   gi::Scene scene_;
@@ -56,6 +58,7 @@ class App {
   std::unique_ptr<ImguiContext> imgui_;
   std::unique_ptr<Presenter> presenter_;
   std::unique_ptr<FreeCamera> camera_;
+  AccuracyCheck accuracy_;
   gi::vk::Image preview_;  // the viewed resource when it is not the output
   FrameStats stats_;
   DemoState state_;

@@ -26,7 +26,7 @@ const char* kUsage =
     "  --validation           enable Vulkan validation layers (also GI_VALIDATION=1)\n"
     "  --device NAME          pick the Vulkan device by name or index (also GI_DEVICE)\n"
     "keys: WASD walk, Q/E down/up, Shift run, Ctrl creep, right-drag look, P pause, N step,\n"
-    "      F2 screenshot, Tab panel, F1 help, Esc quit\n";
+    "      R accuracy check, F2 screenshot, Tab panel, F1 help, Esc quit\n";
 
 [[noreturn]] void usageError(const std::string& message) {
   throw gi::Error(gi::ErrorKind::Usage, "", message + " (see gi-demo --help)");

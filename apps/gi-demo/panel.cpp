@@ -149,8 +149,23 @@ bool settingWidget(Controller& controller, const std::string& owner, const gi::S
   return true;
 }
 
+void accuracySection(DemoState& state, const AccuracyCheck& accuracy) {
+  if (!ImGui::CollapsingHeader("Accuracy (CPU reference)")) return;
+  ImGui::SliderInt("reference spp", &state.accuracySpp, 1, 1024, "%d",
+                   ImGuiSliderFlags_Logarithmic | ImGuiSliderFlags_AlwaysClamp);
+  ImGui::TextDisabled("an effect's \"accuracy\" button (or R: the first one on) starts a check");
+  if (accuracy.running()) ImGui::ProgressBar(accuracy.progress(), {-1, 0}, "reference rendering");
+  if (!accuracy.error().empty())
+    ImGui::TextColored({1, 0.4f, 0.3f, 1}, "%s", accuracy.error().c_str());
+  if (const auto& r = accuracy.result()) {
+    ImGui::Text("%s vs %s: NRMSE %.4f", r->effect.c_str(), r->quantity.c_str(), r->nrmse);
+    ImGui::Text("%zu pixels, %u spp, %.1f s", r->pixels, r->spp, r->seconds);
+    ImGui::Checkbox("show the error image", &state.showError);
+  }
+}
+
 void drawPanel(Controller& controller, const FrameStats& stats, DemoState& state,
-               FreeCamera& camera) {
+               FreeCamera& camera, const AccuracyCheck& accuracy) {
   if (!state.panel) return;
   ImGui::SetNextWindowPos({10, 10}, ImGuiCond_FirstUseEver);
   ImGui::SetNextWindowSize({420, 640}, ImGuiCond_FirstUseEver);
@@ -202,6 +217,10 @@ void drawPanel(Controller& controller, const FrameStats& stats, DemoState& state
         ImGui::TextWrapped("%s", info.description.c_str());
         if (!info.debugView.empty() && ImGui::SmallButton("show its view"))
           controller.setView(info.debugView);
+        if (on) {
+          ImGui::SameLine();
+          if (ImGui::SmallButton("accuracy")) state.accuracyRequest = name;
+        }
         settingsOf(controller, name);
         ImGui::TreePop();
       }
@@ -209,6 +228,7 @@ void drawPanel(Controller& controller, const FrameStats& stats, DemoState& state
     }
   }
   if (ImGui::CollapsingHeader("Engine")) settingsOf(controller, gi::kEngineSettingsOwner);
+  accuracySection(state, accuracy);
   ImGui::End();
 }
 
@@ -222,6 +242,7 @@ void drawHelp(DemoState& state) {
                            {"right mouse drag", "look around"},
                            {"P", "pause / play the clock"},
                            {"N", "step one frame (paused)"},
+                           {"R", "accuracy check of the first effect on"},
                            {"F2", "screenshot (PNG in out/)"},
                            {"Tab", "hide / show the panel"},
                            {"F1", "this help"},

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "accuracy.h"
 #include "controller.h"
 #include "free_camera.h"
 
@@ -25,11 +26,14 @@ struct DemoState {
   bool paused = false, stepOnce = false, screenshot = false;
   bool help = false, panel = true;
   double time = 0.0;
-  std::string message;  // last screenshot path or similar
+  std::string message;          // last screenshot path or similar
+  std::string accuracyRequest;  // an effect whose accuracy check the user asked for
+  int accuracySpp = 64;
+  bool showError = false;  // show the last accuracy check's error image
 };
 
 void drawPanel(Controller& controller, const FrameStats& stats, DemoState& state,
-               FreeCamera& camera);
+               FreeCamera& camera, const AccuracyCheck& accuracy);
 void drawHelp(DemoState& state);
 
 // One setting as a widget; true when the user changed it (then it is sent to the controller).

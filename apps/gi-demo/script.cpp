@@ -14,9 +14,9 @@ namespace {
 
 // Verb -> argument count (-1: one or more).
 const std::map<std::string, int> kVerbs = {
-    {"frames", 1}, {"key", 2},    {"look", 2},       {"camera", 5}, {"effect", 2},
-    {"set", 1},    {"preset", 1}, {"view", 1},       {"resize", 2}, {"pause", 1},
-    {"step", 0},   {"time", 1},   {"screenshot", 1}, {"print", 1}};
+    {"frames", 1}, {"key", 2},      {"look", 2}, {"camera", 5},     {"effect", 2},
+    {"set", 1},    {"preset", 1},   {"view", 1}, {"resize", 2},     {"pause", 1},
+    {"step", 0},   {"accuracy", 2}, {"time", 1}, {"screenshot", 1}, {"print", 1}};
 
 [[noreturn]] void fail(const std::string& path, int line, const std::string& what) {
   throw gi::Error(gi::ErrorKind::Parse, path, "line " + std::to_string(line) + ": " + what);
@@ -53,8 +53,8 @@ std::vector<ScriptStep> loadScript(const std::string& path) {
                std::to_string(s.args.size()));
     // Numbers are checked now, so a bad script fails before any window opens.
     const std::map<std::string, std::vector<size_t>> numeric = {
-        {"frames", {0}},    {"key", {1}}, {"look", {0, 1}}, {"camera", {0, 1, 2, 3, 4}},
-        {"resize", {0, 1}}, {"time", {0}}};
+        {"frames", {0}},    {"key", {1}},  {"look", {0, 1}}, {"camera", {0, 1, 2, 3, 4}},
+        {"resize", {0, 1}}, {"time", {0}}, {"accuracy", {1}}};
     if (auto n = numeric.find(s.verb); n != numeric.end())
       for (size_t i : n->second) scriptNumber(s, i, path);
     if ((s.verb == "effect" && s.args[1] != "on" && s.args[1] != "off") ||

@@ -12,6 +12,8 @@
 //   pause on|off             stop or restart the clock
 //   step                     advance the stopped clock by one frame's time
 //   time T                   set the clock
+//   accuracy EFFECT SPP      compare the last frame of EFFECT with the CPU reference (SPP
+//                            samples per pixel; waits) and print its NRMSE
 //   screenshot PATH          write the rendered image (without the panel) as PNG
 //   print passes|views|timings|memory|camera   print to stdout (views: what `view` takes)
 #pragma once
