@@ -231,6 +231,44 @@ TEST(Demo, DemoSceneRuns) {
   EXPECT_TRUE(passes[0].count("skinning")) << "the Fox and CesiumMan are skinned:\n" << r.output;
 }
 
+// Preset switching goes through the same resolution as gi-render (defaults, preset, scene,
+// --set): switching to a preset changes the image, switching back to none restores it
+// exactly, and each equals gi-render's image with that preset.
+TEST(Demo, PresetSwitchMatchesHeadlessRender) {
+  REQUIRE_DEMO();
+  const std::string dir = test::makeTempDir("demo_preset");
+  const std::string script = writeScript(dir,
+                                         "frames 1\n"
+                                         "screenshot " +
+                                             dir +
+                                             "/none.png\n"
+                                             "preset low\n"
+                                             "frames 1\n"
+                                             "screenshot " +
+                                             dir +
+                                             "/low.png\n"
+                                             "preset none\n"
+                                             "frames 1\n"
+                                             "screenshot " +
+                                             dir + "/back.png\n");
+  auto r = runDemo(" --scene default --effects ssao --paused" + kSize + " --script " + script);
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_EQ(r.output.find("validation"), std::string::npos) << r.output;
+  const ImageRGBA8 none = readPng(dir + "/none.png"), low = readPng(dir + "/low.png");
+  EXPECT_NE(none.pixels, low.pixels) << "the low preset changes SSAO's settings";
+  EXPECT_EQ(readPng(dir + "/back.png").pixels, none.pixels);
+  auto h = test::runCommand(test::binPath("gi-render") + " --scene default --effects ssao" + kSize +
+                            " --preset low --out " + dir + "/h_low.png");
+  ASSERT_EQ(h.exitCode, 0) << h.output;
+  EXPECT_EQ(readPng(dir + "/h_low.png").pixels, low.pixels);
+
+  auto bad = runDemo(" --scene default --paused" + kSize + " --script " +
+                     writeScript(dir, "frames 1\npreset nowhere\n"));
+  EXPECT_EQ(bad.exitCode, 2) << bad.output;  // a usage error naming the line and the preset
+  EXPECT_NE(bad.output.find("line 2: "), std::string::npos) << bad.output;
+  EXPECT_NE(bad.output.find("nowhere"), std::string::npos) << bad.output;
+}
+
 // Accuracy on demand: the last frame of SSAO against the CPU reference of the quantity it
 // declares, at the same camera (a walked one) and size.
 TEST(Demo, AccuracyCheckComparesTheFrameWithTheReference) {
