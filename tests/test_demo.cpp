@@ -5,6 +5,7 @@
 // no validation message and the device memory where it started.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -113,6 +114,40 @@ TEST(Demo, WalkedCameraPathChangesTheScreenshots) {
   const size_t uiCpu = r.output.find("UI CPU ");
   ASSERT_NE(uiCpu, std::string::npos) << r.output;
   EXPECT_GT(std::stod(r.output.substr(uiCpu + 7)), 0.0) << r.output;
+}
+
+// The walking camera: 2 m/s, x4 with Shift, x0.25 with Ctrl, in steps of 1/30 s; Q goes down
+// until the eye is 0.3 above the floor and no further.
+TEST(Demo, WalkingSpeedsAndTheFloor) {
+  REQUIRE_DEMO();
+  const std::string dir = test::makeTempDir("demo_walk");
+  const std::string script = writeScript(dir,
+                                         "camera 0 1 3 0 0\n"
+                                         "key w 3\n"
+                                         "print camera\n"
+                                         "key w+shift 3\n"
+                                         "print camera\n"
+                                         "key d+ctrl 6\n"
+                                         "print camera\n"
+                                         "key q 30\n"
+                                         "print camera\n");
+  auto r = runDemo(" --scene default --paused --floor -0.5" + kSize + " --script " + script);
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  std::vector<std::array<double, 3>> positions;
+  std::istringstream lines(r.output);
+  for (std::string line; std::getline(lines, line);)
+    if (line.rfind("camera:", 0) == 0) {
+      std::istringstream words(line.substr(7));
+      std::array<double, 3> p{};
+      words >> p[0] >> p[1] >> p[2];
+      positions.push_back(p);
+    }
+  ASSERT_EQ(positions.size(), 4u) << r.output;
+  // Each step is printed after its frames (the camera moves on the frame after "camera").
+  EXPECT_NEAR(positions[0][2], 3.0 - 3 * 2.0 / 30.0, 1e-3) << r.output;
+  EXPECT_NEAR(positions[1][2], positions[0][2] - 3 * 8.0 / 30.0, 1e-3) << r.output;
+  EXPECT_NEAR(positions[2][0], 6 * 0.5 / 30.0, 1e-3) << r.output;
+  EXPECT_NEAR(positions[3][1], -0.5 + 0.3, 1e-4) << "the eye stops 0.3 above --floor";
 }
 
 TEST(Demo, EveryViewOfTheSelectorShows) {
