@@ -132,7 +132,8 @@ void AccuracyCheck::finish() {
       continue;
     }
     const double e = std::abs(double(test.values[i]) - truth.values[i]) / mean * 2.0;
-    const uint8_t v = uint8_t(std::clamp(std::isfinite(e) ? e : 1.0, 0.0, 1.0) * 255.0 + 0.5);
+    const uint8_t v =
+        uint8_t(std::lround(std::clamp(std::isfinite(e) ? e : 1.0, 0.0, 1.0) * 255.0));
     px[0] = px[1] = px[2] = v;
   }
   result_ = std::move(out);

@@ -280,9 +280,12 @@ void App::startAccuracy(const std::string& effect, uint32_t spp) {
       if (other == effect || !controller_->enabled(other)) continue;
       for (const std::string& w : registry_.info(other).writes)
         for (const std::string& mine : registry_.info(effect).writes)
-          if (w == mine)
-            throw gi::Error(gi::ErrorKind::Usage, "",
-                            other + " also writes '" + w + "': switch it off to check " + effect);
+          if (w == mine) {
+            std::string why = other;
+            why += " also writes '" + w + "': switch it off to check ";
+            why += effect;
+            throw gi::Error(gi::ErrorKind::Usage, "", why);
+          }
     }
     accuracy_.start(controller_->renderer(), scene_, state_.time, registry_, effect,
                     controller_->settings(effect), spp);

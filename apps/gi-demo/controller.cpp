@@ -26,7 +26,7 @@ gi::ImageRGBA8 previewOf(const gi::ImageRGBA32F& img, const std::string& view) {
     float v = grey ? img.pixels[i - i % 4] : img.pixels[i];
     if (signedData) v = v * 0.5f + 0.5f;
     if (i % 4 == 3 || !std::isfinite(v)) v = i % 4 == 3 ? 1.0f : 0.0f;
-    out.pixels[i] = uint8_t(std::clamp(v, 0.0f, 1.0f) * 255.0f + 0.5f);
+    out.pixels[i] = uint8_t(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f));
   }
   return out;
 }
