@@ -33,7 +33,7 @@ bool haveXvfb() {
     GTEST_SKIP() << "xvfb-run/Xvfb not installed (Debian packages xvfb, xauth): skipping";
 
 std::string writeScript(const std::string& dir, const std::string& text) {
-  const std::string path = dir + "/script.txt";
+  std::string path = dir + "/script.txt";
   std::ofstream(path) << text;
   return path;
 }
