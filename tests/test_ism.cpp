@@ -183,7 +183,8 @@ std::vector<std::string> with(std::vector<std::string> a, const std::vector<std:
 
 // One VPL: the shadow the box casts in the ISM agrees with the classic map's. IoU of the
 // zero-indirect masks (shadow + surfaces facing away, the latter identical in both) > 0.85
-// (measured 0.91 with one pull-push level; 0.86 without, 0.82 with two: pull-push's push
+// (measured 0.94 with one pull-push level; with the paraboloid RSM of an earlier version
+// 0.91, 0.86 without pull-push, 0.82 with two levels: pull-push's push
 // dilates silhouettes by up to 2^levels - 1 texels, so the ISM shadow is the larger one).
 TEST_F(IsmTest, OneVplIsmShadowOverlapsTheClassicShadow) {
   const Scene s = panelScene();
@@ -204,8 +205,8 @@ TEST_F(IsmTest, OneVplIsmShadowOverlapsTheClassicShadow) {
 }
 
 // With few points (2048 for a 128^2 map, no splat enlargement) the ISM has holes through which
-// light leaks; pull-push fills them. Measured IoU against the classic shadow: 0.22 without,
-// 0.75 with two levels.
+// light leaks; pull-push fills them. Measured IoU against the classic shadow: 0.25 without,
+// 0.79 with two levels.
 TEST_F(IsmTest, PullPushClosesLightLeaks) {
   const Scene s = panelScene();
   const std::vector<std::string> sparse = {"ism.vpls=1",

@@ -90,7 +90,7 @@ class IsmEffect : public gi::Effect {
          "surface points splatted into each ISM (a fixed subset per VPL; the engine keeps "
          "min(vpls x points_per_ism, 2^21) points)",
          true},
-        {"pull_push_levels", SettingType::Int, 2, 0, gi::ism::kMaxPullPushLevels,
+        {"pull_push_levels", SettingType::Int, 1, 0, gi::ism::kMaxPullPushLevels,
          "pull-push pyramid levels filling the ISMs' holes (0: none; at most log2 resolution)",
          true},
         {"pull_threshold", SettingType::Float, 0.05, 0.0, 1.0,
@@ -111,7 +111,8 @@ class IsmEffect : public gi::Effect {
                                      "paraboloid shadow maps from the triangles (reference)",
                                      true),
         {"rsm_resolution", SettingType::Int, 64, 16, 256,
-         "side of the reflective shadow map (a point light gets two paraboloids side by side)",
+         "side of the reflective shadow map's face (a point light gets six cube faces in a 3 x 2 "
+         "atlas; a spot light one perspective face, or a paraboloid beyond 60 degrees)",
          true},
         {"bias", SettingType::Float, 0.01, 0.0, 1.0,
          "constant shadow bias, fraction of the scene extent", false},
@@ -128,7 +129,9 @@ class IsmEffect : public gi::Effect {
         {"blur_radius", SettingType::Int, 0, 0, 8,
          "blur taps beyond the k that cancel the block pattern, each side", true},
         {"blur_tolerance", SettingType::Float, 0.05, 0.0, 1.0,
-         "blur: relative view-distance difference a neighbour may have", false},
+         "blur: distance a neighbour may lie from the centre's tangent plane, relative to the view "
+         "distance",
+         false},
         {"strength", SettingType::Float, 1.0, 0.0, 16.0, "scales the indirect light", false},
     };
   }
@@ -226,13 +229,13 @@ class IsmEffect : public gi::Effect {
       return d;
     };
 
-    // 1. Reflective shadow map of the primary light: two paraboloids side by side for a point
-    // light (the whole sphere), one paraboloid (spot) or orthographic view (directional).
+    // 1. Reflective shadow map of the primary light (drawRsm below: cube faces, one face or an
+    // orthographic view).
     graph.addPass(
         "ism_rsm",
         [&](gi::PassBuilder& b) {
           ctx.scene().declareRead(b);
-          const uint32_t w = uint32_t(2 * c.rsm), h = uint32_t(c.rsm);
+          const uint32_t w = uint32_t(3 * c.rsm), h = uint32_t(2 * c.rsm);
           const std::vector<VkFormat> f =
               gi::sceneColorFormats(gi::SceneOutputs::ReflectiveShadowMap);
           io->rsmDepth = b.write(b.create("ism_rsm_depth", absolute(gi::kSceneDepthFormat, w, h)),
@@ -258,7 +261,7 @@ class IsmEffect : public gi::Effect {
           io->rsmNormal = b.read(io->rsmNormal);
           io->rsmFlux = b.read(io->rsmFlux);
           io->cdf = b.write(
-              b.create("ism_cdf", gi::BufferDesc{VkDeviceSize(2 * c.rsm * c.rsm) * sizeof(float)}),
+              b.create("ism_cdf", gi::BufferDesc{VkDeviceSize(6 * c.rsm * c.rsm) * sizeof(float)}),
               gi::BufferUsage::StorageWrite);
           io->vpls = b.write(io->vpls, gi::BufferUsage::StorageWrite);
         },
@@ -418,7 +421,7 @@ class IsmEffect : public gi::Effect {
     const float dMin = float(s.number("distance_clamp")) * extent;
     const float k = float(c.block);
     gi::ism::Uniforms u{};
-    u.rsm = glm::vec4(2 * c.rsm, c.rsm, c.vpls, c.padded);
+    u.rsm = glm::vec4(3 * c.rsm, 2 * c.rsm, c.vpls, c.padded);
     u.atlas = glm::vec4(c.res, c.perRow, c.perIsm, 0.0f);  // point count: set by ism_splat
     u.bias = glm::vec4(float(s.number("bias")) * extent, float(s.number("bias_slope")),
                        classicNear(extent), classicFar(ctx, extent));
@@ -449,21 +452,27 @@ class IsmEffect : public gi::Effect {
     t.depth = pc.view(io.rsmDepth);
     t.colors = {pc.view(io.rsmPos), pc.view(io.rsmNormal), pc.view(io.rsmFlux)};
     t.extent = pc.extent(io.rsmDepth);
+    // Perspective faces rasterize triangles exactly (a paraboloid interpolates positions
+    // linearly across the disk, which misplaces the texels of large triangles).
     std::vector<gi::SceneView> views;
+    const float znear = 1e-3f * extent;
+    const float outer = std::acos(std::clamp(light.cosOuter, -1.0f, 1.0f));
     if (light.type == gi::LightType::Directional) {
       views.push_back(gi::SceneView::orthographic(center - light.direction * extent,
                                                   light.direction, 0.5f * extent, 0.5f * extent,
                                                   1e-3f * extent, 2.0f * extent));
+    } else if (light.type == gi::LightType::Spot && outer < glm::radians(60.0f)) {
+      views.push_back(gi::SceneView::perspective(light.position, light.direction,
+                                                 2.0f * outer + 0.02f, 1.0f, znear, far));
+    } else if (light.type == gi::LightType::Spot) {
+      views.push_back(gi::SceneView::paraboloid(light.position, light.direction, znear, far));
     } else {
-      views.push_back(
-          gi::SceneView::paraboloid(light.position, light.direction, 1e-4f * extent, far));
-      if (light.type == gi::LightType::Point)
-        views.push_back(
-            gi::SceneView::paraboloid(light.position, -light.direction, 1e-4f * extent, far));
+      const auto faces = gi::SceneView::cube(light.position, znear, far);
+      views.assign(faces.begin(), faces.end());
     }
     for (size_t i = 0; i < views.size(); ++i) {
-      views[i].viewport = {{int32_t(i * r), 0}, {r, r}};
-      t.clear = i == 0;  // the first draw clears the whole map
+      views[i].viewport = {{int32_t((i % 3) * r), int32_t((i / 3) * r)}, {r, r}};
+      t.clear = i == 0;  // the first draw clears the whole map (3 x 2 faces)
       ctx.scene().drawRsm(pc, t, views[i], light);
     }
   }

@@ -1,7 +1,7 @@
 // Included by ism_blur_x.comp / ism_blur_y.comp (AXIS 0 / 1). Geometry-aware blur removing the K x K block pattern (seed 002 §3.4): along x (AXIS 0) then
 // y (AXIS 1), taps LO..HI around the pixel (K taps cover every phase once; the blur_radius
-// setting widens it), averaging only neighbours whose view distance is within the tolerance
-// and whose normal is close. AXIS 1 then reflects: indirect = diffuse albedo / pi x irradiance.
+// setting widens it), averaging only neighbours within the tolerance (x view distance) of the centre's
+// tangent plane and whose normal is close. AXIS 1 then reflects: indirect = diffuse albedo / pi x irradiance.
 #include "common.glsl"
 #include "ism_common.glsl"
 
@@ -28,6 +28,12 @@ vec3 unpackNormal(uint q) {
 }
 vec3 unpackValue(uvec4 t) { return vec3(unpackHalf2x16(t.x), unpackHalf2x16(t.y).x); }
 
+// View-space position of pixel q at view distance `dist`.
+vec3 viewPoint(ivec2 q, float dist) {
+  vec2 uv = (vec2(q) + 0.5) * frame.viewport.zw;
+  return normalize(viewPositionFromDepth(frame.invProj, uv, 0.5)) * dist;
+}
+
 void main() {
   ivec2 p = ivec2(gl_GlobalInvocationID.xy);
   ivec2 size = ivec2(frame.viewport.xy);
@@ -35,6 +41,7 @@ void main() {
   uvec4 c = texelFetch(inRaw, p, 0);
   float z = uintBitsToFloat(c.z);
   vec3 n = unpackNormal(c.w);
+  vec3 centre = viewPoint(p, z);
   vec3 sum = vec3(0.0);
   float wsum = 0.0;
   ivec2 axis = AXIS == 0 ? ivec2(1, 0) : ivec2(0, 1);
@@ -42,8 +49,10 @@ void main() {
     ivec2 q = clamp(p + axis * o, ivec2(0), size - 1);
     uvec4 t = texelFetch(inRaw, q, 0);
     float zt = uintBitsToFloat(t.z);
-    float w = (zt > 0.0 && abs(zt - z) <= ism.blur.x * z &&
-               dot(unpackNormal(t.w), n) >= ism.blur.y) ? 1.0 : 0.0;
+    // Same surface: the neighbour lies near the centre's tangent plane and faces alike.
+    float plane = abs(dot(n, viewPoint(q, zt) - centre));
+    float w = (zt > 0.0 && plane <= ism.blur.x * z && dot(unpackNormal(t.w), n) >= ism.blur.y)
+                  ? 1.0 : 0.0;
     sum += w * unpackValue(t);
     wsum += w;
   }
