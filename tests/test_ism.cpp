@@ -2,7 +2,8 @@
 // on the GPU: one VPL above a floor with a box casts an ISM shadow that overlaps the classic
 // (triangle) shadow map's, pull-push closes light leaks, an all-black RSM gives zero indirect
 // light without NaN, a receiver behind every VPL's hemisphere gets 0, moving the light moves
-// the VPLs (and their light), and a scene without the effect runs no ISM pass.
+// the VPLs (and their light), 1, 2, 3 bounces add up monotonically, and a scene without the
+// effect runs no ISM pass.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -309,6 +310,28 @@ TEST_F(IsmTest, MovingTheLightMovesTheVpls) {
   EXPECT_GT(b, 0.5);
 }
 
+// Multi-bounce: in the (closed) Cornell box each further bounce adds light (VPLs sampled from
+// points lit by the previous bounce), less each time: the mean indirect radiance increases
+// monotonically with 1, 2, 3 bounces and the increments shrink (measured rgb sums 0.463,
+// 0.789, 0.993 at 128 VPLs per bounce: increments 0.326, 0.203).
+TEST_F(IsmTest, CornellBoxBouncesIncreaseMonotonicallyAndConverge) {
+  const Scene s = loadScene(std::string(GI_SOURCE_DIR) + "/assets/scenes/cornell_box.json");
+  double mean[4] = {0, 0, 0, 0};
+  for (int b = 1; b <= 3; ++b) {
+    const Result r = render(s, {"ism.vpls=128", "ism.bounces=" + std::to_string(b)});
+    expectFinite(r.indirect);
+    for (size_t i = 0; i < r.indirect.pixels.size(); i += 4)
+      mean[b] += r.indirect.pixels[i] + r.indirect.pixels[i + 1] + r.indirect.pixels[i + 2];
+    mean[b] /= double(r.indirect.pixels.size() / 4);
+  }
+  std::printf("mean indirect (rgb sum): 1 bounce %.4f, 2: %.4f, 3: %.4f\n", mean[1], mean[2],
+              mean[3]);
+  EXPECT_GT(mean[1], 0.0);
+  EXPECT_GT(mean[2], mean[1] * 1.2);
+  EXPECT_GT(mean[3], mean[2] * 1.05);
+  EXPECT_LT(mean[3] - mean[2], mean[2] - mean[1]);
+}
+
 // The frame graph runs ISM passes only when the scene asks for the effect.
 TEST_F(IsmTest, NoIsmPassWithoutTheEffect) {
   const Scene s = panelScene();
@@ -318,6 +341,9 @@ TEST_F(IsmTest, NoIsmPassWithoutTheEffect) {
   for (const char* p :
        {"ism_rsm", "ism_vpl", "ism_splat", "ism_pull_push", "ism_gather", "ism_blur"})
     EXPECT_NE(std::find(passes.begin(), passes.end(), p), passes.end()) << p;
+  const auto three = render(s, {"ism.vpls=16", "ism.bounces=3"}).passes;
+  for (const char* p : {"ism_bounce2", "ism_splat2", "ism_bounce3", "ism_splat3"})
+    EXPECT_NE(std::find(three.begin(), three.end(), p), three.end()) << p;
   const auto classic = render(s, {"ism.vpls=16", "ism.mode=classic"}).passes;
   EXPECT_NE(std::find(classic.begin(), classic.end(), "ism_classic_sm"), classic.end());
   EXPECT_EQ(std::find(classic.begin(), classic.end(), "ism_splat"), classic.end());

@@ -20,6 +20,8 @@
 #include "gi/vk/resources.h"
 #include "ism_blur_x.comp.h"
 #include "ism_blur_y.comp.h"
+#include "ism_bounce.comp.h"
+#include "ism_bounce_classic.comp.h"
 #include "ism_clear.comp.h"
 #include "ism_gather.comp.h"
 #include "ism_gather_classic.comp.h"
@@ -53,7 +55,8 @@ int log2i(int v) {
 // The graph-fixed configuration, derived once per prepare().
 struct Config {
   int vpls = 256, padded = 256, block = 4, perPixel = 16, res = 64, perRow = 16, rows = 16;
-  int perIsm = 1024, levels = 2, rsm = 64, splat = 1, blurExtra = 0;
+  int perIsm = 1024, levels = 2, rsm = 64, splat = 1, blurExtra = 0, bounces = 1;
+  int total() const { return vpls * bounces; }  // VPLs of all bounces (one tile each)
   bool classic = false;
   uint32_t atlasWidth() const { return uint32_t(perRow * res); }
   uint32_t atlasHeight() const { return uint32_t(rows * res); }
@@ -68,7 +71,7 @@ class IsmEffect : public gi::Effect {
     i.description =
         "instant radiosity with imperfect shadow maps (Ritschel et al. 2008): VPLs from the "
         "primary light's RSM, point-splatted paraboloid ISMs with pull-push, interleaved "
-        "gathering, geometry-aware blur; one diffuse bounce";
+        "gathering, geometry-aware blur; 1 to 3 diffuse bounces";
     i.stage = gi::EffectStage::BeforeLighting;
     i.reads = {res::kDepth, res::kNormal, res::kAlbedo, res::kMaterial, res::kSurfacePoints};
     i.writes = {res::kIndirect};
@@ -81,7 +84,8 @@ class IsmEffect : public gi::Effect {
     using gi::ism::kMaxVpls;
     return {
         {"vpls", SettingType::Int, 256, 1, kMaxVpls,
-         "virtual point lights N_vpl sampled from the primary light's RSM (each gets one ISM)",
+         "virtual point lights N_vpl per bounce, the first sampled from the primary light's RSM "
+         "(each gets one ISM)",
          true},
         {"ism_resolution", SettingType::Int, 64, 8, gi::ism::kMaxIsmResolution,
          "side of each VPL's paraboloid shadow map in texels (rounded down to a power of two)",
@@ -103,8 +107,10 @@ class IsmEffect : public gi::Effect {
          false},
         {"block_size", SettingType::Int, 4, 1, gi::ism::kMaxBlock,
          "interleaving block k: each pixel of a k x k block gathers N_vpl / k^2 VPLs", true},
-        {"bounces", SettingType::Int, 1, 1, 1,
-         "indirect bounces (only 1 so far: imperfect reflective shadow maps are not written)",
+        {"bounces", SettingType::Int, 1, 1, gi::ism::kMaxBounces,
+         "indirect bounces: each bounce after the first samples `vpls` more VPLs from surface "
+         "points lit by the previous bounce's VPLs (with their maps' visibility), each with its "
+         "own map; vpls x bounces is capped at 1024",
          true},
         gi::SettingDesc::enumeration("mode", {"ism", "classic"}, 0,
                                      "ism: imperfect shadow maps from points; classic: accurate "
@@ -140,14 +146,16 @@ class IsmEffect : public gi::Effect {
     gi::vk::Context& vk = ctx.vulkan();
     vk.requireWorkgroup(kGroupX, kGroupY, "ism");
     Config c;
-    c.vpls = std::clamp(s.integer("vpls"), 1, gi::ism::kMaxVpls);
+    c.bounces = std::clamp(s.integer("bounces"), 1, gi::ism::kMaxBounces);
+    // The VPL table holds every bounce's VPLs: at most kMaxVpls in all.
+    c.vpls = std::clamp(s.integer("vpls"), 1, gi::ism::kMaxVpls / c.bounces);
     c.block = std::clamp(s.integer("block_size"), 1, gi::ism::kMaxBlock);
     const int k2 = c.block * c.block;
-    c.perPixel = (c.vpls + k2 - 1) / k2;
+    c.perPixel = (c.total() + k2 - 1) / k2;
     c.padded = c.perPixel * k2;
     c.res = floorPow2(std::clamp(s.integer("ism_resolution"), 8, gi::ism::kMaxIsmResolution));
-    c.perRow = int(std::ceil(std::sqrt(double(c.vpls))));
-    c.rows = (c.vpls + c.perRow - 1) / c.perRow;
+    c.perRow = int(std::ceil(std::sqrt(double(c.total()))));
+    c.rows = (c.total() + c.perRow - 1) / c.perRow;
     c.perIsm = s.integer("points_per_ism");
     c.levels = std::clamp(s.integer("pull_push_levels"), 0, log2i(c.res));
     c.rsm = s.integer("rsm_resolution");
@@ -155,9 +163,12 @@ class IsmEffect : public gi::Effect {
     c.blurExtra = s.integer("blur_radius");
     c.classic = s.option("mode") == "classic";
     cfg_ = c;
+    nearest_ = ctx.nearestSampler();
     if (!c.classic)
-      ctx.requestSurfacePoints(
-          uint32_t(std::min<uint64_t>(uint64_t(c.vpls) * uint64_t(c.perIsm), gi::ism::kMaxPoints)));
+      ctx.requestSurfacePoints(uint32_t(
+          std::min<uint64_t>(uint64_t(c.total()) * uint64_t(c.perIsm), gi::ism::kMaxPoints)));
+    else if (c.bounces > 1)
+      ctx.requestSurfacePoints(gi::ism::kShadePoints);
 
     const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
                tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
@@ -171,12 +182,24 @@ class IsmEffect : public gi::Effect {
           vk, spv(std::begin(ism_clear_comp), std::end(ism_clear_comp)), {{0, img}});
       splat_ = gi::vk::Pipeline::compute(
           vk, spv(std::begin(ism_splat_comp), std::end(ism_splat_comp)),
-          {{1, ubo}, {2, ubo}, {3, ssbo}, {4, img}}, 0, {uint32_t(c.splat)});
+          {{1, ubo}, {2, ubo}, {3, ssbo}, {4, img}}, sizeof(int32_t), {uint32_t(c.splat)});
       for (uint32_t push = 0; push < 2; ++push)
         pullPush_[push] =
             gi::vk::Pipeline::compute(vk, spv(std::begin(ism_pull_comp), std::end(ism_pull_comp)),
-                                      {{1, ubo}, {2, img}, {3, img}}, sizeof(int32_t), {push});
+                                      {{1, ubo}, {2, img}, {3, img}}, 3 * sizeof(int32_t), {push});
     }
+    const std::vector<gi::vk::Binding> bounceBindings = {{1, ubo}, {2, ubo},  {3, ssbo}, {4, ssbo},
+                                                         {5, tex}, {6, ssbo}, {7, ssbo}};
+    const std::vector<uint32_t> bounceSpec = {uint32_t(c.vpls), uint32_t(gi::ism::kShadePoints)};
+    if (c.bounces > 1)
+      bounce_ =
+          c.classic
+              ? gi::vk::Pipeline::compute(
+                    vk, spv(std::begin(ism_bounce_classic_comp), std::end(ism_bounce_classic_comp)),
+                    bounceBindings, sizeof(int32_t), bounceSpec)
+              : gi::vk::Pipeline::compute(
+                    vk, spv(std::begin(ism_bounce_comp), std::end(ism_bounce_comp)), bounceBindings,
+                    sizeof(int32_t), bounceSpec);
     const std::vector<uint32_t> gatherSpec = {uint32_t(c.perPixel), uint32_t(c.block)};
     const std::vector<gi::vk::Binding> gatherBindings = {{0, ubo}, {1, ubo}, {2, ubo}, {3, tex},
                                                          {4, tex}, {5, tex}, {6, img}};
@@ -214,7 +237,7 @@ class IsmEffect : public gi::Effect {
     struct Io {
       gi::TextureHandle rsmDepth, rsmPos, rsmNormal, rsmFlux, atlas, depth, normal, albedo,
           material, raw, half, indirect;
-      gi::BufferHandle cdf, vpls, points;
+      gi::BufferHandle cdf, vpls, points, shade;
     };
     auto io = std::make_shared<Io>();
     gi::Blackboard& bb = graph.blackboard();
@@ -277,7 +300,8 @@ class IsmEffect : public gi::Effect {
           pc.dispatch(vpl_, w, {1, 1}, 1, 1);
         });
 
-    // 3. One shadow map per VPL in an atlas: imperfect (points + pull-push) or classic.
+    // 3. One shadow map per VPL in an atlas: imperfect (points + pull-push) or classic; and the
+    // next bounces' VPLs from points lit by the previous bounce (their maps follow).
     if (!c.classic) {
       graph.addPass(
           "ism_splat",
@@ -289,49 +313,35 @@ class IsmEffect : public gi::Effect {
                                                        c.atlasHeight(), uint32_t(c.levels + 1))),
                         gi::TextureUsage::StorageWrite, gi::Subresource::mipLevel(0));
           },
-          [this, io, c, params, ubo, ssbo](gi::PassContext& pc) {
+          [this, io, c](gi::PassContext& pc) {
             uploaded_.atlas.w = float(pc.bufferSize(io->points) / (2 * sizeof(glm::vec4)));
             uniforms_.write(&uploaded_.atlas, sizeof(glm::vec4),
                             offsetof(gi::ism::Uniforms, atlas));
+            // One clear for every bounce's tiles: the later splats only add points.
             const gi::Subresource mip0 = gi::Subresource::mipLevel(0);
-            VkImageView level0 = pc.view(io->atlas, mip0);
             gi::vk::DescriptorWriter clear;
-            clear.storageImage(0, level0);
+            clear.storageImage(0, pc.view(io->atlas, mip0));
             pc.dispatch(clear_, clear, pc.extent(io->atlas), kGroupX, kGroupY);
             pc.barrier(io->atlas, mip0);
-            gi::vk::DescriptorWriter w;
-            w.buffer(1, ubo, params)
-                .buffer(2, ubo, pc.buffer(io->vpls))
-                .buffer(3, ssbo, pc.buffer(io->points))
-                .storageImage(4, level0);
-            pc.dispatch(splat_, w, {uint32_t(c.perIsm), uint32_t(c.vpls)}, 256, 1);
+            splat(pc, *io, c, 0);
           });
-      if (c.levels > 0)
+      addPullPush(graph, io, c, 0, "ism_pull_push");
+      for (int bounce = 1; bounce < c.bounces; ++bounce) {
+        addBounce(graph, ctx, io, bounce);
+        const std::string n = std::to_string(bounce + 1);
         graph.addPass(
-            "ism_pull_push",
+            "ism_splat" + n,
             [&](gi::PassBuilder& b) {
-              // Reads the splatted level 0, writes every level (level 0 in place).
-              io->atlas = b.read(io->atlas, gi::TextureUsage::StorageRead);
-              io->atlas = b.write(io->atlas, gi::TextureUsage::StorageWrite);
+              io->vpls = b.read(io->vpls, gi::BufferUsage::Uniform);
+              io->points = b.read(io->points, gi::BufferUsage::StorageRead);
+              io->atlas =
+                  b.read(io->atlas, gi::TextureUsage::StorageRead, gi::Subresource::mipLevel(0));
+              io->atlas =
+                  b.write(io->atlas, gi::TextureUsage::StorageWrite, gi::Subresource::mipLevel(0));
             },
-            [this, io, c, params, ubo](gi::PassContext& pc) {
-              auto run = [&](int push, int level) {
-                const int32_t l = level;
-                vkCmdPushConstants(pc.cmd(), pullPush_[push].layout(), VK_SHADER_STAGE_ALL, 0,
-                                   sizeof l, &l);
-                gi::vk::DescriptorWriter w;
-                w.buffer(1, ubo, params)
-                    .storageImage(2, pc.view(io->atlas, gi::Subresource::mipLevel(uint32_t(level))))
-                    .storageImage(
-                        3, pc.view(io->atlas, gi::Subresource::mipLevel(uint32_t(level + 1))));
-                pc.dispatch(pullPush_[push], w,
-                            pc.extent(io->atlas, uint32_t(push ? level : level + 1)), kGroupX,
-                            kGroupY);
-                pc.barrier(io->atlas, gi::Subresource::all());
-              };
-              for (int l = 0; l < c.levels; ++l) run(0, l);
-              for (int l = c.levels - 1; l >= 0; --l) run(1, l);
-            });
+            [this, io, c, bounce](gi::PassContext& pc) { splat(pc, *io, c, bounce); });
+        addPullPush(graph, io, c, bounce, "ism_pull_push" + n);
+      }
     } else {
       graph.addPass(
           "ism_classic_sm",
@@ -343,6 +353,8 @@ class IsmEffect : public gi::Effect {
                         gi::TextureUsage::DepthAttachment);
           },
           [this, io, c, cx = &ctx](gi::PassContext& pc) { drawClassic(pc, *cx, *io, c); });
+      if (c.bounces > 1) io->points = graph.blackboard().buffer(res::kSurfacePoints);
+      for (int bounce = 1; bounce < c.bounces; ++bounce) addBounce(graph, ctx, io, bounce);
     }
 
     // 4. Interleaved gathering.
@@ -407,6 +419,88 @@ class IsmEffect : public gi::Effect {
   }
 
  private:
+  // Splats bounce `bounce`'s VPLs' point subsets into their tiles (mip 0).
+  template <class IoT>
+  void splat(gi::PassContext& pc, const IoT& io, const Config& c, int bounce) {
+    const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    const int32_t base = bounce * c.vpls;
+    vkCmdPushConstants(pc.cmd(), splat_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof base, &base);
+    gi::vk::DescriptorWriter w;
+    w.buffer(1, ubo, uniforms_.handle())
+        .buffer(2, ubo, pc.buffer(io.vpls))
+        .buffer(3, ssbo, pc.buffer(io.points))
+        .storageImage(4, pc.view(io.atlas, gi::Subresource::mipLevel(0)));
+    pc.dispatch(splat_, w, {uint32_t(c.perIsm), uint32_t(c.vpls)}, 256, 1);
+  }
+
+  // Pull-push over the tiles of bounce `bounce`'s VPLs.
+  template <class IoPtr>
+  void addPullPush(gi::FrameGraph& graph, const IoPtr& io, const Config& c, int bounce,
+                   const std::string& name) {
+    if (c.levels == 0) return;
+    graph.addPass(
+        name,
+        [&](gi::PassBuilder& b) {
+          // Reads the splatted level 0, writes every level (level 0 in place).
+          io->atlas = b.read(io->atlas, gi::TextureUsage::StorageRead);
+          io->atlas = b.write(io->atlas, gi::TextureUsage::StorageWrite);
+        },
+        [this, io, c, bounce](gi::PassContext& pc) {
+          auto run = [&](int push, int level) {
+            const std::array<int32_t, 3> pcs = {level, bounce * c.vpls, (bounce + 1) * c.vpls};
+            vkCmdPushConstants(pc.cmd(), pullPush_[push].layout(), VK_SHADER_STAGE_ALL, 0,
+                               sizeof pcs, pcs.data());
+            gi::vk::DescriptorWriter w;
+            w.buffer(1, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms_.handle())
+                .storageImage(2, pc.view(io->atlas, gi::Subresource::mipLevel(uint32_t(level))))
+                .storageImage(3,
+                              pc.view(io->atlas, gi::Subresource::mipLevel(uint32_t(level + 1))));
+            pc.dispatch(pullPush_[push], w,
+                        pc.extent(io->atlas, uint32_t(push ? level : level + 1)), kGroupX, kGroupY);
+            pc.barrier(io->atlas, gi::Subresource::all());
+          };
+          for (int l = 0; l < c.levels; ++l) run(0, l);
+          for (int l = c.levels - 1; l >= 0; --l) run(1, l);
+        });
+  }
+
+  // Bounce `bounce` + 1's VPLs from points lit by bounce `bounce`'s (ism_bounce.glsl).
+  template <class IoPtr>
+  void addBounce(gi::FrameGraph& graph, gi::EffectContext& ctx, const IoPtr& io, int bounce) {
+    graph.addPass(
+        "ism_bounce" + std::to_string(bounce + 1),
+        [&](gi::PassBuilder& b) {
+          io->points = b.read(io->points, gi::BufferUsage::StorageRead);
+          io->atlas = b.read(io->atlas, gi::TextureUsage::Sampled, gi::Subresource::mipLevel(0));
+          io->vpls = b.read(io->vpls, gi::BufferUsage::Uniform);
+          io->vpls = b.write(io->vpls, gi::BufferUsage::StorageWrite);
+          io->shade = b.write(
+              b.create("ism_shade" + std::to_string(bounce + 1),
+                       gi::BufferDesc{VkDeviceSize(5 * gi::ism::kShadePoints) * sizeof(float)}),
+              gi::BufferUsage::StorageWrite);
+        },
+        [this, io, bounce, materials = ctx.scene().materials()](gi::PassContext& pc) {
+          const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
+                     ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+          if (cfg_.classic) {  // no splat pass sets the point count
+            uploaded_.atlas.w = float(pc.bufferSize(io->points) / (2 * sizeof(glm::vec4)));
+            uniforms_.write(&uploaded_.atlas, sizeof(glm::vec4),
+                            offsetof(gi::ism::Uniforms, atlas));
+          }
+          const int32_t b = bounce;
+          vkCmdPushConstants(pc.cmd(), bounce_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof b, &b);
+          gi::vk::DescriptorWriter w;
+          w.buffer(1, ubo, uniforms_.handle())
+              .buffer(2, ubo, pc.buffer(io->vpls))
+              .buffer(3, ssbo, pc.buffer(io->points))
+              .buffer(4, ssbo, materials)
+              .sampled(5, pc.view(io->atlas, gi::Subresource::mipLevel(0)), nearest_)
+              .buffer(6, ssbo, pc.buffer(io->shade))
+              .buffer(7, ssbo, pc.buffer(io->vpls));
+          pc.dispatch(bounce_, w, {1, 1}, 1, 1);
+        });
+  }
+
   static float sceneExtent(gi::EffectContext& ctx) {
     glm::vec3 lo, hi;
     ctx.scene().bounds(lo, hi);
@@ -428,8 +522,8 @@ class IsmEffect : public gi::Effect {
     u.pull = glm::vec4(float(s.number("pull_threshold")) * extent,
                        float(s.number("push_threshold")) * extent, c.levels, extent);
     u.gather = glm::vec4(dMin * dMin, k, k * k, float(s.number("strength")));
-    u.blur =
-        glm::vec4(float(s.number("blur_tolerance")), 0.9f, float(s.number("splat_scale")), 0.0f);
+    u.blur = glm::vec4(float(s.number("blur_tolerance")), 0.9f, float(s.number("splat_scale")),
+                       float(c.total()));
     uniforms_.write(&u, sizeof u);
     uploaded_ = u;
   }
@@ -517,7 +611,8 @@ class IsmEffect : public gi::Effect {
   }
 
   Config cfg_;
-  gi::vk::Pipeline vpl_, clear_, splat_, gather_, blurX_, blurY_;
+  gi::vk::Pipeline vpl_, clear_, splat_, bounce_, gather_, blurX_, blurY_;
+  VkSampler nearest_ = VK_NULL_HANDLE;
   std::array<gi::vk::Pipeline, 2> pullPush_;
   gi::vk::Buffer uniforms_, vplBuffer_;
   gi::ism::Uniforms uploaded_{};

@@ -13,7 +13,7 @@ layout(set = 0, binding = 1, std140) uniform IsmParams {
   vec4 bias;    // constant (world), slope, near, far (classic maps)
   vec4 pull;    // pull threshold, push threshold, levels, scene extent
   vec4 gather;  // d_min^2, block k, k^2, strength
-  vec4 blur;    // plane tolerance, min normal cosine, splat scale, seed
+  vec4 blur;    // plane tolerance, min normal cosine, splat scale, VPLs of all bounces
 } ism;
 
 // One VPL: position (w 1: valid), normal, flux (rgb, W).

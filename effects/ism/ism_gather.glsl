@@ -16,11 +16,7 @@ layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 layout(set = 0, binding = 2, std140) uniform Vpls { Vpl vpls[ISM_VPL_SLOTS]; };
 layout(set = 0, binding = 3) uniform sampler2D gDepth;
 layout(set = 0, binding = 4) uniform sampler2D gNormal;
-#ifdef ISM_CLASSIC
-layout(set = 0, binding = 5) uniform sampler2D maps;
-#else
-layout(set = 0, binding = 5) uniform usampler2D maps;
-#endif
+#include "ism_lookup.glsl"
 layout(set = 0, binding = 6, rgba32ui) uniform writeonly uimage2D outRaw;
 
 vec2 signNotZero(vec2 v) { return vec2(v.x >= 0.0 ? 1.0 : -1.0, v.y >= 0.0 ? 1.0 : -1.0); }
@@ -28,16 +24,6 @@ uint packNormal(vec3 n) {
   n /= max(abs(n.x) + abs(n.y) + abs(n.z), 1e-30);
   vec2 e = n.z >= 0.0 ? n.xy : (1.0 - abs(n.yx)) * signNotZero(n.xy);
   return packSnorm2x16(e);
-}
-
-float storedDistance(ivec2 t) {
-#ifdef ISM_CLASSIC
-  float z = texelFetch(maps, t, 0).r;  // reverse-Z: 0 = nothing up to far
-  return ism.bias.z + (1.0 - z) * (ism.bias.w - ism.bias.z);
-#else
-  uint u = texelFetch(maps, t, 0).r;
-  return u == ISM_EMPTY ? 3.0e38 : uintBitsToFloat(u);
-#endif
 }
 
 void main() {
@@ -58,18 +44,7 @@ void main() {
   vec3 e = vec3(0.0);
   for (int j = 0; j < PER_PIXEL; ++j) {
     uint i = phase + uint(j * K * K);
-    Vpl v = vpls[i];
-    vec3 w = x - v.position.xyz;
-    float d2 = dot(w, w);
-    float d = sqrt(d2);
-    vec3 dir = d > 1e-10 ? w / d : v.normal.xyz;
-    float cv = max(dot(v.normal.xyz, dir), 0.0);
-    float cr = d > 1e-10 ? max(-dot(n, dir), 0.0) : 0.0;  // guard: d = 0 has no direction
-    vec3 s, u;
-    ismBasis(v.normal.xyz, s, u);
-    ivec2 t = ismTexel(i, dir, s, u, max(cv, 1e-4));
-    float visible = d - (ism.bias.x + ism.bias.y * d) <= storedDistance(t) ? 1.0 : 0.0;
-    e += v.flux.rgb * (visible * cv * cr / (3.14159265 * max(d2, ism.gather.x)));
+    e += vplIrradiance(vpls[i], min(i, uint(ism.blur.w) - 1u), x, n);
   }
   e = min(e * (ism.gather.z * ism.gather.w), vec3(65000.0));  // guard: half floats
   imageStore(outRaw, p, uvec4(packHalf2x16(e.rg), packHalf2x16(vec2(e.b, 0.0)),

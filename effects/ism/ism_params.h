@@ -18,6 +18,9 @@ inline constexpr int kMaxBlock = 8;    // interleaving block k (k x k VPL subset
 inline constexpr int kVplSlots = kMaxVpls + kMaxBlock * kMaxBlock;  // padded to whole blocks
 inline constexpr int kMaxIsmResolution = 512;
 inline constexpr int kMaxPullPushLevels = 6;
+inline constexpr int kMaxBounces = 3;
+// Surface points shaded per extra bounce as candidates for its VPLs (ism_bounce.glsl).
+inline constexpr uint32_t kShadePoints = 2048;
 inline constexpr int kMaxSplatRadius = 2;
 inline constexpr uint32_t kMaxPoints = 1u << 21;  // surface points asked of the engine
 inline constexpr uint32_t kEmpty = 0xffffffffu;   // an ISM texel no point reached

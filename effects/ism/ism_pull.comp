@@ -8,13 +8,17 @@
 
 layout(constant_id = 0) const int PUSH = 0;
 layout(local_size_x = 32, local_size_y = 16) in;
-layout(push_constant) uniform Push { int level; };
+layout(push_constant) uniform Push { int level, tileBegin, tileEnd; };  // tiles of one bounce
 layout(set = 0, binding = 2, r32ui) uniform uimage2D fine;
 layout(set = 0, binding = 3, r32ui) uniform uimage2D coarse;
 
 void main() {
   ivec2 p = ivec2(gl_GlobalInvocationID.xy);
   float scale = float(1 << level);
+  // Only the tiles [tileBegin, tileEnd) (one bounce's VPLs): the others are done or empty.
+  int tileRes = int(ism.atlas.x) >> (PUSH == 1 ? level : level + 1);  // at p's level
+  int tile = p.x / tileRes + int(ism.atlas.y) * (p.y / tileRes);
+  if (tile < tileBegin || tile >= tileEnd) return;
   if (PUSH == 0) {
     if (any(greaterThanEqual(p, imageSize(coarse)))) return;
     uint c[4];

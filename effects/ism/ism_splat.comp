@@ -1,5 +1,5 @@
 #version 460
-// Imperfect shadow maps (seed 002 §3.1): workgroup row y = VPL y (a uniform index into the VPL
+// Imperfect shadow maps (seed 002 §3.1): workgroup row y = VPL base + y (a uniform index into the VPL
 // table), each invocation one point of the VPL's fixed subset of the point representation
 // (points [y P, y P + P) modulo the count: the engine places them in random order, so each run
 // is a random subset). The point's distance is splatted with imageAtomicMin into the VPL's
@@ -12,12 +12,13 @@
 
 layout(constant_id = 0) const int MAX_SPLAT = 1;
 layout(local_size_x = 256) in;
+layout(push_constant) uniform Push { int base; };  // first VPL of this bounce
 layout(set = 0, binding = 2, std140) uniform Vpls { Vpl vpls[ISM_VPL_SLOTS]; };
 layout(set = 0, binding = 3, std430) readonly buffer Points { vec4 points[]; };
 layout(set = 0, binding = 4, r32ui) uniform coherent uimage2D atlas;
 
 void main() {
-  uint v = gl_WorkGroupID.y;
+  uint v = uint(base) + gl_WorkGroupID.y;
   uint j = gl_GlobalInvocationID.x;
   uint perIsm = uint(ism.atlas.z), count = uint(ism.atlas.w);
   Vpl vpl = vpls[v];

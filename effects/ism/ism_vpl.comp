@@ -1,9 +1,7 @@
 #version 460
-// VPLs by importance sampling the reflective shadow map's flux (seed 002 §3.3): one workgroup
-// builds the CDF of the texels' flux (r + g + b) with a parallel prefix sum, then places VPL i
-// at u_i = (i + jitter_i) / N (stratified, a fixed jitter per i: static lights give the same
-// VPLs every frame) by binary search. VPL flux = texel flux / (N pdf). An all-black map (light
-// facing away, no light) has an empty CDF: every VPL gets flux 0 and w = 0 (guard).
+// First-bounce VPLs by importance sampling the reflective shadow map's flux (seed 002 §3.3),
+// the texels' r + g + b (ism_sample.glsl). An all-black map (light facing away, no light) has an
+// empty CDF: every VPL gets flux 0 and w = 0 (guard). Also zeroes the table's padding.
 #extension GL_GOOGLE_include_directive : require
 #include "common.glsl"
 #include "ism_common.glsl"
@@ -16,7 +14,7 @@ layout(set = 0, binding = 4) uniform sampler2D rsmFlux;
 layout(set = 0, binding = 5, std430) buffer Cdf { float cdf[]; };
 layout(set = 0, binding = 6, std430) writeonly buffer Vpls { Vpl vpls[]; };
 
-shared float partial[256];
+#include "ism_sample.glsl"
 
 ivec2 texelOf(int i, int w) { return ivec2(i % w, i / w); }
 
@@ -32,20 +30,7 @@ void main() {
     run += (isnan(v) || isinf(v)) ? 0.0 : v;  // guard: a bad texel never enters the CDF
     cdf[i] = run;
   }
-  partial[t] = run;
-  barrier();
-  // Hillis-Steele inclusive scan of the 256 chunk sums.
-  for (int off = 1; off < 256; off <<= 1) {
-    float add = t >= off ? partial[t - off] : 0.0;
-    barrier();
-    partial[t] += add;
-    barrier();
-  }
-  float base = t > 0 ? partial[t - 1] : 0.0;
-  for (int i = begin; i < end; ++i) cdf[i] += base;
-  memoryBarrierBuffer();
-  barrier();
-  float sum = partial[255];
+  float sum = ismScan(run, begin, end);
   int n = int(ism.rsm.z), padded = int(ism.rsm.w);
   for (int i = t; i < padded; i += 256) {
     Vpl v;
@@ -53,15 +38,8 @@ void main() {
     v.normal = vec4(0.0, 1.0, 0.0, 0.0);
     v.flux = vec4(0.0);
     if (i < n && sum > 1e-30) {
-      float u = (float(i) + float(ismHash(uint(i) * 747796405u + 1u) >> 8) / 16777216.0) /
-                float(n);
-      float target = u * sum;
-      int lo = 0, hi = total - 1;  // smallest j with cdf[j] > target
-      while (lo < hi) {
-        int mid = (lo + hi) / 2;
-        if (cdf[mid] > target) hi = mid; else lo = mid + 1;
-      }
-      float p = cdf[lo] - (lo > 0 ? cdf[lo - 1] : 0.0);
+      float p;
+      int lo = ismPick(i, n, total, sum, p);
       ivec2 tx = texelOf(lo, w);
       vec4 pos = texelFetch(rsmPosition, tx, 0);
       if (p > 0.0 && pos.w > 0.5) {
@@ -72,7 +50,7 @@ void main() {
         // triangles over the whole disk).
         v.position = vec4(pos.xyz + nrm * (1e-3 * ism.pull.w), 1.0);
         v.normal = vec4(nrm, 0.0);
-        v.flux = vec4(f * (sum / (p * float(n))), 0.0);
+        v.flux = vec4(f / (p * float(n)), 0.0);
       }
     }
     vpls[i] = v;
