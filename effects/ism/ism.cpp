@@ -518,7 +518,7 @@ class IsmEffect : public gi::Effect {
     u.rsm = glm::vec4(3 * c.rsm, 2 * c.rsm, c.vpls, c.padded);
     u.atlas = glm::vec4(c.res, c.perRow, c.perIsm, 0.0f);  // point count: set by ism_splat
     u.bias = glm::vec4(float(s.number("bias")) * extent, float(s.number("bias_slope")),
-                       classicNear(extent), classicFar(ctx, extent));
+                       classicNear(extent), classicFar(extent));
     u.pull = glm::vec4(float(s.number("pull_threshold")) * extent,
                        float(s.number("push_threshold")) * extent, c.levels, extent);
     u.gather = glm::vec4(dMin * dMin, k, k * k, float(s.number("strength")));
@@ -529,7 +529,7 @@ class IsmEffect : public gi::Effect {
   }
 
   static float classicNear(float extent) { return 1e-4f * extent; }
-  static float classicFar(gi::EffectContext&, float extent) { return 2.0f * extent; }
+  static float classicFar(float extent) { return 2.0f * extent; }
 
   template <class IoT>
   void drawRsm(gi::PassContext& pc, gi::EffectContext& ctx, const IoT& io, const Config& c) {
@@ -582,7 +582,7 @@ class IsmEffect : public gi::Effect {
       const glm::vec4 pos = v[3 * i], n = v[3 * i + 1];
       if (pos.w < 0.5f) continue;
       gi::SceneView view = gi::SceneView::paraboloid(glm::vec3(pos), glm::vec3(n),
-                                                     classicNear(extent), classicFar(ctx, extent));
+                                                     classicNear(extent), classicFar(extent));
       view.viewport = {{int32_t((i % c.perRow) * c.res), int32_t((i / c.perRow) * c.res)},
                        {uint32_t(c.res), uint32_t(c.res)}};
       views.push_back(view);
