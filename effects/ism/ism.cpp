@@ -1,0 +1,623 @@
+// Instant radiosity with imperfect shadow maps (Ritschel, Grosch, Kim, Seidel, Dachsbacher,
+// Kautz 2008; seed 002; README.md). Passes: a reflective shadow map of the primary light
+// (ism_rsm), VPLs by importance sampling its flux (ism_vpl), per VPL a paraboloid imperfect
+// shadow map splatted from a subset of the surface points (ism_splat) and hole-filled by
+// pull-push (ism_pull_push) -- or, in `classic` mode, accurate paraboloid shadow maps drawn from
+// the triangles (ism_classic_sm) --, interleaved gathering (ism_gather) and a geometry-aware blur
+// (ism_blur) into "indirect", which the lighting pass adds.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <memory>
+#include <vector>
+
+#include "gi/effect.h"
+#include "gi/effect_registry.h"
+#include "gi/errors.h"
+#include "gi/lights.h"
+#include "gi/vk/pipeline.h"
+#include "gi/vk/resources.h"
+#include "ism_blur_x.comp.h"
+#include "ism_blur_y.comp.h"
+#include "ism_bounce.comp.h"
+#include "ism_bounce_classic.comp.h"
+#include "ism_clear.comp.h"
+#include "ism_gather.comp.h"
+#include "ism_gather_classic.comp.h"
+#include "ism_params.h"
+#include "ism_pull.comp.h"
+#include "ism_splat.comp.h"
+#include "ism_vpl.comp.h"
+
+namespace {
+
+namespace res = gi::resources;
+using gi::SettingType;
+
+constexpr VkFormat kRawFormat = VK_FORMAT_R32G32B32A32_UINT;
+constexpr VkFormat kAtlasFormat = VK_FORMAT_R32_UINT;
+constexpr VkFormat kOutFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
+constexpr uint32_t kGroupX = 32, kGroupY = 16;
+constexpr VkDeviceSize kVplBytes = 3 * sizeof(glm::vec4);
+
+int floorPow2(int v) {
+  int p = 1;
+  while (p * 2 <= v) p *= 2;
+  return p;
+}
+int log2i(int v) {
+  int l = 0;
+  while ((1 << (l + 1)) <= v) ++l;
+  return l;
+}
+
+// The graph-fixed configuration, derived once per prepare().
+struct Config {
+  int vpls = 256, padded = 256, block = 4, perPixel = 16, res = 64, perRow = 16, rows = 16;
+  int perIsm = 1024, levels = 2, rsm = 64, splat = 1, blurExtra = 0, bounces = 1;
+  int total() const { return vpls * bounces; }  // VPLs of all bounces (one tile each)
+  bool classic = false;
+  uint32_t atlasWidth() const { return uint32_t(perRow * res); }
+  uint32_t atlasHeight() const { return uint32_t(rows * res); }
+};
+
+class IsmEffect : public gi::Effect {
+ public:
+  gi::EffectInfo info() const override {
+    gi::EffectInfo i;
+    i.name = "ism";
+    i.version = "1.0";
+    i.description =
+        "instant radiosity with imperfect shadow maps (Ritschel et al. 2008): VPLs from the "
+        "primary light's RSM, point-splatted paraboloid ISMs with pull-push, interleaved "
+        "gathering, geometry-aware blur; 1 to 3 diffuse bounces";
+    i.stage = gi::EffectStage::BeforeLighting;
+    i.reads = {res::kDepth, res::kNormal, res::kAlbedo, res::kMaterial, res::kSurfacePoints};
+    i.writes = {res::kIndirect};
+    i.debugView = res::kIndirect;
+    i.estimates = gi::GroundTruth::IndirectLight;
+    return i;
+  }
+
+  std::vector<gi::SettingDesc> settings() const override {
+    using gi::ism::kMaxVpls;
+    return {
+        {"vpls", SettingType::Int, 256, 1, kMaxVpls,
+         "virtual point lights N_vpl per bounce, the first sampled from the primary light's RSM "
+         "(each gets one ISM)",
+         true},
+        {"ism_resolution", SettingType::Int, 64, 8, gi::ism::kMaxIsmResolution,
+         "side of each VPL's paraboloid shadow map in texels (rounded down to a power of two)",
+         true},
+        {"points_per_ism", SettingType::Int, 1024, 16, 65536,
+         "surface points splatted into each ISM (a fixed subset per VPL; the engine keeps "
+         "min(vpls x points_per_ism, 2^21) points)",
+         true},
+        {"pull_push_levels", SettingType::Int, 1, 0, gi::ism::kMaxPullPushLevels,
+         "pull-push pyramid levels filling the ISMs' holes (0: none; at most log2 resolution)",
+         true},
+        {"pull_threshold", SettingType::Float, 0.05, 0.0, 1.0,
+         "pull outlier threshold, fraction of the scene extent at level 0 (x 2^level): "
+         "children farther than this behind the nearest are not averaged",
+         false},
+        {"push_threshold", SettingType::Float, 0.05, 0.0, 1.0,
+         "push outlier threshold, fraction of the scene extent at level 0 (x 2^level): a "
+         "texel this far behind the coarse value is replaced by it",
+         false},
+        {"block_size", SettingType::Int, 4, 1, gi::ism::kMaxBlock,
+         "interleaving block k: each pixel of a k x k block gathers N_vpl / k^2 VPLs", true},
+        {"bounces", SettingType::Int, 1, 1, gi::ism::kMaxBounces,
+         "indirect bounces: each bounce after the first samples `vpls` more VPLs from surface "
+         "points lit by the previous bounce's VPLs (with their maps' visibility), each with its "
+         "own map; vpls x bounces is capped at 1024",
+         true},
+        gi::SettingDesc::enumeration("mode", {"ism", "classic"}, 0,
+                                     "ism: imperfect shadow maps from points; classic: accurate "
+                                     "paraboloid shadow maps from the triangles (reference)",
+                                     true),
+        {"rsm_resolution", SettingType::Int, 64, 16, 256,
+         "side of the reflective shadow map's face (a point light gets six cube faces in a 3 x 2 "
+         "atlas; a spot light one perspective face, or a paraboloid beyond 60 degrees)",
+         true},
+        {"bias", SettingType::Float, 0.01, 0.0, 1.0,
+         "constant shadow bias, fraction of the scene extent", false},
+        {"bias_slope", SettingType::Float, 0.1, 0.0, 4.0,
+         "shadow bias per unit distance to the VPL (grows with the texel footprint)", false},
+        {"distance_clamp", SettingType::Float, gi::ism::kDistanceClamp, 1e-6, 1.0,
+         "VPL singularity guard d_min as a fraction of the scene extent: 1 / max(d^2, d_min^2)",
+         false},
+        {"splat_radius", SettingType::Int, 1, 0, gi::ism::kMaxSplatRadius,
+         "largest splat radius in texels (the radius follows each point's area / distance^2)",
+         true},
+        {"splat_scale", SettingType::Float, 1.0, 0.0, 8.0,
+         "scales the splat radius computed from the point's footprint", false},
+        {"blur_radius", SettingType::Int, 0, 0, 8,
+         "blur taps beyond the k that cancel the block pattern, each side", true},
+        {"blur_tolerance", SettingType::Float, 0.05, 0.0, 1.0,
+         "blur: distance a neighbour may lie from the centre's tangent plane, relative to the view "
+         "distance",
+         false},
+        {"strength", SettingType::Float, 1.0, 0.0, 16.0, "scales the indirect light", false},
+    };
+  }
+
+  void prepare(gi::EffectContext& ctx, const gi::SettingValues& s) override {
+    gi::vk::Context& vk = ctx.vulkan();
+    vk.requireWorkgroup(kGroupX, kGroupY, "ism");
+    Config c;
+    c.bounces = std::clamp(s.integer("bounces"), 1, gi::ism::kMaxBounces);
+    // The VPL table holds every bounce's VPLs: at most kMaxVpls in all.
+    c.vpls = std::clamp(s.integer("vpls"), 1, gi::ism::kMaxVpls / c.bounces);
+    c.block = std::clamp(s.integer("block_size"), 1, gi::ism::kMaxBlock);
+    const int k2 = c.block * c.block;
+    c.perPixel = (c.total() + k2 - 1) / k2;
+    c.padded = c.perPixel * k2;
+    c.res = floorPow2(std::clamp(s.integer("ism_resolution"), 8, gi::ism::kMaxIsmResolution));
+    c.perRow = int(std::ceil(std::sqrt(double(c.total()))));
+    c.rows = (c.total() + c.perRow - 1) / c.perRow;
+    c.perIsm = s.integer("points_per_ism");
+    c.levels = std::clamp(s.integer("pull_push_levels"), 0, log2i(c.res));
+    c.rsm = s.integer("rsm_resolution");
+    c.splat = s.integer("splat_radius");
+    c.blurExtra = s.integer("blur_radius");
+    c.classic = s.option("mode") == "classic";
+    cfg_ = c;
+    nearest_ = ctx.nearestSampler();
+    if (!c.classic)
+      ctx.requestSurfacePoints(uint32_t(
+          std::min<uint64_t>(uint64_t(c.total()) * uint64_t(c.perIsm), gi::ism::kMaxPoints)));
+    else if (c.bounces > 1)
+      ctx.requestSurfacePoints(gi::ism::kShadePoints);
+
+    const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
+               tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+               img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    auto spv = [](const uint32_t* b, const uint32_t* e) { return std::vector<uint32_t>(b, e); };
+    vpl_ = gi::vk::Pipeline::compute(
+        vk, spv(std::begin(ism_vpl_comp), std::end(ism_vpl_comp)),
+        {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, tex}, {5, ssbo}, {6, ssbo}});
+    if (!c.classic) {
+      clear_ = gi::vk::Pipeline::compute(
+          vk, spv(std::begin(ism_clear_comp), std::end(ism_clear_comp)), {{0, img}});
+      splat_ = gi::vk::Pipeline::compute(
+          vk, spv(std::begin(ism_splat_comp), std::end(ism_splat_comp)),
+          {{1, ubo}, {2, ubo}, {3, ssbo}, {4, img}}, sizeof(int32_t), {uint32_t(c.splat)});
+      for (uint32_t push = 0; push < 2; ++push)
+        pullPush_[push] =
+            gi::vk::Pipeline::compute(vk, spv(std::begin(ism_pull_comp), std::end(ism_pull_comp)),
+                                      {{1, ubo}, {2, img}, {3, img}}, 3 * sizeof(int32_t), {push});
+    }
+    const std::vector<gi::vk::Binding> bounceBindings = {{1, ubo}, {2, ubo},  {3, ssbo}, {4, ssbo},
+                                                         {5, tex}, {6, ssbo}, {7, ssbo}};
+    const std::vector<uint32_t> bounceSpec = {uint32_t(c.vpls), uint32_t(gi::ism::kShadePoints)};
+    if (c.bounces > 1)
+      bounce_ =
+          c.classic
+              ? gi::vk::Pipeline::compute(
+                    vk, spv(std::begin(ism_bounce_classic_comp), std::end(ism_bounce_classic_comp)),
+                    bounceBindings, sizeof(int32_t), bounceSpec)
+              : gi::vk::Pipeline::compute(
+                    vk, spv(std::begin(ism_bounce_comp), std::end(ism_bounce_comp)), bounceBindings,
+                    sizeof(int32_t), bounceSpec);
+    const std::vector<uint32_t> gatherSpec = {uint32_t(c.perPixel), uint32_t(c.block)};
+    const std::vector<gi::vk::Binding> gatherBindings = {{0, ubo}, {1, ubo}, {2, ubo}, {3, tex},
+                                                         {4, tex}, {5, tex}, {6, img}};
+    gather_ =
+        c.classic
+            ? gi::vk::Pipeline::compute(
+                  vk, spv(std::begin(ism_gather_classic_comp), std::end(ism_gather_classic_comp)),
+                  gatherBindings, 0, gatherSpec)
+            : gi::vk::Pipeline::compute(vk,
+                                        spv(std::begin(ism_gather_comp), std::end(ism_gather_comp)),
+                                        gatherBindings, 0, gatherSpec);
+    // K taps from -K/2 cover each phase of a K-periodic pattern exactly once.
+    const int lo = -c.block / 2 - c.blurExtra, hi = c.block - 1 - c.block / 2 + c.blurExtra;
+    const std::vector<uint32_t> blurSpec = {uint32_t(lo), uint32_t(hi)};
+    blurX_ =
+        gi::vk::Pipeline::compute(vk, spv(std::begin(ism_blur_x_comp), std::end(ism_blur_x_comp)),
+                                  {{0, ubo}, {1, ubo}, {2, tex}, {3, img}}, 0, blurSpec);
+    blurY_ = gi::vk::Pipeline::compute(
+        vk, spv(std::begin(ism_blur_y_comp), std::end(ism_blur_y_comp)),
+        {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, tex}, {5, img}}, 0, blurSpec);
+    if (!uniforms_)
+      uniforms_ =
+          gi::vk::Buffer(vk, sizeof(gi::ism::Uniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true);
+    // Host-visible: classic mode reads last frame's VPLs back to place its views.
+    if (!vplBuffer_) {
+      vplBuffer_ = gi::vk::Buffer(
+          vk, kVplBytes * gi::ism::kVplSlots,
+          VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true);
+      std::fill_n(static_cast<char*>(vplBuffer_.mapped()), vplBuffer_.size(), 0);
+    }
+  }
+
+  void addPasses(gi::FrameGraph& graph, gi::EffectContext& ctx,
+                 const gi::SettingValues& settings) override {
+    struct Io {
+      gi::TextureHandle rsmDepth, rsmPos, rsmNormal, rsmFlux, atlas, depth, normal, albedo,
+          material, raw, half, indirect;
+      gi::BufferHandle cdf, vpls, points, shade;
+    };
+    auto io = std::make_shared<Io>();
+    gi::Blackboard& bb = graph.blackboard();
+    const Config c = cfg_;
+    const VkBuffer frame = ctx.frameUniforms();
+    const VkSampler nearest = ctx.nearestSampler();
+    const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    const VkBuffer params = uniforms_.handle();
+    auto absolute = [](VkFormat f, uint32_t w, uint32_t h, uint32_t mips = 1) {
+      gi::TextureDesc d{f, gi::SizeClass::Absolute, 1.0f, w, h};
+      d.mips = mips;
+      return d;
+    };
+
+    // 1. Reflective shadow map of the primary light (drawRsm below: cube faces, one face or an
+    // orthographic view).
+    graph.addPass(
+        "ism_rsm",
+        [&](gi::PassBuilder& b) {
+          ctx.scene().declareRead(b);
+          const uint32_t w = uint32_t(3 * c.rsm), h = uint32_t(2 * c.rsm);
+          const std::vector<VkFormat> f =
+              gi::sceneColorFormats(gi::SceneOutputs::ReflectiveShadowMap);
+          io->rsmDepth = b.write(b.create("ism_rsm_depth", absolute(gi::kSceneDepthFormat, w, h)),
+                                 gi::TextureUsage::DepthAttachment);
+          io->rsmPos = b.write(b.create("ism_rsm_position", absolute(f[0], w, h)),
+                               gi::TextureUsage::ColorAttachment);
+          io->rsmNormal = b.write(b.create("ism_rsm_normal", absolute(f[1], w, h)),
+                                  gi::TextureUsage::ColorAttachment);
+          io->rsmFlux = b.write(b.create("ism_rsm_flux", absolute(f[2], w, h)),
+                                gi::TextureUsage::ColorAttachment);
+        },
+        [this, io, c, values = &settings, cx = &ctx](gi::PassContext& pc) {
+          upload(*cx, *values);
+          drawRsm(pc, *cx, *io, c);
+        });
+
+    // 2. VPLs from the RSM's flux.
+    io->vpls = graph.importBuffer("ism_vpls", vplBuffer_.handle(), vplBuffer_.size());
+    graph.addPass(
+        "ism_vpl",
+        [&](gi::PassBuilder& b) {
+          io->rsmPos = b.read(io->rsmPos);
+          io->rsmNormal = b.read(io->rsmNormal);
+          io->rsmFlux = b.read(io->rsmFlux);
+          io->cdf = b.write(
+              b.create("ism_cdf", gi::BufferDesc{VkDeviceSize(6 * c.rsm * c.rsm) * sizeof(float)}),
+              gi::BufferUsage::StorageWrite);
+          io->vpls = b.write(io->vpls, gi::BufferUsage::StorageWrite);
+        },
+        [this, io, frame, nearest, params, ubo, ssbo](gi::PassContext& pc) {
+          gi::vk::DescriptorWriter w;
+          w.buffer(0, ubo, frame)
+              .buffer(1, ubo, params)
+              .sampled(2, pc.view(io->rsmPos), nearest)
+              .sampled(3, pc.view(io->rsmNormal), nearest)
+              .sampled(4, pc.view(io->rsmFlux), nearest)
+              .buffer(5, ssbo, pc.buffer(io->cdf))
+              .buffer(6, ssbo, pc.buffer(io->vpls));
+          pc.dispatch(vpl_, w, {1, 1}, 1, 1);
+        });
+
+    // 3. One shadow map per VPL in an atlas: imperfect (points + pull-push) or classic; and the
+    // next bounces' VPLs from points lit by the previous bounce (their maps follow).
+    if (!c.classic) {
+      graph.addPass(
+          "ism_splat",
+          [&](gi::PassBuilder& b) {
+            io->vpls = b.read(io->vpls, gi::BufferUsage::Uniform);
+            io->points = b.read(bb.buffer(res::kSurfacePoints), gi::BufferUsage::StorageRead);
+            io->atlas =
+                b.write(b.create("ism_atlas", absolute(kAtlasFormat, c.atlasWidth(),
+                                                       c.atlasHeight(), uint32_t(c.levels + 1))),
+                        gi::TextureUsage::StorageWrite, gi::Subresource::mipLevel(0));
+          },
+          [this, io, c](gi::PassContext& pc) {
+            uploaded_.atlas.w = float(pc.bufferSize(io->points) / (2 * sizeof(glm::vec4)));
+            uniforms_.write(&uploaded_.atlas, sizeof(glm::vec4),
+                            offsetof(gi::ism::Uniforms, atlas));
+            // One clear for every bounce's tiles: the later splats only add points.
+            const gi::Subresource mip0 = gi::Subresource::mipLevel(0);
+            gi::vk::DescriptorWriter clear;
+            clear.storageImage(0, pc.view(io->atlas, mip0));
+            pc.dispatch(clear_, clear, pc.extent(io->atlas), kGroupX, kGroupY);
+            pc.barrier(io->atlas, mip0);
+            splat(pc, *io, c, 0);
+          });
+      addPullPush(graph, io, c, 0, "ism_pull_push");
+      for (int bounce = 1; bounce < c.bounces; ++bounce) {
+        addBounce(graph, ctx, io, bounce);
+        const std::string n = std::to_string(bounce + 1);
+        graph.addPass(
+            "ism_splat" + n,
+            [&](gi::PassBuilder& b) {
+              io->vpls = b.read(io->vpls, gi::BufferUsage::Uniform);
+              io->points = b.read(io->points, gi::BufferUsage::StorageRead);
+              io->atlas =
+                  b.read(io->atlas, gi::TextureUsage::StorageRead, gi::Subresource::mipLevel(0));
+              io->atlas =
+                  b.write(io->atlas, gi::TextureUsage::StorageWrite, gi::Subresource::mipLevel(0));
+            },
+            [this, io, c, bounce](gi::PassContext& pc) { splat(pc, *io, c, bounce); });
+        addPullPush(graph, io, c, bounce, "ism_pull_push" + n);
+      }
+    } else {
+      graph.addPass(
+          "ism_classic_sm",
+          [&](gi::PassBuilder& b) {
+            ctx.scene().declareRead(b);
+            io->atlas =
+                b.write(b.create("ism_classic_atlas",
+                                 absolute(gi::kSceneDepthFormat, c.atlasWidth(), c.atlasHeight())),
+                        gi::TextureUsage::DepthAttachment);
+          },
+          [this, io, c, cx = &ctx](gi::PassContext& pc) { drawClassic(pc, *cx, *io, c); });
+      if (c.bounces > 1) io->points = graph.blackboard().buffer(res::kSurfacePoints);
+      for (int bounce = 1; bounce < c.bounces; ++bounce) addBounce(graph, ctx, io, bounce);
+    }
+
+    // 4. Interleaved gathering.
+    graph.addPass(
+        "ism_gather",
+        [&](gi::PassBuilder& b) {
+          io->depth = b.read(bb.texture(res::kDepth));
+          io->normal = b.read(bb.texture(res::kNormal));
+          io->vpls = b.read(io->vpls, gi::BufferUsage::Uniform);
+          io->atlas = b.read(io->atlas, gi::TextureUsage::Sampled, gi::Subresource::mipLevel(0));
+          io->raw = b.write(b.create("ism_raw", gi::TextureDesc{kRawFormat}),
+                            gi::TextureUsage::StorageWrite);
+        },
+        [this, io, c, frame, nearest, params, ubo](gi::PassContext& pc) {
+          gi::vk::DescriptorWriter w;
+          w.buffer(0, ubo, frame)
+              .buffer(1, ubo, params)
+              .buffer(2, ubo, pc.buffer(io->vpls))
+              .sampled(3, pc.view(io->depth), nearest)
+              .sampled(4, pc.view(io->normal), nearest)
+              .sampled(5, pc.view(io->atlas, gi::Subresource::mipLevel(0)), nearest)
+              .storageImage(6, pc.view(io->raw));
+          pc.descriptors().bind(pc.cmd(), gather_, w);
+          const VkExtent2D e = pc.extent(io->raw);
+          const uint32_t k = uint32_t(c.block);
+          const uint32_t sx = (e.width + k - 1) / k, sy = (e.height + k - 1) / k;
+          vkCmdDispatch(pc.cmd(), (sx + kGroupX - 1) / kGroupX, (sy + kGroupY - 1) / kGroupY,
+                        k * k);
+        });
+
+    // 5. Geometry-aware blur (x, then y with the diffuse albedo) into "indirect".
+    graph.addPass(
+        "ism_blur",
+        [&](gi::PassBuilder& b) {
+          io->raw = b.read(io->raw);
+          io->albedo = b.read(bb.texture(res::kAlbedo));
+          io->material = b.read(bb.texture(res::kMaterial));
+          io->half = b.write(b.create("ism_blur_x", gi::TextureDesc{kRawFormat}),
+                             gi::TextureUsage::StorageWrite);
+          io->indirect = b.write(b.create(res::kIndirect, gi::TextureDesc{kOutFormat}),
+                                 gi::TextureUsage::StorageWrite);
+        },
+        [this, io, frame, nearest, params, ubo](gi::PassContext& pc) {
+          const VkExtent2D e = pc.extent(io->indirect);
+          gi::vk::DescriptorWriter x;
+          x.buffer(0, ubo, frame)
+              .buffer(1, ubo, params)
+              .sampled(2, pc.view(io->raw), nearest)
+              .storageImage(3, pc.view(io->half));
+          pc.dispatch(blurX_, x, e, kGroupX, kGroupY);
+          imageBarrier(pc.cmd(), pc.image(io->half));
+          gi::vk::DescriptorWriter y;
+          y.buffer(0, ubo, frame)
+              .buffer(1, ubo, params)
+              .sampled(2, pc.view(io->half), nearest, VK_IMAGE_LAYOUT_GENERAL)
+              .sampled(3, pc.view(io->albedo), nearest)
+              .sampled(4, pc.view(io->material), nearest)
+              .storageImage(5, pc.view(io->indirect));
+          pc.dispatch(blurY_, y, e, kGroupX, kGroupY);
+        });
+    bb.put(res::kIndirect, io->indirect);
+  }
+
+ private:
+  // Splats bounce `bounce`'s VPLs' point subsets into their tiles (mip 0).
+  template <class IoT>
+  void splat(gi::PassContext& pc, const IoT& io, const Config& c, int bounce) {
+    const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    const int32_t base = bounce * c.vpls;
+    vkCmdPushConstants(pc.cmd(), splat_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof base, &base);
+    gi::vk::DescriptorWriter w;
+    w.buffer(1, ubo, uniforms_.handle())
+        .buffer(2, ubo, pc.buffer(io.vpls))
+        .buffer(3, ssbo, pc.buffer(io.points))
+        .storageImage(4, pc.view(io.atlas, gi::Subresource::mipLevel(0)));
+    pc.dispatch(splat_, w, {uint32_t(c.perIsm), uint32_t(c.vpls)}, 256, 1);
+  }
+
+  // Pull-push over the tiles of bounce `bounce`'s VPLs.
+  template <class IoPtr>
+  void addPullPush(gi::FrameGraph& graph, const IoPtr& io, const Config& c, int bounce,
+                   const std::string& name) {
+    if (c.levels == 0) return;
+    graph.addPass(
+        name,
+        [&](gi::PassBuilder& b) {
+          // Reads the splatted level 0, writes every level (level 0 in place).
+          io->atlas = b.read(io->atlas, gi::TextureUsage::StorageRead);
+          io->atlas = b.write(io->atlas, gi::TextureUsage::StorageWrite);
+        },
+        [this, io, c, bounce](gi::PassContext& pc) {
+          auto run = [&](int push, int level) {
+            const std::array<int32_t, 3> pcs = {level, bounce * c.vpls, (bounce + 1) * c.vpls};
+            vkCmdPushConstants(pc.cmd(), pullPush_[push].layout(), VK_SHADER_STAGE_ALL, 0,
+                               sizeof pcs, pcs.data());
+            gi::vk::DescriptorWriter w;
+            w.buffer(1, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms_.handle())
+                .storageImage(2, pc.view(io->atlas, gi::Subresource::mipLevel(uint32_t(level))))
+                .storageImage(3,
+                              pc.view(io->atlas, gi::Subresource::mipLevel(uint32_t(level + 1))));
+            pc.dispatch(pullPush_[push], w,
+                        pc.extent(io->atlas, uint32_t(push ? level : level + 1)), kGroupX, kGroupY);
+            pc.barrier(io->atlas, gi::Subresource::all());
+          };
+          for (int l = 0; l < c.levels; ++l) run(0, l);
+          for (int l = c.levels - 1; l >= 0; --l) run(1, l);
+        });
+  }
+
+  // Bounce `bounce` + 1's VPLs from points lit by bounce `bounce`'s (ism_bounce.glsl).
+  template <class IoPtr>
+  void addBounce(gi::FrameGraph& graph, gi::EffectContext& ctx, const IoPtr& io, int bounce) {
+    graph.addPass(
+        "ism_bounce" + std::to_string(bounce + 1),
+        [&](gi::PassBuilder& b) {
+          io->points = b.read(io->points, gi::BufferUsage::StorageRead);
+          io->atlas = b.read(io->atlas, gi::TextureUsage::Sampled, gi::Subresource::mipLevel(0));
+          io->vpls = b.read(io->vpls, gi::BufferUsage::Uniform);
+          io->vpls = b.write(io->vpls, gi::BufferUsage::StorageWrite);
+          io->shade = b.write(
+              b.create("ism_shade" + std::to_string(bounce + 1),
+                       gi::BufferDesc{VkDeviceSize(5 * gi::ism::kShadePoints) * sizeof(float)}),
+              gi::BufferUsage::StorageWrite);
+        },
+        [this, io, bounce, materials = ctx.scene().materials()](gi::PassContext& pc) {
+          const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
+                     ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+          if (cfg_.classic) {  // no splat pass sets the point count
+            uploaded_.atlas.w = float(pc.bufferSize(io->points) / (2 * sizeof(glm::vec4)));
+            uniforms_.write(&uploaded_.atlas, sizeof(glm::vec4),
+                            offsetof(gi::ism::Uniforms, atlas));
+          }
+          const int32_t b = bounce;
+          vkCmdPushConstants(pc.cmd(), bounce_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof b, &b);
+          gi::vk::DescriptorWriter w;
+          w.buffer(1, ubo, uniforms_.handle())
+              .buffer(2, ubo, pc.buffer(io->vpls))
+              .buffer(3, ssbo, pc.buffer(io->points))
+              .buffer(4, ssbo, materials)
+              .sampled(5, pc.view(io->atlas, gi::Subresource::mipLevel(0)), nearest_)
+              .buffer(6, ssbo, pc.buffer(io->shade))
+              .buffer(7, ssbo, pc.buffer(io->vpls));
+          pc.dispatch(bounce_, w, {1, 1}, 1, 1);
+        });
+  }
+
+  static float sceneExtent(gi::EffectContext& ctx) {
+    glm::vec3 lo, hi;
+    ctx.scene().bounds(lo, hi);
+    const float e = glm::length(hi - lo);
+    return std::isfinite(e) && e > 1e-6f ? e : 1.0f;
+  }
+
+  // Written while recording (the renderer waits for each frame before recording the next).
+  void upload(gi::EffectContext& ctx, const gi::SettingValues& s) {
+    const Config& c = cfg_;
+    const float extent = sceneExtent(ctx);
+    const float dMin = float(s.number("distance_clamp")) * extent;
+    const float k = float(c.block);
+    gi::ism::Uniforms u{};
+    u.rsm = glm::vec4(3 * c.rsm, 2 * c.rsm, c.vpls, c.padded);
+    u.atlas = glm::vec4(c.res, c.perRow, c.perIsm, 0.0f);  // point count: set by ism_splat
+    u.bias = glm::vec4(float(s.number("bias")) * extent, float(s.number("bias_slope")),
+                       classicNear(extent), classicFar(extent));
+    u.pull = glm::vec4(float(s.number("pull_threshold")) * extent,
+                       float(s.number("push_threshold")) * extent, c.levels, extent);
+    u.gather = glm::vec4(dMin * dMin, k, k * k, float(s.number("strength")));
+    u.blur = glm::vec4(float(s.number("blur_tolerance")), 0.9f, float(s.number("splat_scale")),
+                       float(c.total()));
+    uniforms_.write(&u, sizeof u);
+    uploaded_ = u;
+  }
+
+  static float classicNear(float extent) { return 1e-4f * extent; }
+  static float classicFar(float extent) { return 2.0f * extent; }
+
+  template <class IoT>
+  void drawRsm(gi::PassContext& pc, gi::EffectContext& ctx, const IoT& io, const Config& c) {
+    gi::LightInfo light;
+    light.radiance = glm::vec3(0.0f);  // no light: an all-black map, zero VPLs
+    if (!ctx.lights().empty()) light = ctx.lights().front();
+    glm::vec3 lo, hi;
+    ctx.scene().bounds(lo, hi);
+    const glm::vec3 center = 0.5f * (lo + hi);
+    const float extent = sceneExtent(ctx);
+    const float far = extent + 2.0f * glm::length(light.position - center);
+    const uint32_t r = uint32_t(c.rsm);
+    gi::SceneTargets t;
+    t.depth = pc.view(io.rsmDepth);
+    t.colors = {pc.view(io.rsmPos), pc.view(io.rsmNormal), pc.view(io.rsmFlux)};
+    t.extent = pc.extent(io.rsmDepth);
+    // Perspective faces rasterize triangles exactly (a paraboloid interpolates positions
+    // linearly across the disk, which misplaces the texels of large triangles).
+    std::vector<gi::SceneView> views;
+    const float znear = 1e-3f * extent;
+    const float outer = std::acos(std::clamp(light.cosOuter, -1.0f, 1.0f));
+    if (light.type == gi::LightType::Directional) {
+      views.push_back(gi::SceneView::orthographic(center - light.direction * extent,
+                                                  light.direction, 0.5f * extent, 0.5f * extent,
+                                                  1e-3f * extent, 2.0f * extent));
+    } else if (light.type == gi::LightType::Spot && outer < glm::radians(60.0f)) {
+      views.push_back(gi::SceneView::perspective(light.position, light.direction,
+                                                 2.0f * outer + 0.02f, 1.0f, znear, far));
+    } else if (light.type == gi::LightType::Spot) {
+      views.push_back(gi::SceneView::paraboloid(light.position, light.direction, znear, far));
+    } else {
+      const auto faces = gi::SceneView::cube(light.position, znear, far);
+      views.assign(faces.begin(), faces.end());
+    }
+    for (size_t i = 0; i < views.size(); ++i) {
+      views[i].viewport = {{int32_t((i % 3) * r), int32_t((i / 3) * r)}, {r, r}};
+      t.clear = i == 0;  // the first draw clears the whole map (3 x 2 faces)
+      ctx.scene().drawRsm(pc, t, views[i], light);
+    }
+  }
+
+  // Classic reference: last frame's VPLs (read back from the host-visible table; the renderer
+  // waited for that frame) as paraboloid depth maps drawn from the triangles.
+  template <class IoT>
+  void drawClassic(gi::PassContext& pc, gi::EffectContext& ctx, const IoT& io, const Config& c) {
+    const float extent = sceneExtent(ctx);
+    const auto* v = static_cast<const glm::vec4*>(vplBuffer_.mapped());
+    std::vector<gi::SceneView> views;
+    for (int i = 0; i < c.vpls; ++i) {
+      const glm::vec4 pos = v[3 * i], n = v[3 * i + 1];
+      if (pos.w < 0.5f) continue;
+      gi::SceneView view = gi::SceneView::paraboloid(glm::vec3(pos), glm::vec3(n),
+                                                     classicNear(extent), classicFar(extent));
+      view.viewport = {{int32_t((i % c.perRow) * c.res), int32_t((i / c.perRow) * c.res)},
+                       {uint32_t(c.res), uint32_t(c.res)}};
+      views.push_back(view);
+    }
+    gi::SceneTargets t;
+    t.depth = pc.view(io.atlas);
+    t.extent = pc.extent(io.atlas);
+    t.clear = true;
+    ctx.scene().drawDepth(pc, t, views);
+  }
+
+  // Compute write -> compute sampled read of a storage image that stays in GENERAL.
+  static void imageBarrier(VkCommandBuffer cmd, VkImage image) {
+    VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
+    b.srcStageMask = b.dstStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
+    b.srcAccessMask = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
+    b.dstAccessMask = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT;
+    b.oldLayout = b.newLayout = VK_IMAGE_LAYOUT_GENERAL;
+    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    b.image = image;
+    b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+    VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+    dep.imageMemoryBarrierCount = 1;
+    dep.pImageMemoryBarriers = &b;
+    vkCmdPipelineBarrier2(cmd, &dep);
+  }
+
+  Config cfg_;
+  gi::vk::Pipeline vpl_, clear_, splat_, bounce_, gather_, blurX_, blurY_;
+  VkSampler nearest_ = VK_NULL_HANDLE;
+  std::array<gi::vk::Pipeline, 2> pullPush_;
+  gi::vk::Buffer uniforms_, vplBuffer_;
+  gi::ism::Uniforms uploaded_{};
+};
+
+}  // namespace
+
+GI_EFFECT_MODULE(IsmEffect)

@@ -1,0 +1,66 @@
+// Included by ism_blur_x.comp / ism_blur_y.comp (AXIS 0 / 1). Geometry-aware blur removing the K x K block pattern (seed 002 §3.4): along x (AXIS 0) then
+// y (AXIS 1), taps LO..HI around the pixel (K taps cover every phase once; the blur_radius
+// setting widens it), averaging only neighbours within the tolerance (x view distance) of the centre's
+// tangent plane and whose normal is close. AXIS 1 then reflects: indirect = diffuse albedo / pi x irradiance.
+#include "common.glsl"
+#include "ism_common.glsl"
+
+layout(constant_id = 0) const int LO = -2;
+layout(constant_id = 1) const int HI = 1;
+layout(local_size_x = 32, local_size_y = 16) in;
+layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
+layout(set = 0, binding = 2) uniform usampler2D inRaw;
+#if AXIS == 0
+layout(set = 0, binding = 3, rgba32ui) uniform writeonly uimage2D outRaw;
+#else
+layout(set = 0, binding = 3) uniform sampler2D gAlbedo;
+layout(set = 0, binding = 4) uniform sampler2D gMaterial;
+layout(set = 0, binding = 5, rgba16f) uniform writeonly image2D outIndirect;
+#endif
+
+vec2 signNotZero(vec2 v) { return vec2(v.x >= 0.0 ? 1.0 : -1.0, v.y >= 0.0 ? 1.0 : -1.0); }
+vec3 unpackNormal(uint q) {
+  vec2 e = unpackSnorm2x16(q);
+  vec3 n = vec3(e, 1.0 - abs(e.x) - abs(e.y));
+  float t = max(-n.z, 0.0);
+  n.xy -= t * signNotZero(n.xy);
+  return safeNormalize(n, vec3(0.0, 0.0, 1.0));
+}
+vec3 unpackValue(uvec4 t) { return vec3(unpackHalf2x16(t.x), unpackHalf2x16(t.y).x); }
+
+// View-space position of pixel q at view distance `dist`.
+vec3 viewPoint(ivec2 q, float dist) {
+  vec2 uv = (vec2(q) + 0.5) * frame.viewport.zw;
+  return normalize(viewPositionFromDepth(frame.invProj, uv, 0.5)) * dist;
+}
+
+void main() {
+  ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+  ivec2 size = ivec2(frame.viewport.xy);
+  if (p.x >= size.x || p.y >= size.y) return;
+  uvec4 c = texelFetch(inRaw, p, 0);
+  float z = uintBitsToFloat(c.z);
+  vec3 n = unpackNormal(c.w);
+  vec3 centre = viewPoint(p, z);
+  vec3 sum = vec3(0.0);
+  float wsum = 0.0;
+  ivec2 axis = AXIS == 0 ? ivec2(1, 0) : ivec2(0, 1);
+  for (int o = LO; o <= HI; ++o) {
+    ivec2 q = clamp(p + axis * o, ivec2(0), size - 1);
+    uvec4 t = texelFetch(inRaw, q, 0);
+    float zt = uintBitsToFloat(t.z);
+    // Same surface: the neighbour lies near the centre's tangent plane and faces alike.
+    float plane = abs(dot(n, viewPoint(q, zt) - centre));
+    float w = (zt > 0.0 && plane <= ism.blur.x * z && dot(unpackNormal(t.w), n) >= ism.blur.y)
+                  ? 1.0 : 0.0;
+    sum += w * unpackValue(t);
+    wsum += w;
+  }
+  vec3 e = z > 0.0 ? sum / max(wsum, 1.0) : vec3(0.0);
+#if AXIS == 0
+  imageStore(outRaw, p, uvec4(packHalf2x16(e.rg), packHalf2x16(vec2(e.b, 0.0)), c.z, c.w));
+#else
+  vec3 diffuse = texelFetch(gAlbedo, p, 0).rgb * (1.0 - texelFetch(gMaterial, p, 0).g);
+  imageStore(outIndirect, p, vec4(min(diffuse * e / 3.14159265, vec3(65000.0)), 1.0));
+#endif
+}

@@ -1,0 +1,4 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#define AXIS 1
+#include "ism_blur.glsl"

@@ -1,0 +1,49 @@
+// Shared by the ISM shaders: the parameter block (C++ mirror gi::ism::Uniforms in
+// ism_params.h), the VPL table and the paraboloid mapping (the same basis as
+// SceneView::paraboloid, so ISMs and the classic maps share texels).
+#ifndef ISM_COMMON_GLSL
+#define ISM_COMMON_GLSL
+
+const uint ISM_EMPTY = 0xffffffffu;  // an ISM texel no point reached
+const int ISM_VPL_SLOTS = 1024 + 64;   // gi::ism::kVplSlots
+
+layout(set = 0, binding = 1, std140) uniform IsmParams {
+  vec4 rsm;     // width, height, vpl count, padded count
+  vec4 atlas;   // tile resolution, tiles per row, points per ISM, surface point count
+  vec4 bias;    // constant (world), slope, near, far (classic maps)
+  vec4 pull;    // pull threshold, push threshold, levels, scene extent
+  vec4 gather;  // d_min^2, block k, k^2, strength
+  vec4 blur;    // plane tolerance, min normal cosine, splat scale, VPLs of all bounces
+} ism;
+
+// One VPL: position (w 1: valid), normal, flux (rgb, W).
+struct Vpl {
+  vec4 position;
+  vec4 normal;
+  vec4 flux;
+};
+
+void ismBasis(vec3 n, out vec3 s, out vec3 u) {
+  vec3 up = abs(n.y) > 0.99 ? vec3(0.0, 0.0, 1.0) : vec3(0.0, 1.0, 0.0);
+  s = normalize(cross(n, up));
+  u = cross(s, n);
+}
+
+// Texel of direction `dir` (unit, cosine c = dot(dir, n) > 0) in tile `tile` of the atlas.
+ivec2 ismTexel(uint tile, vec3 dir, vec3 s, vec3 u, float c) {
+  vec2 p = vec2(dot(dir, s), dot(dir, u)) / max(1.0 + c, 1e-6);
+  int res = int(ism.atlas.x), perRow = int(ism.atlas.y);
+  ivec2 t = clamp(ivec2((p * 0.5 + 0.5) * float(res)), ivec2(0), ivec2(res - 1));
+  return ivec2(int(tile) % perRow, int(tile) / perRow) * res + t;
+}
+
+uint ismHash(uint x) {
+  x ^= x >> 16;
+  x *= 0x7feb352du;
+  x ^= x >> 15;
+  x *= 0x846ca68bu;
+  x ^= x >> 16;
+  return x;
+}
+
+#endif

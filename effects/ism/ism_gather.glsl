@@ -1,0 +1,52 @@
+// Interleaved gathering (seed 002 §3.4, after Segovia et al. 2006). Workgroup layer z is the
+// phase (x % K, y % K) of a K x K block: its pixels gather only VPLs phase + j K^2, so the VPL
+// index is uniform in the workgroup (one uniform-buffer load, not one per lane) and each pixel
+// sums N / K^2 VPLs, weighted K^2; the blur averages the K^2 phases back. Per VPL: irradiance
+// phi / pi cos cos / max(d^2, d_min^2) (the singularity guard), visibility from the VPL's map
+// with a constant + slope bias. Output texel (RGBA32UI): x, y irradiance (half rg, half b),
+// z view distance (float bits, 0: sky), w view normal (octahedral snorm 16x2).
+// ISM_CLASSIC: the maps are accurate paraboloid depth maps (D32 reverse-Z, near..far).
+#include "common.glsl"
+#include "ism_common.glsl"
+
+layout(constant_id = 0) const int PER_PIXEL = 16;  // ceil(N / K^2)
+layout(constant_id = 1) const int K = 4;
+layout(local_size_x = 32, local_size_y = 16) in;
+layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
+layout(set = 0, binding = 2, std140) uniform Vpls { Vpl vpls[ISM_VPL_SLOTS]; };
+layout(set = 0, binding = 3) uniform sampler2D gDepth;
+layout(set = 0, binding = 4) uniform sampler2D gNormal;
+#include "ism_lookup.glsl"
+layout(set = 0, binding = 6, rgba32ui) uniform writeonly uimage2D outRaw;
+
+vec2 signNotZero(vec2 v) { return vec2(v.x >= 0.0 ? 1.0 : -1.0, v.y >= 0.0 ? 1.0 : -1.0); }
+uint packNormal(vec3 n) {
+  n /= max(abs(n.x) + abs(n.y) + abs(n.z), 1e-30);
+  vec2 e = n.z >= 0.0 ? n.xy : (1.0 - abs(n.yx)) * signNotZero(n.xy);
+  return packSnorm2x16(e);
+}
+
+void main() {
+  uint phase = gl_WorkGroupID.z;
+  ivec2 p = ivec2(gl_GlobalInvocationID.xy) * K + ivec2(int(phase) % K, int(phase) / K);
+  ivec2 size = ivec2(frame.viewport.xy);
+  if (p.x >= size.x || p.y >= size.y) return;
+  float depth = texelFetch(gDepth, p, 0).r;
+  if (isSky(depth)) {
+    imageStore(outRaw, p, uvec4(0u));
+    return;
+  }
+  vec2 uv = (vec2(p) + 0.5) * frame.viewport.zw;
+  vec3 viewPos = viewPositionFromDepth(frame.invProj, uv, depth);
+  vec3 viewN = safeNormalize(texelFetch(gNormal, p, 0).xyz, vec3(0.0, 0.0, 1.0));
+  vec3 x = (frame.invView * vec4(viewPos, 1.0)).xyz;
+  vec3 n = safeNormalize(mat3(frame.invView) * viewN, vec3(0.0, 1.0, 0.0));
+  vec3 e = vec3(0.0);
+  for (int j = 0; j < PER_PIXEL; ++j) {
+    uint i = phase + uint(j * K * K);
+    e += vplIrradiance(vpls[i], min(i, uint(ism.blur.w) - 1u), x, n);
+  }
+  e = min(e * (ism.gather.z * ism.gather.w), vec3(65000.0));  // guard: half floats
+  imageStore(outRaw, p, uvec4(packHalf2x16(e.rg), packHalf2x16(vec2(e.b, 0.0)),
+                              floatBitsToUint(length(viewPos)), packNormal(viewN)));
+}

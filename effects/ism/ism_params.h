@@ -1,0 +1,97 @@
+// Instant radiosity with imperfect shadow maps (Ritschel et al. 2008, seed 002): the parameter
+// block the shaders read (mirror of IsmParams in ism_common.glsl), the limits of the settings,
+// and CPU mirrors of the formulas the tests check (paraboloid mapping, the VPL singularity
+// guard, the pull-push rules).
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+#include <glm/glm.hpp>
+
+namespace gi::ism {
+
+inline constexpr int kMaxVpls = 1024;  // the VPL table is a uniform buffer (64 KiB)
+inline constexpr int kMaxBlock = 8;    // interleaving block k (k x k VPL subsets)
+inline constexpr int kVplSlots = kMaxVpls + kMaxBlock * kMaxBlock;  // padded to whole blocks
+inline constexpr int kMaxIsmResolution = 512;
+inline constexpr int kMaxPullPushLevels = 6;
+inline constexpr int kMaxBounces = 3;
+// Surface points shaded per extra bounce as candidates for its VPLs (ism_bounce.glsl).
+inline constexpr uint32_t kShadePoints = 2048;
+inline constexpr int kMaxSplatRadius = 2;
+inline constexpr uint32_t kMaxPoints = 1u << 21;  // surface points asked of the engine
+inline constexpr uint32_t kEmpty = 0xffffffffu;   // an ISM texel no point reached
+// VPL singularity guard: 1 / d^2 becomes 1 / max(d^2, d_min^2) with d_min = kDistanceClamp
+// x the scene's extent (the `distance_clamp` setting overrides the fraction). Without it a
+// receiver next to a VPL gets unbounded irradiance (and 0/0 at d = 0).
+inline constexpr float kDistanceClamp = 0.02f;
+
+// std140 mirror of IsmParams (ism_common.glsl); vec4 members only.
+struct Uniforms {
+  glm::vec4 rsm;     // width, height, vpl count, padded count (whole k x k blocks)
+  glm::vec4 atlas;   // tile resolution, tiles per row, points per ISM, surface point count
+  glm::vec4 bias;    // constant (world), slope (per unit distance), near, far (classic SMs)
+  glm::vec4 pull;    // pull threshold, push threshold (world, level 0), levels, scene extent
+  glm::vec4 gather;  // d_min^2, block k, k^2 (VPL subset weight), strength
+  glm::vec4 blur;    // plane tolerance (relative depth), min normal cosine, splat scale, seed
+};
+static_assert(sizeof(Uniforms) == 6 * sizeof(glm::vec4));
+
+// The paraboloid basis of a VPL with normal n, the same as SceneView::paraboloid's view matrix
+// (lookAlong: up +y, or +z when n is nearly vertical), so ISMs and classic maps share texels.
+struct Basis {
+  glm::vec3 s, u, f;
+};
+inline Basis basis(const glm::vec3& n) {
+  const glm::vec3 up = std::abs(n.y) > 0.99f ? glm::vec3(0, 0, 1) : glm::vec3(0, 1, 0);
+  const glm::vec3 s = glm::normalize(glm::cross(n, up));
+  return {s, glm::cross(s, n), n};
+}
+// Disk coordinates in [-1, 1]^2 of direction `dir` (unit) in the hemisphere around b.f;
+// false behind it (cosine <= 0).
+inline bool paraboloid(const Basis& b, const glm::vec3& dir, glm::vec2& p) {
+  const float c = glm::dot(dir, b.f);
+  if (!(c > 0.0f)) return false;
+  p = glm::vec2(glm::dot(dir, b.s), glm::dot(dir, b.u)) / (1.0f + c);
+  return true;
+}
+
+// Irradiance at a receiver (position x, normal n) from a VPL (position xv, normal nv, flux phi)
+// without visibility: phi / pi cos(theta_v) cos(theta_r) / max(d^2, dMin^2). Zero behind either
+// surface and for d = 0 (no direction); finite for every finite input.
+inline glm::vec3 vplIrradiance(const glm::vec3& x, const glm::vec3& n, const glm::vec3& xv,
+                               const glm::vec3& nv, const glm::vec3& phi, float dMin) {
+  const glm::vec3 w = x - xv;
+  const float d2 = glm::dot(w, w);
+  if (!(d2 > 1e-20f)) return glm::vec3(0.0f);
+  const glm::vec3 dir = w / std::sqrt(d2);
+  const float cv = std::max(glm::dot(nv, dir), 0.0f), cr = std::max(-glm::dot(n, dir), 0.0f);
+  return phi * (cv * cr / (3.14159265f * std::max(d2, dMin * dMin)));
+}
+
+// Pull-push over one 2x2 block (seed 002 §3.2, after Marroquim et al. 2007). Depths are
+// distances; kEmpty marks a hole. Pull: the mean of the valid children within `threshold` of
+// the nearest one (points from a hidden surface behind are not mixed in). Push: a texel takes
+// the coarse value when it is a hole or lies more than `threshold` behind it (an outlier).
+inline float pullDepth(const float child[4], float threshold) {
+  float nearest = std::numeric_limits<float>::infinity();
+  for (int i = 0; i < 4; ++i) nearest = std::min(nearest, child[i]);
+  if (!std::isfinite(nearest)) return std::numeric_limits<float>::infinity();
+  float sum = 0.0f;
+  int count = 0;
+  for (int i = 0; i < 4; ++i)
+    if (child[i] <= nearest + threshold) {
+      sum += child[i];
+      ++count;
+    }
+  return sum / float(count);
+}
+inline float pushDepth(float fine, float coarse, float threshold) {
+  if (!std::isfinite(coarse)) return fine;
+  return (!std::isfinite(fine) || fine > coarse + threshold) ? coarse : fine;
+}
+
+}  // namespace gi::ism

@@ -1,0 +1,59 @@
+#version 460
+// Imperfect shadow maps (seed 002 §3.1): workgroup row y = VPL base + y (a uniform index into the VPL
+// table), each invocation one point of the VPL's fixed subset of the point representation
+// (points [y P, y P + P) modulo the count: the engine places them in random order, so each run
+// is a random subset). The point's distance is splatted with imageAtomicMin into the VPL's
+// paraboloid tile as float bits (non-negative floats order like their bits). Splat radius in
+// texels from the point's area and distance (the seed: size from squared distance), at most
+// MAX_SPLAT (a specialization constant).
+#extension GL_GOOGLE_include_directive : require
+#include "common.glsl"
+#include "ism_common.glsl"
+
+layout(constant_id = 0) const int MAX_SPLAT = 1;
+layout(local_size_x = 256) in;
+layout(push_constant) uniform Push { int base; };  // first VPL of this bounce
+layout(set = 0, binding = 2, std140) uniform Vpls { Vpl vpls[ISM_VPL_SLOTS]; };
+layout(set = 0, binding = 3, std430) readonly buffer Points { vec4 points[]; };
+layout(set = 0, binding = 4, r32ui) uniform coherent uimage2D atlas;
+
+void main() {
+  uint v = uint(base) + gl_WorkGroupID.y;
+  uint j = gl_GlobalInvocationID.x;
+  uint perIsm = uint(ism.atlas.z), count = uint(ism.atlas.w);
+  Vpl vpl = vpls[v];
+  if (j >= perIsm || count == 0u || vpl.position.w < 0.5) return;
+  uint idx = (v * perIsm + j) % count;
+  vec4 pa = points[2u * idx];
+  vec3 w = pa.xyz - vpl.position.xyz;
+  float d = length(w);
+  vec3 n = vpl.normal.xyz;
+  if (!(d > 1e-6)) return;
+  vec3 dir = w / d;
+  float c = dot(dir, n);
+  if (!(c > 0.0)) return;  // behind the VPL's hemisphere
+  vec3 s, u;
+  ismBasis(n, s, u);
+  uint tile = v;
+  ivec2 t = ismTexel(tile, dir, s, u, c);
+  uint depth = floatBitsToUint(d);
+  if (MAX_SPLAT == 0) {
+    imageAtomicMin(atlas, t, depth);
+  } else {
+    // Point footprint: solid angle area / d^2 against a texel's, 4 (2 / res)^2 / (1 + r^2)^2
+    // on the disk (r ~ 1 - c for the radius); radius = half the footprint's width.
+    float res = ism.atlas.x;
+    vec2 pd = vec2(dot(dir, s), dot(dir, u)) / (1.0 + c);
+    float r2 = dot(pd, pd);
+    float texelOmega = 16.0 / (res * res) / ((1.0 + r2) * (1.0 + r2));
+    float omega = pa.w / (d * d);
+    int radius = clamp(int(0.5 * sqrt(omega / texelOmega) * ism.blur.z), 0, MAX_SPLAT);
+    int perRow = int(ism.atlas.y);
+    ivec2 lo = ivec2(int(tile) % perRow, int(tile) / perRow) * int(res);
+    ivec2 hi = lo + ivec2(int(res) - 1);
+    for (int y = -MAX_SPLAT; y <= MAX_SPLAT; ++y)
+      for (int x = -MAX_SPLAT; x <= MAX_SPLAT; ++x)
+        if (abs(x) <= radius && abs(y) <= radius)
+          imageAtomicMin(atlas, clamp(t + ivec2(x, y), lo, hi), depth);
+  }
+}
