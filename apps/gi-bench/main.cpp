@@ -568,6 +568,7 @@ std::vector<Measurement> measureAll(
       settings.height = o.height;
       settings.floorPass = floorPass;
       settings.effects = *jobs[i].effects;
+      settings.keepForReadback = {jobs[i].resource, gi::resources::kDepth};  // read when scored
       renderers.push_back(std::make_unique<gi::Renderer>(ctx, *jobs[i].scene, settings, &registry));
       renderers.back()->renderFrame();  // first-use costs stay out of every repetition
     }

@@ -56,6 +56,8 @@ Controller::Controller(gi::vk::Context& ctx, const gi::Scene& scene,
   s.width = options.width;
   s.height = options.height;
   s.view = view_;
+  // What the accuracy check reads from the current frame (accuracy.cpp).
+  s.keepForReadback = {gi::resources::kAO, gi::resources::kLit, gi::resources::kDepth};
   s.effects = configs();
   renderer_.emplace(ctx, scene_, s, &registry_);
 }

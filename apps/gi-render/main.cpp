@@ -230,6 +230,8 @@ int run(const Options& o) {
   settings.height = o.height;
   settings.floorPass = o.timings;
   settings.view = view;
+  // A .pfm of the output view holds the HDR lit image (writeImage).
+  if (view == gi::resources::kOutput) settings.keepForReadback = {gi::resources::kLit};
   settings.isolatePasses = o.isolatePasses;
   settings.effects = effects;
   gi::Renderer renderer(ctx, scene, settings, &registry);

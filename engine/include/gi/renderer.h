@@ -43,6 +43,10 @@ struct RenderSettings {
   uint64_t surfacePointSeed = 1;
   std::string view =
       "output";  // the resource the frame delivers (a G-buffer channel, an effect's view)
+  // Resources readTarget() will read besides `view`: kept intact to the end of the frame (the
+  // frame graph otherwise lets later passes reuse their memory). A name this frame does not
+  // produce is skipped (e.g. "ao" without an AO effect); readTarget() of it fails as always.
+  std::vector<std::string> keepForReadback;
   std::vector<EffectConfig> effects;
 };
 

@@ -440,10 +440,13 @@ void FrameGraph::compile() {
     }
     ++order;
   }
-  for (const auto& [id, version] : outputs_)
+  for (const auto& [id, version] : outputs_) {
     if (!produced.count({id, version}))
       throw Error(ErrorKind::Usage, "",
                   "frame graph: output '" + resources_[id]->name + "' is never written");
+    // Read after execute(): no later transient may share its memory.
+    resources_[id]->lastUse = order;
+  }
   allocateTransients();
   compiled_ = true;
 }
@@ -535,6 +538,16 @@ void FrameGraph::allocateTransients() {
       r.buffer = t.buffer;
     }
   }
+}
+
+bool FrameGraph::intactAtEnd(TextureHandle h) const {
+  const Resource& r = resource(h.id);
+  if (r.external() || r.transient < 0) return true;
+  const Transient& t = *pool_[r.transient];
+  if (t.slot < 0) return true;
+  for (const auto& [first, last] : slots_[t.slot].lifetimes)
+    if (first > r.lastUse) return false;  // a later occupant overwrote it
+  return true;
 }
 
 FrameGraph::TextureState FrameGraph::textureState(TextureHandle h) const {

@@ -446,6 +446,8 @@ struct Renderer::Impl : EffectContext {
     if (!view.valid())
       throw Error(ErrorKind::Usage, "", "view '" + settings.view + "' is a buffer, not an image");
     graph.markOutput(view);
+    for (const std::string& name : settings.keepForReadback)
+      if (bb.has(name) && bb.texture(name).valid()) graph.markOutput(bb.texture(name));
     if (settings.floorPass) graph.markOutput(bb.texture(res::kFloor));
     graph.compile();
     graphDirty = false;
@@ -693,6 +695,12 @@ struct Renderer::Impl : EffectContext {
     TextureHandle h = graph.blackboard().texture(name);
     if (!h.valid())
       throw Error(ErrorKind::Usage, "", "no resource named '" + name + "' in this frame");
+    // Never hand out another resource's texels as this one's.
+    if (!graph.intactAtEnd(h))
+      throw Error(ErrorKind::Usage, "",
+                  "'" + name +
+                      "' cannot be read back: a later pass reused its memory (frame-graph "
+                      "aliasing); list it in RenderSettings::keepForReadback");
     return graph.textureState(h);
   }
 };

@@ -159,9 +159,14 @@ class FrameGraph {
                               VkImageLayout finalLayout = VK_IMAGE_LAYOUT_UNDEFINED);
   BufferHandle importBuffer(const std::string& name, VkBuffer buffer, VkDeviceSize size);
 
-  // Marks a resource version as a result of the frame: culling walks back from these.
+  // Marks a resource version as a result of the frame: culling walks back from these, and
+  // its memory is not reused by later passes (it can be read after execute()).
   void markOutput(TextureHandle h);
   void markOutput(BufferHandle h);
+  // After compile(): false when a later pass's transient shares this texture's memory
+  // (aliasing), so after execute() it no longer holds its own contents. Outputs, imported and
+  // persistent textures are always intact.
+  bool intactAtEnd(TextureHandle h) const;
 
   Blackboard& blackboard() { return blackboard_; }
   VkExtent2D outputExtent() const { return outputExtent_; }
