@@ -9,11 +9,15 @@
 
 #include "gi/engine_settings.h"
 #include "gi/errors.h"
+#include "gi/input_file.h"
 
 namespace gi {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
+
+// A preset is a few hundred bytes; anything near this is not one.
+constexpr uint64_t kMaxPresetBytes = 64ull << 20;
 
 std::vector<std::string> presetLocations() {
   std::vector<std::string> dirs;
@@ -55,20 +59,17 @@ void onlyKeys(const json& j, const std::set<std::string>& allowed, const std::st
 }  // namespace
 
 Preset loadPreset(const std::string& nameOrPath) {
+  const std::string path = findPreset(nameOrPath);
+  // Regular files only, size-limited: a directory or a FIFO is refused, not read.
+  return parsePreset(readInputFile(path, "preset file", kMaxPresetBytes), path);
+}
+
+Preset parsePreset(std::string_view text, const std::string& path) {
   Preset p;
-  p.path = findPreset(nameOrPath);
-  std::ifstream in(p.path);
-  if (!in) throw Error(ErrorKind::FileNotFound, p.path, "cannot open preset");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  if (ss.str().find_first_not_of(" \t\r\n") == std::string::npos)
+  p.path = path;
+  if (text.find_first_not_of(" \t\r\n") == std::string::npos)
     throw Error(ErrorKind::EmptyFile, p.path, "preset file is empty");
-  json j;
-  try {
-    j = json::parse(ss.str());
-  } catch (const json::parse_error& e) {
-    throw Error(ErrorKind::Parse, p.path, std::string("invalid JSON: ") + e.what());
-  }
+  const json j = parseJsonText(text, p.path);
   if (!j.is_object()) throw Error(ErrorKind::Schema, p.path, "a preset must be a JSON object");
   onlyKeys(j, {"name", "description", "platform", "target_ms", "reference_resolution", "effects"},
            "", p.path);

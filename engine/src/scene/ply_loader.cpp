@@ -18,6 +18,7 @@
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
 
 #include "gi/errors.h"
+#include "gi/input_file.h"
 #include "scene_io_util.h"
 
 namespace gi::detail {
@@ -207,7 +208,7 @@ class CheckingImporter : public OpenMesh::IO::ImporterT<OmMesh> {
       if (vh.idx() < 0 || static_cast<size_t>(vh.idx()) >= vertices) {
         if (badFace < 0) {
           badFace = static_cast<long long>(facesSeen) - 1;
-          badIndex = static_cast<unsigned>(vh.idx());
+          badIndex = vh.idx();
         }
         return OpenMesh::FaceHandle();
       }
@@ -221,18 +222,15 @@ class CheckingImporter : public OpenMesh::IO::ImporterT<OmMesh> {
 
   size_t vertices = 0, facesSeen = 0, shortFaces = 0;
   long long badFace = -1;
-  unsigned badIndex = 0;
+  long long badIndex = 0;
   std::vector<uint32_t> indices;
 };
 
 }  // namespace
 
 MeshFileData readPly(const std::string& path) {
-  std::error_code ec;
-  if (!fs::exists(path, ec)) throw Error(ErrorKind::FileNotFound, path, "file does not exist");
-  if (fs::is_directory(path, ec))
-    throw Error(ErrorKind::FileNotFound, path, "is a directory, not a file");
-  if (fs::file_size(path, ec) == 0 || ec) throw Error(ErrorKind::EmptyFile, path, "file is empty");
+  // Regular files only (OpenMesh would read a FIFO or /dev/zero forever), size-limited.
+  if (checkInputFile(path) == 0) throw Error(ErrorKind::EmptyFile, path, "file is empty");
   const PlyHeader header = readHeader(path);
   if (header.ascii)
     checkAsciiBody(path, header);
