@@ -720,6 +720,36 @@ TEST(SceneInputs, PlyNegativeIndexIsReportedAsWritten) {
               "face 0 uses vertex index -1 but there are only 3 vertices");
 }
 
+// Found by tools/fuzz: OpenMesh's header reader loops forever on a format line with extra
+// words; every header line must now hold exactly its tokens.
+TEST(SceneInputs, PlyHeaderLinesHoldExactlyTheirTokens) {
+  TempDir dir;
+  const std::string body =
+      "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+      "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  EXPECT_EQ(gi::loadScene(dir.write("ok.ply", "ply\nformat ascii 1.0\n" + body)).triangleCount(),
+            1u);
+  expectError(
+      [&] { gi::loadScene(dir.write("loop.ply", "ply\nformat ascii format ascii 1.0\n" + body)); },
+      gi::ErrorKind::Parse, "loop.ply", "line 2: format version must be 1.0, got 'format'");
+  expectError([&] { gi::loadScene(dir.write("extra.ply", "ply\nformat ascii 1.0 x\n" + body)); },
+              gi::ErrorKind::Parse, "extra.ply", "line 2: format line: unexpected 'x'");
+  expectError(
+      [&] {
+        gi::loadScene(dir.write("twice.ply", "ply\nformat ascii 1.0\nformat ascii 1.0\n" + body));
+      },
+      gi::ErrorKind::Parse, "twice.ply", "line 3: format line repeated");
+  expectError(
+      [&] {
+        gi::loadScene(dir.write("prop.ply",
+                                "ply\nformat ascii 1.0\nelement vertex 3\n"
+                                "property float x junk\n" +
+                                    body.substr(17)));
+      },
+      gi::ErrorKind::Parse, "prop.ply", "line 4: property line: unexpected 'junk'");
+}
+
 TEST(SceneInputs, ZeroSizeSceneIsAnErrorAndExtremeSizesWarn) {
   TempDir dir;
   // A hand-written glTF: one triangle under a node scaled by `s`.
