@@ -7,11 +7,13 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
 
 #include "bench_support.h"
+#include "gi/effect_registry.h"
 #include "gi/image_io.h"
 #include "process.h"
 #include "test_support.h"
@@ -148,6 +150,14 @@ TEST(BenchCli, DeclaredQuantityFollowsTheSweptRadius) {
   EXPECT_EQ(j["results"][1]["declared"].get<std::string>().rfind("obscurance linear r=0.6", 0), 0u);
   EXPECT_EQ(j["results"][1]["reference"].get<std::string>().rfind("ao r=0.6", 0), 0u);
   EXPECT_NE(j["results"][0]["declared_nrmse"], j["results"][1]["declared_nrmse"]);
+  // Obscurance is not AO: the error against AO is split into that gap and the estimator's.
+  for (const auto& row : j["results"]) {
+    ASSERT_TRUE(row.contains("quantity_gap")) << row.dump();
+    EXPECT_GT(row["quantity_gap"]["gap_nrmse"].get<double>(), 0.0);
+    EXPECT_TRUE(std::isfinite(row["quantity_gap"]["gap_share"].get<double>()));
+  }
+  EXPECT_NE(readAll(out + "/report.md").find("## The declared quantity against the target"),
+            std::string::npos);
   size_t entries = 0;
   for (const auto& e : fs::directory_iterator(cache)) entries += e.path().extension() == ".json";
   EXPECT_EQ(entries, 4u) << "AO and obscurance(linear) at two radii";
@@ -192,6 +202,28 @@ TEST(BenchCli, PresetsFormAPlatformProfileTable) {
       << "the low preset's gtao settings (assets/presets/low.json)\n"
       << report;
   EXPECT_NE(report.find("| gtao | NRMSE vs declared |", table), std::string::npos);
+}
+
+// 'all': every registered effect, each alone; with a preset, only the effects it configures
+// (its platform-profile column); 'none' keeps all of them.
+TEST(BenchCli, AllMeansEveryEffectEachPresetConfigures) {
+  const std::string dir = test::makeTempDir("bench-all");
+  { std::ofstream(dir + "/gtao_only.json") << R"({"effects": {"gtao": {"slices": 1}}})"; }
+  EffectRegistry registry;
+  registry.scanDefaultLocations();
+  if (!registry.has("gtao")) GTEST_SKIP() << "the gtao plugin is not built";
+  auto r = test::runCommand("GI_PRESET_PATH='" + dir + "' " +
+                            bench("--quick --reps 1 --effects all --presets gtao_only,none "
+                                  "--cache '" +
+                                  dir + "/cache' --out '" + dir + "/out'"));
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  const nlohmann::json rows = nlohmann::json::parse(readAll(dir + "/out/results.json"))["results"];
+  std::set<std::string> withPreset, withNone;
+  for (const auto& row : rows)
+    (row["preset"] == "gtao_only" ? withPreset : withNone).insert(row["effect"]);
+  EXPECT_EQ(withPreset, std::set<std::string>{"gtao"});
+  const std::vector<std::string> names = registry.names();
+  EXPECT_EQ(withNone, std::set<std::string>(names.begin(), names.end()));
 }
 
 TEST(BenchCli, BadInputFailsBeforeRendering) {
@@ -246,15 +278,29 @@ TEST(BenchCli, CalibratedPresetLoadsAndFitsTheBudget) {
   const std::string dir = test::makeTempDir("bench-calibrate");
   const std::string preset = dir + "/calibrated.json";
   const double budget = 400.0;
+  const bool alchemy = fs::exists(test::binPath("plugins/gi_effect_alchemy.so"));
   auto r = test::runCommand(bench("--calibrate --budget-ms " + std::to_string(budget) +
-                                  " --width 64 --height 48 --frames 3 --ref-spp 16 --effects ssao "
-                                  "--cache '" +
-                                  dir + "/cache' --out '" + preset + "'"));
+                                  " --width 64 --height 48 --frames 3 --ref-spp 16 --effects " +
+                                  (alchemy ? "ssao,alchemy" : "ssao") + " --cache '" + dir +
+                                  "/cache' --out '" + preset + "'"));
   ASSERT_EQ(r.exitCode, 0) << r.output;
   const nlohmann::json j = nlohmann::json::parse(readAll(preset));
   ASSERT_TRUE(j["effects"]["ssao"]["samples"].is_number_integer()) << j.dump();
   EXPECT_EQ(j["target_ms"].get<double>(), budget);
   EXPECT_EQ(j["reference_resolution"], nlohmann::json({64, 48}));
+  // The search is in the file: each effect calibrated alone, every power of two of its sample
+  // counts (ssao: 1..64, alchemy: 1..64) with time, interval and scores, and the choice.
+  const nlohmann::json& items = j["calibration"]["items"];
+  ASSERT_EQ(items.size(), alchemy ? 2u : 1u) << j.dump(2);
+  for (const auto& item : items) {
+    EXPECT_EQ(item["candidates"].size(), 7u) << item.dump(2);
+    const std::string e = item["effects"];
+    EXPECT_EQ(item["chosen"],
+              e + ".samples=" + std::to_string(j["effects"][e]["samples"].get<int>()));
+    EXPECT_GE(item["margin_ms"].get<double>(), 0.0);
+    for (const auto& c : item["candidates"])
+      EXPECT_LE(c["interval_ms"][0].get<double>(), c["median_ms"].get<double>()) << c.dump();
+  }
 
   // gi-render loads it; the chosen configuration's measured frame time is within the budget.
   auto g = test::runCommand(

@@ -99,6 +99,27 @@ TEST(BenchMetrics, DegenerateInputsAreFinite) {
   EXPECT_EQ(m.ssim, 1.0);
 }
 
+// e = S - T splits into the declared quantity's gap D - T and the estimator's S - D.
+TEST(BenchMetrics, QuantityGapSplitsTheErrorAgainstTheTarget) {
+  const Plane target{2, 1, {0.5f, 0.5f}}, declared{2, 1, {0.7f, 0.7f}};
+  // S = D: all of the error is the gap; gap NRMSE = 0.2 / 0.5.
+  QuantityGap g = quantityGap(declared, target, declared, {});
+  EXPECT_NEAR(g.gapNrmse, 0.4, 1e-6);
+  EXPECT_NEAR(g.gapShare, 1.0, 1e-6);
+  // S = 0.8: e = 0.3 of which the gap 0.2 -> share 0.2 * 0.3 / 0.09 = 2/3.
+  g = quantityGap(Plane{2, 1, {0.8f, 0.8f}}, target, declared, {});
+  EXPECT_NEAR(g.gapShare, 2.0 / 3.0, 1e-6);
+  // An estimator below the target cancels the gap: the gap's share is negative.
+  g = quantityGap(Plane{2, 1, {0.4f, 0.4f}}, target, declared, {});
+  EXPECT_NEAR(g.gapShare, 0.2 * -0.1 / 0.01, 1e-5);
+  // S = T: no error to split (share 0, not NaN); the mask drops every pixel: all 0.
+  g = quantityGap(target, target, declared, {});
+  EXPECT_EQ(g.gapShare, 0.0);
+  g = quantityGap(declared, target, declared, {0, 0});
+  EXPECT_EQ(g.gapNrmse, 0.0);
+  EXPECT_EQ(g.gapShare, 0.0);
+}
+
 TEST(BenchMetrics, ChannelAndLuminance) {
   const std::vector<float> rgba = {1, 0, 0, 1, 0, 1, 0, 1, 0, 0, 1, 1, 1, 1, 1, 1};
   const Plane r = channel(2, 2, rgba, 0), l = channel(2, 2, rgba, -1);

@@ -23,7 +23,7 @@ using test::VulkanTest;
 
 // What the probe draws and how.
 struct ProbeConfig {
-  enum class Mode { CameraDepth, CameraGBuffer, Rsm, Paraboloid, Cube } mode;
+  enum class Mode { CameraDepth, CameraGBuffer, Rsm, Paraboloid, Cube, Peel } mode;
   float scale = 1.0f;  // extent of the probe's targets relative to the output
   uint32_t size = 0;   // absolute square size (Rsm, Paraboloid, Cube face) when non-zero
   std::function<SceneView(EffectContext&)> view;  // Rsm/Paraboloid/Cube: the view(s) to draw
@@ -78,12 +78,13 @@ class Probe : public Effect {
             handles->push_back(
                 b.write(b.create(names[1 + i], desc(formats[i])), TextureUsage::ColorAttachment));
         },
-        [this, handles, &scene, &ctx](PassContext& pc) {
+        [this, handles, &scene, &ctx, colorCount = formats.size()](PassContext& pc) {
           SceneTargets t;
           t.depth = pc.view((*handles)[0]);
-          for (size_t i = 1; i < handles->size(); ++i) t.colors.push_back(pc.view((*handles)[i]));
+          for (size_t i = 1; i <= colorCount; ++i) t.colors.push_back(pc.view((*handles)[i]));
           t.extent = pc.extent((*handles)[0]);
           switch (c_.mode) {
+            case ProbeConfig::Mode::Peel:  // layer 0: the plain depth
             case ProbeConfig::Mode::CameraDepth: {
               const SceneView v = SceneView::fromCamera(ctx.camera());
               scene.drawDepth(pc, t, {&v, 1});
@@ -110,6 +111,21 @@ class Probe : public Effect {
             }
           }
         });
+    if (c_.mode == ProbeConfig::Mode::Peel)
+      // Layer 1: the nearest surfaces strictly behind layer 0 (depth peeling).
+      graph.addPass(
+          "probe_peel",
+          [&](PassBuilder& b) {
+            scene.declareRead(b);
+            (*handles)[0] = b.read((*handles)[0]);
+            handles->push_back(b.write(b.create(names[1], desc(kSceneDepthFormat)),
+                                       TextureUsage::DepthAttachment));
+          },
+          [handles, &scene, &ctx](PassContext& pc) {
+            const SceneView v = SceneView::fromCamera(ctx.camera());
+            const SceneTargets t{pc.view((*handles)[1]), {}, pc.extent((*handles)[1])};
+            scene.drawDepthPeeled(pc, t, {&v, 1}, pc.view((*handles)[0]));
+          });
     for (size_t i = 0; i < names.size(); ++i) graph.blackboard().put(names[i], (*handles)[i]);
   }
 
@@ -121,6 +137,8 @@ class Probe : public Effect {
                 "probe_material", "probe_emission", "probe_motion"};
       case ProbeConfig::Mode::Rsm:
         return {"probe_depth", "probe_position", "probe_rsm_normal", "probe_flux"};
+      case ProbeConfig::Mode::Peel:
+        return {"probe_depth", "probe_layer1"};
       default:
         return {"probe_depth"};
     }
@@ -189,6 +207,45 @@ TEST_F(EngineServicesTest, ExtraViewDepthAndGBufferEqualTheMainGBufferWhereViews
       EXPECT_LE(worstN, 1e-3) << "normals of the extra view differ from the main G-buffer's";
     }
   }
+}
+
+// Depth peeling (GpuScene::drawDepthPeeled): a unit box seen along its axis from distance 3
+// has its front face at view distance 2.5 in layer 0 and its back face at 3.5 in layer 1; every
+// layer-1 texel lies strictly behind layer 0, and where layer 0 is empty so is layer 1.
+TEST_F(EngineServicesTest, PeeledLayerIsTheNearestSurfaceBehindTheFirst) {
+  const Scene scene = sceneFromJson(R"({
+      "models": [ { "primitive": "box", "size": 1 } ],
+      "camera": { "position": [0, 0, 3], "target": [0, 0, 0] } })");
+  EffectRegistry reg;
+  auto r = render(ctx(), scene, reg, {ProbeConfig::Mode::Peel});
+  const ImageRGBA32F l0 = r->readTarget("probe_depth");
+  r->setView("probe_layer1");
+  r->renderFrame();
+  const ImageRGBA32F l1 = r->readTarget("probe_layer1");
+  ASSERT_EQ(l0.pixels.size(), l1.pixels.size());
+  size_t both = 0;
+  for (size_t i = 0; i < l0.pixels.size(); i += 4) {
+    if (l0.pixels[i] <= 0.0f) {
+      ASSERT_EQ(l1.pixels[i], 0.0f) << "texel " << i / 4;
+    }
+    if (l1.pixels[i] > 0.0f) {
+      ASSERT_LT(l1.pixels[i], l0.pixels[i]) << "texel " << i / 4;
+      ++both;
+    }
+  }
+  EXPECT_GT(both, l0.pixels.size() / 4 / 20);
+  // View distance at the image centre from each layer's reverse-Z depth.
+  const CameraView cam = r->camera();
+  const glm::mat4 invProj = glm::inverse(cam.proj);
+  auto distanceAt = [&](const ImageRGBA32F& img) {
+    const int x = img.width / 2, y = img.height / 2;
+    const float d = img.pixels[(size_t(y) * img.width + x) * 4];
+    const glm::vec4 v = invProj * glm::vec4((x + 0.5f) / img.width * 2 - 1,
+                                            (y + 0.5f) / img.height * 2 - 1, d, 1.0f);
+    return -v.z / v.w;
+  };
+  EXPECT_NEAR(distanceAt(l0), 2.5f, 1e-3f);
+  EXPECT_NEAR(distanceAt(l1), 3.5f, 1e-3f);
 }
 
 TEST_F(EngineServicesTest, QuarterResolutionExtraView) {

@@ -176,6 +176,24 @@ TEST(Registry, GiRenderListsPluginsFromGiPluginPath) {
   fs::remove_all(dir);
 }
 
+TEST(Registry, DescribesEachDeclaredQuantityWithTheParametersItUses) {
+  using K = EstimatedQuantity::Kind;
+  EstimatedQuantity q;
+  q.radius = 0.25;
+  q.membership = "smoothstep";
+  q.kind = K::AmbientOcclusion;
+  EXPECT_EQ(describe(q), "ao(r=0.25)");  // no membership: AO has none
+  q.kind = K::Obscurance;
+  EXPECT_EQ(describe(q), "obscurance(r=0.25, membership=smoothstep)");
+  q.kind = K::Alchemy;
+  q.epsilon = 1e-8;
+  EXPECT_EQ(describe(q), "alchemy(r=0.25, sigma=1, u=0, epsilon=1e-08, contrast=1)");
+  q.kind = K::DirectIndirect;
+  EXPECT_EQ(describe(q), "direct+indirect light");
+  q.kind = K::DirectLight;
+  EXPECT_EQ(describe(q), "direct light");
+}
+
 TEST(Registry, GiRenderListsTheInTreeSsaoPlugin) {
   const std::string ssao = std::string(GI_BIN_DIR) + "/plugins/gi_effect_ssao.so";
   if (!fs::exists(ssao)) GTEST_SKIP() << "no ssao module built (" << ssao << ")";
@@ -187,6 +205,10 @@ TEST(Registry, GiRenderListsTheInTreeSsaoPlugin) {
               contains(r.output, "  module: " + ssao))
       << r.output;
   EXPECT_TRUE(contains(r.output, "  ssao.")) << "ssao's settings are listed\n" << r.output;
+  // Its exact quantity with the parameters of its defaults (radius 0.5, linear falloff).
+  EXPECT_TRUE(
+      contains(r.output, "  declares at its defaults: obscurance(r=0.5, membership=linear)"))
+      << r.output;
   EXPECT_FALSE(contains(r.output, "refused:")) << r.output;
 }
 

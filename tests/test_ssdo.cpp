@@ -330,8 +330,11 @@ TEST_F(SsdoTest, NoNaNAtGrazingAnglesExtremeClipPlanesAndSky) {
                         Case{{2.5f, 1.6f, 0}, {0, 0, 0}, 1e-4f, 1e5f},
                         Case{{2.5f, 0.3f, 0}, {0, 3, 0}, 1e-4f, 1e5f}}) {
     const Scene s = test::quadScene(cornerQuads(), k.eye, k.target, 1.0f, k.znear, k.zfar);
-    for (const char* bounce : {"ssdo.bounce=true", "ssdo.bounce=false"}) {
-      const Result r = render(s, {bounce, "ssdo.distance_clamp=1e-6"});
+    // The last: depth peeling and additional cameras on the same hard cases.
+    for (const char* bounce : {"ssdo.bounce=true", "ssdo.bounce=false", "ssdo.layers=2"}) {
+      std::vector<std::string> sets = {bounce, "ssdo.distance_clamp=1e-6"};
+      if (std::string(bounce) == "ssdo.layers=2") sets.push_back("ssdo.cameras=2");
+      const Result r = render(s, sets);
       EXPECT_TRUE(finite(r.ambient)) << bounce << " near " << k.znear;
       EXPECT_TRUE(finite(r.indirect)) << bounce << " near " << k.znear;
       EXPECT_TRUE(finite(r.lit)) << bounce << " near " << k.znear;
@@ -384,6 +387,134 @@ TEST_F(SsdoTest, SenderShadowsOnlyRemoveBounceLight) {
   }
   std::printf("indirect gained without sender shadows: %.3f (sum over components)\n", gained);
   EXPECT_GT(gained, 1.0) << "the room's shadowed senders must matter";
+}
+
+// Seed 000 Fig. 5: a thin wall floating in front of the floor (seen from the camera). Floor
+// points behind it, more than R from the wall, are truly open (nothing within R but the floor),
+// but with one depth layer the samples above them that project onto the wall are behind it and
+// within R: wrongly blocked. With two layers (the wall's back face peeled) they lie behind the
+// solid interval and are open: ambient = albedo x L as on an open plane (1%, as above).
+TEST_F(SsdoTest, DepthPeelingLightsTheFloorBehindAThinWall) {
+  const Scene s = jsonScene("slab", R"({
+      "models": [
+        { "primitive": "plane", "size": 40, "material": { "base_color": [0.5, 0.5, 0.5] } },
+        { "primitive": "box", "size": [3, 2, 0.04], "translation": [0, 1.3, 0.5],
+          "material": { "base_color": [0.5, 0.5, 0.5] } } ],
+      "lights": [ { "type": "directional", "intensity": 0, "casts_shadows": false } ],
+      "camera": { "position": [0, 0.6, 4], "target": [0, 0.2, 0] },
+      "environment": { "type": "constant", "color": [1, 1, 1] } })");
+  const Result one = render(s, {"ssdo.radius=1", "ssdo.bounce=false", "ssdo.layers=1"});
+  const Result two = render(s, {"ssdo.radius=1", "ssdo.bounce=false", "ssdo.layers=2"});
+  // Floor seen under the wall, 1.2 .. 1.4 behind it: its nearest point is > 1.22 = R away.
+  auto behind = [](glm::vec3 p) {
+    return std::abs(p.y) < 1e-3f && std::abs(p.x) < 0.5f && p.z > -0.9f && p.z < -0.7f;
+  };
+  int n1 = 0, n2 = 0;
+  const glm::dvec3 a1 = mean(one, one.ambient, behind, &n1),
+                   a2 = mean(two, two.ambient, behind, &n2);
+  ASSERT_GT(n1, 20);
+  ASSERT_EQ(n1, n2);
+  std::printf("floor behind the wall: one layer %.4f, two layers %.4f (open 0.5)\n", a1.r, a2.r);
+  EXPECT_LT(a1.r, 0.44) << "one layer: samples behind the wall count as blocked";
+  // The pixel that one layer shadows most is open with two.
+  float worst = 1.0f;
+  int wx = -1, wy = -1;
+  for (int y = 0; y < one.h; ++y)
+    for (int x = 0; x < one.w; ++x)
+      if (!one.sky(x, y) && behind(one.worldAt(x, y)) && one.px(one.ambient, x, y).r < worst) {
+        worst = one.px(one.ambient, x, y).r;
+        wx = x;
+        wy = y;
+      }
+  ASSERT_GE(wx, 0);
+  std::printf("pixel %d,%d: one layer %.4f, two layers %.4f\n", wx, wy, worst,
+              two.px(two.ambient, wx, wy).r);
+  EXPECT_LT(worst, 0.44f);  // measured 0.426
+  EXPECT_NEAR(two.px(two.ambient, wx, wy).r, 0.5f, 0.005f);
+  for (int y = 0; y < two.h; ++y)
+    for (int x = 0; x < two.w; ++x) {
+      if (two.sky(x, y) || !behind(two.worldAt(x, y))) continue;
+      ASSERT_NEAR(two.px(two.ambient, x, y).r, 0.5f, 0.005f) << x << "," << y;
+    }
+  EXPECT_TRUE(finite(two.ambient));
+  EXPECT_TRUE(finite(two.lit));
+}
+
+// Seed 000 §4, additional cameras: a box just left of the main view shadows the floor at the
+// image's left edge only when the first additional camera (displaced to the right, aimed at the
+// centre of interest: it sees past the left edge) sees it; the main view's samples there leave
+// the image: open. The floor far from it keeps its value (the extra view
+// adds no self-occlusion), and the bounce stays finite.
+TEST_F(SsdoTest, AdditionalCameraSeesAnOccluderOutsideTheView) {
+  const Scene s = jsonScene("offscreen", R"({
+      "models": [
+        { "primitive": "plane", "size": 8, "material": { "base_color": [0.5, 0.5, 0.5] } },
+        { "primitive": "box", "size": [1, 3, 1], "translation": [-3.2, 1.5, 0],
+          "material": { "base_color": [0.5, 0.5, 0.5] } } ],
+      "lights": [ { "type": "directional", "intensity": 0, "casts_shadows": false } ],
+      "camera": { "position": [0, 3, 3], "target": [0, 0, 0] },
+      "environment": { "type": "constant", "color": [1, 1, 1] } })");
+  const Result main = render(s, {"ssdo.radius=1", "ssdo.cameras=0"});
+  const Result extra = render(s, {"ssdo.radius=1", "ssdo.cameras=1"});
+  for (int y = 0; y < main.h; ++y)
+    for (int x = 0; x < main.w; ++x) {
+      ASSERT_TRUE(main.sky(x, y) || std::abs(main.worldAt(x, y).y) < 1e-3f)
+          << "the box must be off-screen: " << x << "," << y << " " << main.worldAt(x, y).x << " "
+          << main.worldAt(x, y).y << " " << main.worldAt(x, y).z;
+    }
+  auto nearBox = [](glm::vec3 p) {
+    return std::abs(p.y) < 1e-3f && p.x < -1.9f && std::abs(p.z) < 0.4f;
+  };
+  auto far = [](glm::vec3 p) {
+    return std::abs(p.y) < 1e-3f && p.x > -0.5f && p.x < 1.0f && std::abs(p.z) < 1.0f;
+  };
+  int n = 0;
+  const glm::dvec3 m = mean(main, main.ambient, nearBox, &n),
+                   e = mean(extra, extra.ambient, nearBox);
+  const glm::dvec3 mFar = mean(main, main.ambient, far), eFar = mean(extra, extra.ambient, far);
+  std::printf(
+      "floor next to the off-screen box: main view %.4f, with a camera %.4f; far %.4f %.4f\n", m.r,
+      e.r, mFar.r, eFar.r);
+  ASSERT_GT(n, 20);
+  EXPECT_NEAR(m.r, 0.5, 0.005) << "the main view alone cannot see the box";
+  EXPECT_LT(e.r, 0.485) << "the additional camera's box must shadow the floor";  // 0.480
+  // The floor pixel nearest the box (the image's left edge, 0.4 from it): darkest.
+  float darkest = 1.0f, mainThere = 0.0f;
+  for (int y = 0; y < extra.h; ++y)
+    for (int x = 0; x < extra.w; ++x)
+      if (!extra.sky(x, y) && nearBox(extra.worldAt(x, y)) &&
+          extra.px(extra.ambient, x, y).r < darkest) {
+        darkest = extra.px(extra.ambient, x, y).r;
+        mainThere = main.px(main.ambient, x, y).r;
+      }
+  std::printf("darkest floor pixel: %.4f with the camera, %.4f without\n", darkest, mainThere);
+  EXPECT_LT(darkest, 0.45f);  // measured 0.433
+  EXPECT_NEAR(mainThere, 0.5f, 0.005f);
+  EXPECT_NEAR(eFar.r, mFar.r, 0.01 * mFar.r);
+  EXPECT_TRUE(finite(extra.ambient));
+  EXPECT_TRUE(finite(extra.indirect));
+  EXPECT_TRUE(finite(extra.lit));
+}
+
+TEST_F(SsdoTest, PeelingAndCameraPassesOnlyWhenAsked) {
+  const Scene scene = test::cornerScene();  // no lights: no shadow pass
+  auto passes = [&](const std::vector<std::string>& sets) {
+    Renderer r(ctx(), scene, settingsFor(scene, "ssdo", sets), &registry);
+    r.renderFrame();
+    EXPECT_TRUE(finite(r.readTarget("ambient")));
+    EXPECT_TRUE(finite(r.readTarget("indirect")));
+    return r.passNames();
+  };
+  using V = std::vector<std::string>;
+  EXPECT_EQ(passes({}), (V{"gbuffer", "ssdo_surface", "ssdo", "ssdo_blur", "lighting", "tonemap"}));
+  EXPECT_EQ(passes({"ssdo.layers=2"}), (V{"gbuffer", "ssdo_peel", "ssdo_surface", "ssdo",
+                                          "ssdo_blur", "lighting", "tonemap"}));
+  EXPECT_EQ(passes({"ssdo.cameras=2"}),
+            (V{"gbuffer", "ssdo_cameras", "ssdo_camera_surface", "ssdo_surface", "ssdo",
+               "ssdo_blur", "lighting", "tonemap"}));
+  EXPECT_EQ(passes({"ssdo.layers=2", "ssdo.cameras=4"}),
+            (V{"gbuffer", "ssdo_peel", "ssdo_cameras", "ssdo_camera_surface", "ssdo_surface",
+               "ssdo", "ssdo_blur", "lighting", "tonemap"}));
 }
 
 // The sample table: every pixel phase has its set, the 16 sets together are one stratified

@@ -46,6 +46,10 @@ struct Row {
   std::string declared;            // "obscurance linear r=0.5 spp=256" ...
   double declaredStdError = 0.0;
   double declaredNrmse = 0.0, declaredSsim = 1.0;
+  // When the declared quantity is not the target: metrics.h QuantityGap (the target error a
+  // perfect estimator of the declared quantity would have, and its share of this row's).
+  bool gapPresent = false;
+  double gapNrmse = 0.0, gapShare = 0.0;
   size_t pixels = 0;              // compared (unmasked) pixels
   double referenceSeconds = 0.0;  // wall time the reference took (when it was computed)
   // With --ao-split (AO effects): the effect's error e = S - F (S the effect's AO, F = AO_full)

@@ -55,8 +55,11 @@ const char* kUsage =
     "                [--effects E] --out PRESET.json\n"
     "  --scenes A,B          scenes (JSON, model files or 'default'; default: default)\n"
     "  --effects A,B+C,none  effect sets to sweep, one per comma; '+' runs effects together,\n"
-    "                        'none' is the engine alone (default: ssao when found, else none)\n"
-    "  --presets P,none      quality presets (names or files; 'none': effect defaults)\n"
+    "                        'none' is the engine alone, 'all' every registered effect (each\n"
+    "                        alone; with presets, each with the presets that configure it)\n"
+    "                        (default: ssao when found, else none)\n"
+    "  --presets P,none,all  quality presets (names or files; 'none': effect defaults; 'all':\n"
+    "                        every preset found, e.g. assets/presets/)\n"
     "  --grid E.K=V1,V2      sweep one setting; several --grid flags form a cartesian product\n"
     "  --frames K            frames per repetition, after one warm-up frame (default 5)\n"
     "  --reps R              repetitions per configuration (default 5), interleaved round-\n"
@@ -411,9 +414,14 @@ std::vector<std::string> splitPlus(const std::string& item) {
   return out;
 }
 
-std::string knownEffects(const gi::EffectRegistry& registry) {
+std::string joinList(const std::vector<std::string>& items) {
   std::string s;
-  for (const auto& n : registry.names()) s += (s.empty() ? "" : ", ") + n;
+  for (const auto& n : items) s += (s.empty() ? "" : ", ") + n;
+  return s;
+}
+
+std::string knownEffects(const gi::EffectRegistry& registry) {
+  const std::string s = joinList(registry.names());
   return s.empty() ? "none found" : s;
 }
 
@@ -604,6 +612,25 @@ Scores score(const Measurement& m, const ReferenceSpec& spec, const Reference& r
   return s;
 }
 
+// The part of the error against the target that the declared quantity's own distance from it
+// explains (metrics.h QuantityGap); nullopt when the effect declares its target.
+std::optional<gi::bench::QuantityGap> gapOf(const Measurement& m, const Comparison& cmp,
+                                            const Reference& target, const Reference& declared,
+                                            const Options& o) {
+  if (cmp.declared == cmp.target ||
+      gi::bench::isAoLike(cmp.declared.quantity) != gi::bench::isAoLike(cmp.target.quantity))
+    return std::nullopt;
+  const size_t n = size_t(o.width) * size_t(o.height);
+  std::vector<unsigned char> mask(n);
+  for (size_t i = 0; i < n; ++i)  // as score(): geometry in the target and in the frame
+    mask[i] = target.depth.pixels[i * 4 + 2] > 0.5f && m.depth.pixels[i * 4] > 0.0f;
+  const int w = int(o.width), h = int(o.height),
+            c = gi::bench::isAoLike(cmp.target.quantity) ? 0 : -1;
+  return gi::bench::quantityGap(gi::bench::channel(w, h, m.out.pixels, c),
+                                gi::bench::channel(w, h, target.value.pixels, c),
+                                gi::bench::channel(w, h, declared.value.pixels, c), mask);
+}
+
 std::string formatDouble(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%g", v);
@@ -623,6 +650,7 @@ struct Setup {
   gi::EffectRegistry registry;
   std::vector<LoadedScene> scenes;
   std::vector<std::unique_ptr<gi::Preset>> presets;  // nullptr entries: "none"
+  std::vector<std::string> presetNames;              // as given, 'all' expanded
 };
 
 void loadInputs(const Options& o, Setup& s) {
@@ -634,7 +662,17 @@ void loadInputs(const Options& o, Setup& s) {
       std::fprintf(stderr, "gi-bench: warning: %s\n", w.c_str());
     s.scenes.push_back(std::move(ls));
   }
-  for (const std::string& p : o.presets) {
+  for (const std::string& given : o.presets) {
+    if (given != "all") s.presetNames.push_back(given);
+    if (given == "all") {
+      const std::vector<std::string> all = gi::presetNames();
+      if (all.empty())
+        usageError("--presets",
+                   "'all': no preset found (searched: " + joinList(gi::presetLocations()) + ")");
+      s.presetNames.insert(s.presetNames.end(), all.begin(), all.end());
+    }
+  }
+  for (const std::string& p : s.presetNames) {
     if (p == "none") {
       s.presets.emplace_back();
       continue;
@@ -647,9 +685,15 @@ void loadInputs(const Options& o, Setup& s) {
 
 std::vector<std::string> effectItems(const Options& o, const gi::EffectRegistry& registry) {
   std::vector<std::string> items;
-  if (o.effects)
-    items = *o.effects;
-  else
+  if (o.effects) {
+    for (const std::string& item : *o.effects)
+      if (item == "all") {
+        const std::vector<std::string> names = registry.names();
+        items.insert(items.end(), names.begin(), names.end());
+      } else {
+        items.push_back(item);
+      }
+  } else
     items = {registry.has("ssao") ? "ssao" : "none"};
   if (items.empty()) items = {"none"};
   for (const std::string& item : items) {
@@ -702,10 +746,17 @@ std::vector<Config> buildConfigs(const Options& o, const Setup& s,
                                  const std::vector<std::string>& items,
                                  const std::vector<Grid>& grids) {
   std::vector<Config> configs;
+  // --effects all: each preset with the effects it configures (its platform-profile column).
+  const bool everyEffect =
+      o.effects && std::find(o.effects->begin(), o.effects->end(), "all") != o.effects->end();
   for (size_t si = 0; si < s.scenes.size(); ++si)
     for (const std::string& item : items)
       for (size_t pi = 0; pi < s.presets.size(); ++pi) {
         const std::vector<std::string> set = splitPlus(item);
+        if (everyEffect && s.presets[pi] &&
+            std::none_of(set.begin(), set.end(),
+                         [&](const std::string& e) { return s.presets[pi]->effects.count(e); }))
+          continue;
         std::vector<const Grid*> active;
         for (const Grid& g : grids)
           if (std::find(set.begin(), set.end(), g.effect) != set.end()) active.push_back(&g);
@@ -715,7 +766,7 @@ std::vector<Config> buildConfigs(const Options& o, const Setup& s,
           c.scene = si;
           c.effectSet = set;
           c.effectLabel = item;
-          c.preset = o.presets[pi];
+          c.preset = s.presetNames[pi];
           c.presetPtr = s.presets[pi].get();
           gi::EffectOverrides ov;
           ov.effects = set;
@@ -778,11 +829,12 @@ std::map<ReferenceKey, Reference> computeReferences(const Options& o, const Setu
 
 void checkFinite(const Row& r) {
   const Row::AoSplit& s = r.split;
-  for (double v : {r.totalMs,        r.effectMs,       r.floorMs,         r.wallMs,
-                   r.totalCi.lo,     r.totalCi.hi,     r.nrmse,           r.ssim,
-                   r.declaredNrmse,  r.declaredSsim,   s.limitNrmse,      s.offscreenNrmse,
-                   s.hiddenNrmse,    s.estimatorNrmse, s.visibleFraction, s.offscreenFraction,
-                   s.hiddenFraction, s.shareOffscreen, s.shareHidden,     s.shareEstimator})
+  for (double v : {r.totalMs,         r.effectMs,          r.floorMs,        r.wallMs,
+                   r.totalCi.lo,      r.totalCi.hi,        r.nrmse,          r.ssim,
+                   r.declaredNrmse,   r.declaredSsim,      r.gapNrmse,       r.gapShare,
+                   s.limitNrmse,      s.offscreenNrmse,    s.hiddenNrmse,    s.estimatorNrmse,
+                   s.visibleFraction, s.offscreenFraction, s.hiddenFraction, s.shareOffscreen,
+                   s.shareHidden,     s.shareEstimator})
     if (!std::isfinite(v))
       throw gi::Error(gi::ErrorKind::NonFinite, r.scene,
                       "non-finite measurement for " + r.effect + " " + r.params);
@@ -811,6 +863,7 @@ int runSweep(const Options& o) {
     jobs.push_back({&s.scenes[c.scene].scene, &c.effects, &c.engine, c.comparison.resource});
   ProgressBar bar(o.progress, "configurations", configs.size());
   std::vector<Scores> vsTargets(configs.size()), vsDeclareds(configs.size());
+  std::vector<std::optional<gi::bench::QuantityGap>> gaps(configs.size());
   const std::vector<Measurement> measured =
       measureAll(ctx, s.registry, jobs, o, true, [&](size_t i, const Measurement& m) {
         const Config& c = configs[i];
@@ -818,6 +871,8 @@ int runSweep(const Options& o) {
             score(m, c.comparison.target, refs.at(ReferenceKey{c.scene, c.comparison.target}), o);
         vsDeclareds[i] = score(m, c.comparison.declared,
                                refs.at(ReferenceKey{c.scene, c.comparison.declared}), o);
+        gaps[i] = gapOf(m, c.comparison, refs.at(ReferenceKey{c.scene, c.comparison.target}),
+                        refs.at(ReferenceKey{c.scene, c.comparison.declared}), o);
         bar.step(s.scenes[c.scene].name + " " + c.effectLabel + " " + c.params);
       });
   std::vector<Row> rows;
@@ -868,6 +923,11 @@ int runSweep(const Options& o) {
     r.declared = referenceLabel(c.comparison.declared, declared.spp);
     r.declaredStdError = declared.meanStdError;
     r.declaredNrmse = vsDeclared.metrics.nrmse;
+    if (gaps[i]) {
+      r.gapPresent = true;
+      r.gapNrmse = gaps[i]->gapNrmse;
+      r.gapShare = gaps[i]->gapShare;
+    }
     r.declaredSsim = vsDeclared.metrics.ssim;
     checkFinite(r);
     rows.push_back(std::move(r));
@@ -889,14 +949,14 @@ int runSweep(const Options& o) {
 // ---- Calibration
 // ----------------------------------------------------------------------------------
 
-// The sample-count settings of an effect: integer settings whose name contains "samples".
+// The sample-count settings of an effect (SettingDesc::sampleCount: samples, directions,
+// steps, slices ...).
 std::vector<gi::SettingDesc> sampleSettings(const gi::EffectRegistry& registry,
                                             const std::string& effect) {
   std::vector<gi::SettingDesc> out;
   const gi::SettingValues defaults = registry.defaultSettings(effect);
   for (const auto& d : defaults.descs())
-    if (d.type == gi::SettingType::Int && d.name.find("samples") != std::string::npos)
-      out.push_back(d);
+    if (d.sampleCount) out.push_back(d);
   return out;
 }
 
@@ -909,135 +969,213 @@ std::vector<int> powersOfTwo(const gi::SettingDesc& d) {
   return v;
 }
 
-int runCalibrate(const Options& o) {
-  Setup s;
-  loadInputs(o, s);
-  if (s.scenes.size() != 1) usageError("--scene", "--calibrate measures one scene");
+// One effect set calibrated on its own (effects a preset offers as alternatives are each given
+// the whole budget; a '+' set runs together and shares it): its knobs, the candidates (the
+// cartesian product of powers of two of every knob), their jobs' indices and the choice.
+struct CalibrationItem {
+  std::string label;
   std::vector<std::string> effects;
-  if (o.effects) {
-    for (const auto& item : effectItems(o, s.registry))
-      for (const auto& e : splitPlus(item)) effects.push_back(e);
-  } else {
-    for (const auto& n : s.registry.names())
-      if (!sampleSettings(s.registry, n).empty()) effects.push_back(n);
-  }
-  // Candidates: the cartesian product of powers of two of every sample-count setting.
   struct Knob {
     std::string effect, key;
     std::vector<int> values;
   };
   std::vector<Knob> knobs;
-  for (const auto& e : effects)
+  std::vector<std::vector<int>> candidates;
+  std::vector<std::vector<gi::EffectConfig>> configs;
+  std::vector<std::string> labels;
+  Comparison cmp;
+  size_t firstJob = 0;
+  std::vector<Scores> scores;
+  gi::bench::CalibrationChoice choice;
+};
+
+CalibrationItem calibrationItem(const std::string& label, const Setup& s) {
+  CalibrationItem it;
+  it.label = label;
+  it.effects = splitPlus(label);
+  for (const auto& e : it.effects)
     for (const auto& d : sampleSettings(s.registry, e))
-      knobs.push_back({e, d.name, powersOfTwo(d)});
-  if (knobs.empty())
-    usageError("--calibrate", "no effect with a sample-count setting to calibrate (effects: " +
-                                  knownEffects(s.registry) + ")");
-  std::vector<std::vector<int>> candidates(1);
-  for (const Knob& k : knobs) {
+      it.knobs.push_back({e, d.name, powersOfTwo(d)});
+  if (it.knobs.empty())
+    usageError(
+        "--effects", "'" + label +
+                         "' has no sample-count setting to calibrate (effects with one: " +
+                         [&] {
+                           std::vector<std::string> with;
+                           for (const auto& n : s.registry.names())
+                             if (!sampleSettings(s.registry, n).empty()) with.push_back(n);
+                           return with.empty() ? std::string("none") : joinList(with);
+                         }() +
+                         ")");
+  it.candidates.assign(1, {});
+  for (const auto& k : it.knobs) {
     std::vector<std::vector<int>> next;
-    for (const auto& c : candidates)
+    for (const auto& c : it.candidates)
       for (int v : k.values) {
         next.push_back(c);
         next.back().push_back(v);
       }
-    candidates = std::move(next);
+    it.candidates = std::move(next);
   }
   const gi::Scene& scene = s.scenes[0].scene;
-  std::vector<gi::EffectConfig> base;
-  {
+  gi::EffectOverrides base;
+  base.effects = it.effects;
+  it.cmp = comparisonFor(gi::resolveEffects(scene, nullptr, base, s.registry), s.registry, false);
+  for (const auto& cand : it.candidates) {
     gi::EffectOverrides ov;
-    ov.effects = effects;
-    base = gi::resolveEffects(scene, nullptr, ov, s.registry);
+    ov.effects = it.effects;
+    std::string text;
+    for (size_t k = 0; k < it.knobs.size(); ++k) {
+      ov.sets.push_back(it.knobs[k].effect + "." + it.knobs[k].key + "=" + std::to_string(cand[k]));
+      text += (text.empty() ? "" : " ") + ov.sets.back();
+    }
+    it.configs.push_back(gi::resolveEffects(scene, nullptr, ov, s.registry));
+    it.labels.push_back(text);
   }
-  const Comparison cmp = comparisonFor(base, s.registry, false);
+  return it;
+}
+
+int runCalibrate(const Options& o) {
+  Setup s;
+  loadInputs(o, s);
+  if (s.scenes.size() != 1) usageError("--scene", "--calibrate measures one scene");
+  // Without --effects, or with 'all': every effect that has a sample count; effects named
+  // explicitly must have one.
+  std::vector<std::string> labels;
+  const bool every =
+      !o.effects || std::find(o.effects->begin(), o.effects->end(), "all") != o.effects->end();
+  for (const auto& item : o.effects ? effectItems(o, s.registry) : s.registry.names()) {
+    const bool single = item.find('+') == std::string::npos;
+    if (item == "none" || (every && single && sampleSettings(s.registry, item).empty())) continue;
+    labels.push_back(item);
+  }
+  if (labels.empty())
+    usageError("--calibrate", "no effect with a sample-count setting to calibrate (effects: " +
+                                  knownEffects(s.registry) + ")");
+  std::vector<CalibrationItem> items;
+  for (const auto& l : labels) items.push_back(calibrationItem(l, s));
+  const gi::Scene& scene = s.scenes[0].scene;
   const gi::SettingValues engine = gi::resolveEngineSettings(scene, nullptr, {}, {});
-  const std::map<ReferenceKey, Reference> refs =
-      computeReferences(o, s, {ReferenceKey{0, cmp.target}});
-  const Reference& reference = refs.begin()->second;
+  std::vector<ReferenceKey> keys;
+  for (const auto& it : items) keys.push_back(ReferenceKey{0, it.cmp.target});
+  const std::map<ReferenceKey, Reference> refs = computeReferences(o, s, keys);
   gi::vk::Context ctx = makeContext(o);
   const double limit = o.budgetMs * (1.0 - o.headroom);
   std::printf(
       "calibrating on %s: %s %ux%u, budget %.3f ms (the upper end of the measured "
-      "time's interval must stay under %.3f)\n",
+      "time's interval must stay under %.3f); each effect set alone in the frame\n",
       ctx.deviceName().c_str(), s.scenes[0].name.c_str(), o.width, o.height, o.budgetMs, limit);
-  // Every candidate measured, repetitions interleaved across candidates.
-  std::vector<std::vector<gi::EffectConfig>> configs;
-  std::vector<std::string> labels;
-  for (size_t ci = 0; ci < candidates.size(); ++ci) {
-    gi::EffectOverrides ov;
-    ov.effects = effects;
-    std::string label;
-    for (size_t k = 0; k < knobs.size(); ++k) {
-      ov.sets.push_back(knobs[k].effect + "." + knobs[k].key + "=" +
-                        std::to_string(candidates[ci][k]));
-      label += (label.empty() ? "" : " ") + ov.sets.back();
-    }
-    configs.push_back(gi::resolveEffects(scene, nullptr, ov, s.registry));
-    labels.push_back(label);
-  }
+  // Every candidate of every item measured, repetitions interleaved across all of them.
   std::vector<RenderJob> jobs;
-  for (const auto& cfg : configs) jobs.push_back({&scene, &cfg, &engine, cmp.resource});
-  ProgressBar bar(o.progress, "candidates", candidates.size());
-  std::vector<Scores> scores(candidates.size());
+  std::vector<std::pair<size_t, size_t>> owner;  // job -> (item, candidate)
+  for (size_t ii = 0; ii < items.size(); ++ii) {
+    items[ii].firstJob = jobs.size();
+    items[ii].scores.resize(items[ii].candidates.size());
+    for (size_t ci = 0; ci < items[ii].configs.size(); ++ci) {
+      jobs.push_back({&scene, &items[ii].configs[ci], &engine, items[ii].cmp.resource});
+      owner.emplace_back(ii, ci);
+    }
+  }
+  ProgressBar bar(o.progress, "candidates", jobs.size());
   const std::vector<Measurement> measured =
-      measureAll(ctx, s.registry, jobs, o, false, [&](size_t i, const Measurement& m) {
-        scores[i] = score(m, cmp.target, reference, o);
-        bar.step(labels[i]);
+      measureAll(ctx, s.registry, jobs, o, false, [&](size_t j, const Measurement& m) {
+        CalibrationItem& it = items[owner[j].first];
+        it.scores[owner[j].second] =
+            score(m, it.cmp.target, refs.at(ReferenceKey{0, it.cmp.target}), o);
+        bar.step(it.labels[owner[j].second]);
       });
   const bool bySsim = o.metric == "ssim";
-  std::vector<gi::bench::CalibrationCandidate> cands;
-  double cheapest = INFINITY;
-  for (size_t ci = 0; ci < candidates.size(); ++ci) {
-    const gi::bench::Metrics& mt = scores[ci].metrics;
-    cands.push_back({candidates[ci], measured[ci].total, bySsim ? -mt.ssim : mt.nrmse});
-    cheapest = std::min(cheapest, measured[ci].total.median);
-  }
-  const gi::bench::CalibrationChoice choice = gi::bench::chooseCalibrated(cands, limit);
   char intervalHeader[32];
   std::snprintf(intervalHeader, sizeof intervalHeader, "%.4g%% interval",
                 100.0 * (measured.empty() ? 0.0 : measured[0].total.coverage));
-  std::printf("%-40s %10s %21s %12s %10s %8s %5s\n", "settings", "frame ms", intervalHeader,
-              "cost bound", "NRMSE", "SSIM", "fits");
-  for (size_t ci = 0; ci < candidates.size(); ++ci) {
-    const Interval& t = measured[ci].total;
-    std::printf("%-40s %10.3f [%8.3f, %8.3f] %12.3f %10.5f %8.5f %5s\n", labels[ci].c_str(),
-                t.median, t.lo, t.hi, choice.boundMs[ci], scores[ci].metrics.nrmse,
-                scores[ci].metrics.ssim, choice.boundMs[ci] <= limit ? "yes" : "no");
+  std::string unfit;
+  for (CalibrationItem& it : items) {
+    std::vector<gi::bench::CalibrationCandidate> cands;
+    double cheapest = INFINITY;
+    for (size_t ci = 0; ci < it.candidates.size(); ++ci) {
+      const gi::bench::Metrics& mt = it.scores[ci].metrics;
+      const Interval& t = measured[it.firstJob + ci].total;
+      cands.push_back({it.candidates[ci], t, bySsim ? -mt.ssim : mt.nrmse});
+      cheapest = std::min(cheapest, t.median);
+    }
+    it.choice = gi::bench::chooseCalibrated(cands, limit);
+    std::printf("\n%s against %s\n%-40s %10s %21s %12s %10s %8s %5s\n", it.label.c_str(),
+                referenceLabel(it.cmp.target, refs.at(ReferenceKey{0, it.cmp.target}).spp).c_str(),
+                "settings", "frame ms", intervalHeader, "cost bound", "NRMSE", "SSIM", "fits");
+    for (size_t ci = 0; ci < it.candidates.size(); ++ci) {
+      const Interval& t = measured[it.firstJob + ci].total;
+      std::printf("%-40s %10.3f [%8.3f, %8.3f] %12.3f %10.5f %8.5f %5s\n", it.labels[ci].c_str(),
+                  t.median, t.lo, t.hi, it.choice.boundMs[ci], it.scores[ci].metrics.nrmse,
+                  it.scores[ci].metrics.ssim, it.choice.boundMs[ci] <= limit ? "yes" : "no");
+    }
+    if (!it.choice.index) {
+      unfit += (unfit.empty() ? "" : "; ") + it.label +
+               " (cheapest measured: " + formatDouble(cheapest) + " ms)";
+      continue;
+    }
+    const size_t b = *it.choice.index;
+    std::printf(
+        "%s: chose %s, margin kept %.3f ms under the limit %.3f (cost bound %.3f ms, of which "
+        "%.3f ms above the median for noise and the monotone-cost assumption)\n",
+        it.label.c_str(), it.labels[b].c_str(), it.choice.marginMs, limit, it.choice.boundMs[b],
+        it.choice.noiseMarginMs);
   }
-  if (!choice.index)
+  if (!unfit.empty())
     throw gi::Error(gi::ErrorKind::InvalidData, o.out,
-                    "no configuration fits the budget of " + formatDouble(o.budgetMs) +
-                        " ms (cheapest measured: " + formatDouble(cheapest) +
-                        " ms at the lowest sample counts, upper ends of the intervals must "
-                        "fit); nothing written");
-  struct Choice {
-    size_t index = 0;
-    double ms = 0.0, nrmse = 0.0, ssim = 0.0;
-  };
-  const Choice best{*choice.index, measured[*choice.index].total.median,
-                    scores[*choice.index].metrics.nrmse, scores[*choice.index].metrics.ssim};
-  std::printf(
-      "margin kept: %.3f ms under the limit %.3f (cost bound %.3f ms, of which %.3f ms "
-      "above the median for noise and the monotone-cost assumption; coverage %.4g)\n",
-      choice.marginMs, limit, choice.boundMs[best.index], choice.noiseMarginMs,
-      measured[best.index].total.coverage);
-  nlohmann::json preset;
+                    "no configuration fits the budget of " + formatDouble(o.budgetMs) + " ms for " +
+                        unfit + " (upper ends of the intervals must fit); nothing written");
+  // The preset, with the search and its margins recorded under "calibration".
+  nlohmann::json preset, record = nlohmann::json::array();
   preset["name"] = fs::path(o.out).stem().string();
+  std::string summary;
+  preset["effects"] = nlohmann::json::object();
+  for (const CalibrationItem& it : items) {
+    const size_t b = *it.choice.index;
+    const Interval& t = measured[it.firstJob + b].total;
+    const gi::bench::Metrics& mt = it.scores[b].metrics;
+    for (size_t k = 0; k < it.knobs.size(); ++k)
+      preset["effects"][it.knobs[k].effect][it.knobs[k].key] = it.candidates[b][k];
+    summary += (summary.empty() ? "" : "; ") + it.label + " " + formatDouble(t.median) +
+               " ms, NRMSE " + formatDouble(mt.nrmse) + ", SSIM " + formatDouble(mt.ssim);
+    nlohmann::json item;
+    item["effects"] = it.label;
+    item["reference"] = referenceLabel(it.cmp.target, refs.at(ReferenceKey{0, it.cmp.target}).spp);
+    item["chosen"] = it.labels[b];
+    item["margin_ms"] = it.choice.marginMs;
+    item["noise_margin_ms"] = it.choice.noiseMarginMs;
+    item["candidates"] = nlohmann::json::array();
+    for (size_t ci = 0; ci < it.candidates.size(); ++ci) {
+      const Interval& c = measured[it.firstJob + ci].total;
+      item["candidates"].push_back({{"settings", it.labels[ci]},
+                                    {"median_ms", c.median},
+                                    {"interval_ms", {c.lo, c.hi}},
+                                    {"cost_bound_ms", it.choice.boundMs[ci]},
+                                    {"nrmse", it.scores[ci].metrics.nrmse},
+                                    {"ssim", it.scores[ci].metrics.ssim},
+                                    {"fits", it.choice.boundMs[ci] <= limit}});
+    }
+    record.push_back(item);
+  }
   preset["description"] =
       "Calibrated by gi-bench on " + ctx.deviceName() + " with " + s.scenes[0].name + " at " +
-      std::to_string(o.width) + "x" + std::to_string(o.height) + ": measured " +
-      formatDouble(best.ms) + " ms per frame (median of " + std::to_string(o.reps) +
-      " repetitions, cost bound " + formatDouble(choice.boundMs[best.index]) + " ms), NRMSE " +
-      formatDouble(best.nrmse) + ", SSIM " + formatDouble(best.ssim) + " vs " +
-      referenceLabel(cmp.target, reference.spp) + " (the sample counts of highest " +
-      (bySsim ? "SSIM" : "NRMSE accuracy") + " within " + formatDouble(o.budgetMs) + " ms)";
+      std::to_string(o.width) + "x" + std::to_string(o.height) + ", each effect set alone within " +
+      formatDouble(o.budgetMs) + " ms per frame (medians of " + std::to_string(o.reps) +
+      " repetitions; the sample counts of highest " + (bySsim ? "SSIM" : "NRMSE accuracy") +
+      " whose cost bound fits): " + summary;
   preset["platform"] = ctx.deviceName();
   preset["target_ms"] = o.budgetMs;
   preset["reference_resolution"] = {o.width, o.height};
-  preset["effects"] = nlohmann::json::object();
-  for (size_t k = 0; k < knobs.size(); ++k)
-    preset["effects"][knobs[k].effect][knobs[k].key] = candidates[best.index][k];
+  preset["calibration"] = {
+      {"command", o.commandLine},
+      {"scene", s.scenes[0].name},
+      {"budget_ms", o.budgetMs},
+      {"headroom", o.headroom},
+      {"limit_ms", limit},
+      {"metric", o.metric},
+      {"reps", o.reps},
+      {"frames", o.frames},
+      {"interval_coverage", measured.empty() ? 0.0 : measured[0].total.coverage},
+      {"items", record}};
   // Written, then checked by the engine's own loader, then moved into place.
   const std::string tmp = o.out + ".check.json";
   gi::cli::writeFileAtomic(tmp, preset.dump(2) + "\n");
@@ -1048,9 +1186,7 @@ int runCalibrate(const Options& o) {
     throw;
   }
   fs::rename(tmp, o.out);
-  std::printf("chose %s: %.3f ms (budget %.3f), NRMSE %.5f, SSIM %.5f -> wrote %s\n",
-              preset["effects"].dump().c_str(), best.ms, o.budgetMs, best.nrmse, best.ssim,
-              o.out.c_str());
+  std::printf("\nwrote %s: %s\n", o.out.c_str(), preset["effects"].dump().c_str());
   return 0;
 }
 

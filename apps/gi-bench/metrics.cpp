@@ -129,6 +129,29 @@ Metrics compare(const Plane& test, const Plane& reference, const std::vector<uns
   return r;
 }
 
+QuantityGap quantityGap(const Plane& test, const Plane& target, const Plane& declared,
+                        const std::vector<unsigned char>& mask) {
+  double sumT = 0.0, gap2 = 0.0, ee = 0.0, eGap = 0.0;
+  size_t n = 0;
+  for (size_t i = 0; i < test.values.size(); ++i) {
+    if (!kept(mask, i)) continue;
+    const double S = sanitize(test.values[i]), T = sanitize(target.values[i]),
+                 D = sanitize(declared.values[i]);
+    const double e = S - T, gap = D - T;
+    sumT += std::abs(T);
+    gap2 += gap * gap;
+    ee += e * e;
+    eGap += e * gap;
+    ++n;
+  }
+  QuantityGap g;
+  if (n == 0) return g;
+  const double meanT = sumT / double(n) > 1e-8 ? sumT / double(n) : 1.0;  // as nrmse()
+  g.gapNrmse = std::sqrt(gap2 / double(n)) / meanT;
+  g.gapShare = ee > 0.0 ? eGap / ee : 0.0;
+  return g;
+}
+
 Plane channel(int width, int height, const std::vector<float>& rgba, int c) {
   Plane p{width, height, std::vector<float>(size_t(width) * size_t(height))};
   if (rgba.size() != p.values.size() * 4)

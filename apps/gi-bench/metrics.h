@@ -38,6 +38,17 @@ double ssim(const Plane& test, const Plane& reference, const std::vector<unsigne
 Metrics compare(const Plane& test, const Plane& reference, const std::vector<unsigned char>& mask,
                 double dynamicRange = 1.0);
 
+// How much of an effect's error against its physical target T comes from the quantity it
+// declares, D, differing from T: e = S - T = (S - D) + (D - T). gapNrmse = RMS(D - T) / mean|T|
+// (the error of a perfect estimator of D); gapShare = mean(e (D - T)) / mean(e^2), the share of
+// the mean squared error the gap explains (1 - gapShare is the estimator's, S - D; a share may
+// be negative or above 1 when the parts cancel). No kept pixel or e = 0 everywhere: shares 0.
+struct QuantityGap {
+  double gapNrmse = 0.0, gapShare = 0.0;
+};
+QuantityGap quantityGap(const Plane& test, const Plane& target, const Plane& declared,
+                        const std::vector<unsigned char>& mask);
+
 // Channel c (0..3) of an RGBA float image; Rec. 709 luminance when c < 0.
 Plane channel(int width, int height, const std::vector<float>& rgba, int c);
 // x / (1 + x) per pixel: maps HDR radiance into [0, 1) for SSIM with L = 1.

@@ -84,7 +84,7 @@ std::string csv(const std::vector<Row>& rows) {
        "total_hi_ms,effect_ms,effect_lo_ms,effect_hi_ms,interval_coverage,floor_ms,"
        "total_over_floor,effect_over_floor,wall_ms,compared,reference,reference_spp,"
        "reference_stderr,pixels,nrmse,ssim,declared,declared_stderr,declared_nrmse,"
-       "declared_ssim";
+       "declared_ssim,gap_nrmse,gap_share";
   // --ao-split runs only, so that other runs keep their columns.
   if (split)
     o << ",reference_seconds,limit_nrmse,offscreen_nrmse,hidden_nrmse,estimator_nrmse,"
@@ -102,7 +102,9 @@ std::string csv(const std::vector<Row>& rows) {
       << r.compared << ',' << csvField(r.reference) << ',' << r.referenceSpp << ','
       << fmt(r.referenceStdError, 6) << ',' << r.pixels << ',' << fmt(r.nrmse, 6) << ','
       << fmt(r.ssim, 6) << ',' << csvField(r.declared) << ',' << fmt(r.declaredStdError, 6) << ','
-      << fmt(r.declaredNrmse, 6) << ',' << fmt(r.declaredSsim, 6);
+      << fmt(r.declaredNrmse, 6) << ',' << fmt(r.declaredSsim, 6) << ','
+      << (r.gapPresent ? fmt(r.gapNrmse, 6) : std::string()) << ','
+      << (r.gapPresent ? fmt(r.gapShare, 6) : std::string());
     if (split) {
       const Row::AoSplit& s = r.split;
       o << ',' << fmt(r.referenceSeconds, 6);
@@ -165,6 +167,8 @@ std::string json(const std::vector<Row>& rows, const RunInfo& info) {
                             {"declared_nrmse", r.declaredNrmse},
                             {"declared_ssim", r.declaredSsim},
                             {"reference_seconds", r.referenceSeconds}});
+    if (r.gapPresent)
+      j["results"].back()["quantity_gap"] = {{"gap_nrmse", r.gapNrmse}, {"gap_share", r.gapShare}};
     if (r.split.present) {
       const Row::AoSplit& s = r.split;
       j["results"].back()["ao_split"] = {
@@ -429,6 +433,32 @@ std::string splitSection(const std::vector<Row>& rows) {
   return o.str();
 }
 
+// Rows whose declared quantity is not their target: how much of the error against the target
+// is the declared quantity's own distance from it (no estimator can remove that part).
+std::string gapSection(const std::vector<Row>& rows) {
+  std::ostringstream o;
+  for (const Row& r : rows) {
+    if (!r.gapPresent) continue;
+    if (o.tellp() == 0)
+      o << "\n## The declared quantity against the target\n\n"
+           "e = effect - target = (effect - declared) + (declared - target). *Gap NRMSE* is "
+           "NRMSE(declared vs target): the error against the target of a perfect estimator of "
+           "what the effect declares. *Share of MSE* is mean(e (declared - target)) / mean(e^2): "
+           "the part of this row's squared error against the target that the choice of "
+           "quantity explains; the rest is the estimator's (sampling, screen-space limits, "
+           "bias) against its own quantity.\n\n"
+           "| scene | effect | preset / params | declared | target | NRMSE vs target | NRMSE vs "
+           "declared | gap NRMSE | share of MSE: quantity gap / estimator |\n"
+           "|---|---|---|---|---|---:|---:|---:|---|\n";
+    o << "| " << r.scene << " | " << r.effect << " | " << r.preset
+      << (r.params.empty() ? "" : " " + r.params) << " | " << r.declared << " | " << r.reference
+      << " | " << fmt(r.nrmse, 4) << " | " << fmt(r.declaredNrmse, 4) << " | " << fmt(r.gapNrmse, 4)
+      << " | " << fmt(100.0 * r.gapShare, 3) << "% / " << fmt(100.0 * (1.0 - r.gapShare), 3)
+      << "% |\n";
+  }
+  return o.str();
+}
+
 // With several presets and no grid: one table per scene shaped like seed 003's Table 1, a
 // column per preset (platform profile), for each effect the settings its preset sets, its time
 // and its errors against the target and against its declared quantity.
@@ -525,6 +555,7 @@ std::string markdown(const std::vector<Row>& rows, const RunInfo& info,
       << " | " << fmt(r.declaredNrmse, 4) << " | " << fmt(r.declaredSsim, 4) << " |\n";
   }
   if (anySplit(rows)) o << splitSection(rows);
+  o << gapSection(rows);
   o << profileTable(rows);
   if (!plots.empty()) {
     o << "\n## Error against time\n\n";

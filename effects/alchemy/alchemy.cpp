@@ -86,8 +86,9 @@ class AlchemyEffect : public gi::Effect {
         gi::SettingDesc::length("radius", 0.5, 1e-6, 1e9,
                                 "world-space radius r: taps lie on its projected disk, occluders "
                                 "farther than r count nothing"),
-        {"samples", SettingType::Int, 12, 1, kMaxSamples,
-         "taps s per pixel (specialized: a change rebuilds the pipeline)", true},
+        gi::SettingDesc::samples("samples", 12, 1, kMaxSamples,
+                                 "taps s per pixel (specialized: a change rebuilds the pipeline)",
+                                 true),
         {"bias", SettingType::Float, 1e-4, 0.0, 0.1,
          "bias beta: the numerator is max(0, v.n - beta z), z the view distance (the paper's "
          "z_C beta); removes self-occlusion from depth precision",

@@ -52,11 +52,13 @@ class GtaoEffect : public gi::Effect {
     return {
         gi::SettingDesc::length("radius", 0.5, 1e-6, 1e9,
                                 "world-space radius R: occluders farther than R are ignored"),
-        {"slices", SettingType::Int, 3, 1, gi::gtao::kMaxSlices,
-         "slice planes through the view vector per pixel (XeGTAO low 1, medium 2, high 3, ultra 9)",
-         true},
-        {"steps", SettingType::Int, 3, 1, gi::gtao::kMaxSteps,
-         "depth samples per side of each slice (XeGTAO low 2, medium 2, high 3, ultra 3)", true},
+        gi::SettingDesc::samples("slices", 3, 1, gi::gtao::kMaxSlices,
+                                 "slice planes through the view vector per pixel (XeGTAO low 1, "
+                                 "medium 2, high 3, ultra 9)",
+                                 true),
+        gi::SettingDesc::samples(
+            "steps", 3, 1, gi::gtao::kMaxSteps,
+            "depth samples per side of each slice (XeGTAO low 2, medium 2, high 3, ultra 3)", true),
         {"falloff", SettingType::Float, 0.0, 0.0, 1.0,
          "fraction of R over which an occluder's weight fades to 0 before R (0: the reference's "
          "hard cut-off)",

@@ -48,9 +48,11 @@ class HbaoEffect : public gi::Effect {
         gi::SettingDesc::length("radius", 0.5, 1e-6, 1e9,
                                 "world-space radius R: samples farther than R are ignored, nearer "
                                 "ones attenuated by 1 - r^2 / R^2"),
-        {"directions", SettingType::Int, 6, 1, gi::hbao::kMaxDirections,
-         "screen directions per pixel (rotated per pixel by the 4x4 interleave)", true},
-        {"steps", SettingType::Int, 4, 1, gi::hbao::kMaxSteps, "depth samples per direction", true},
+        gi::SettingDesc::samples(
+            "directions", 6, 1, gi::hbao::kMaxDirections,
+            "screen directions per pixel (rotated per pixel by the 4x4 interleave)", true),
+        gi::SettingDesc::samples("steps", 4, 1, gi::hbao::kMaxSteps, "depth samples per direction",
+                                 true),
         {"angle_bias", SettingType::Float, 10.0, 0.0, 60.0,
          "degrees added to the tangent angle: horizons below it do not occlude (hides "
          "tessellation and depth-precision self-occlusion)",

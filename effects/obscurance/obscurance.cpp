@@ -79,8 +79,9 @@ class ObscuranceEffect : public gi::Effect {
             "membership", obs::membershipNames(), int(obs::Membership::Sqrt),
             "fuzzy membership mu(d / R) of an occluder at distance d: sqrt (Mendez et al.), "
             "step (ambient occlusion), linear, smoothstep"),
-        {"samples", SettingType::Int, 16, 1, obs::kMaxSamples,
-         "rays per pixel (x 16 interleaved rotations after the filter)", true},
+        gi::SettingDesc::samples("samples", 16, 1, obs::kMaxSamples,
+                                 "rays per pixel (x 16 interleaved rotations after the filter)",
+                                 true),
         {"points_per_ray", SettingType::Int, 1, 1, 2,
          "containment tests along each ray (seed 001: 1 or 2); 2 catches thin occluders", true},
         gi::SettingDesc::enumeration(

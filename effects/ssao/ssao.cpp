@@ -59,7 +59,7 @@ class SsaoEffect : public gi::Effect {
         gi::SettingDesc::length("radius", 0.5, 1e-6, 1e9,
                                 "world-space radius R of the sampled hemisphere (a model loaded "
                                 "without a scene file scales the default to its size)"),
-        {"samples", SettingType::Int, 16, 1, gi::ssao::kMaxSamples, "taps per pixel", false},
+        gi::SettingDesc::samples("samples", 16, 1, gi::ssao::kMaxSamples, "taps per pixel", false),
         {"bias", SettingType::Float, 0.025, 0.0, 0.5,
          "an occluder must be this far in front of a tap, as a fraction of the radius", false},
         {"intensity", SettingType::Float, 1.0, 0.0, 4.0,

@@ -25,10 +25,32 @@ layout(constant_id = 1) const bool kBounce = true;
 // evaluating all three per sample (llvmpipe runs every branch) would cost most of the pass.
 layout(constant_id = 2) const int kEnvironmentKind = 0;
 
+// Depth layers (1, 2): with 2 a sample is blocked only inside the solid interval between the
+// front layer and the peeled one (seed 000 §4, Fig. 5); where no second layer exists, the
+// one-layer test with its range guard.
+layout(constant_id = 3) const int kLayers = 1;
+// Additional cameras (0..4): a sample is also blocked when it is behind a surface one of them
+// sees (same test, their own images), and that surface is then its sender.
+layout(constant_id = 4) const int kCameras = 0;
+
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 #include "ssdo_common.glsl"
 layout(set = 0, binding = 2) uniform usampler2D gSurface;  // ssdo_surface.comp
 layout(set = 0, binding = 3, rgba32ui) uniform writeonly uimage2D outRaw;
+// The additional cameras' surface texels (ssdo_surface.comp through their views; unused ones
+// are bound to gSurface).
+layout(set = 0, binding = 4) uniform usampler2D gCamera0;
+layout(set = 0, binding = 5) uniform usampler2D gCamera1;
+layout(set = 0, binding = 6) uniform usampler2D gCamera2;
+layout(set = 0, binding = 7) uniform usampler2D gCamera3;
+
+// `c` is a constant after the camera loop unrolls: the branches fold.
+uvec4 fetchCamera(int c, ivec2 t) {
+  if (c == 0) return texelFetch(gCamera0, t, 0);
+  if (c == 1) return texelFetch(gCamera1, t, 0);
+  if (c == 2) return texelFetch(gCamera2, t, 0);
+  return texelFetch(gCamera3, t, 0);
+}
 
 // Guard: samples at or behind the camera plane (clip.w below this) are untestable: open.
 const float kMinClipW = 1e-20;
@@ -42,6 +64,18 @@ const float kSlideMinK = 1e-4;
 vec3 clipToPixels(vec3 v, float p00, float p11, float p20, float p21, vec2 halfSize) {
   float w = -v.z;
   return vec3((vec2(p00 * v.x + p20 * v.z, p11 * v.y + p21 * v.z) + w) * halfSize, w);
+}
+
+// The bounce of one sender S (normal Ns, outgoing radiance Ls) at receiver P (normal N), view
+// space. Guard: a sender at P (d -> 0) has no direction: r = N, then cos_s decides; the
+// distance clamp d_min keeps 1 / d^2 finite (seed 000: the paper clamps d to 1).
+vec3 sendFrom(vec3 S, vec3 Ns, vec3 Ls, vec3 P, vec3 N, float dMin2) {
+  vec3 d = S - P;
+  float d2 = dot(d, d);
+  vec3 rdir = safeNormalize(d, N);
+  float cosR = max(dot(N, rdir), 0.0);
+  float cosS = max(-dot(Ns, rdir), 0.0);  // back-facing: 0
+  return Ls * (cosS * cosR / max(d2, dMin2));
 }
 
 // Sum over the open samples of the SH9 irradiance / pi (environmentIrradianceOverPi, without
@@ -116,6 +150,34 @@ void main() {
   vec3 skyZenith = frame.skyZenith.rgb * frame.skyZenith.w,
        skyHorizon = frame.skyHorizon.rgb * frame.skyZenith.w,
        skyGround = frame.skyGround.rgb * frame.skyZenith.w;
+  // The additional cameras' views of the sample frame (the same construction in their
+  // spaces: N.Q is invariant, so K follows from their N.P).
+  vec3 camP[4], camT[4], camB[4], camN[4];
+  vec4 camProj[4];
+  vec2 camG[4], camSize[4], camInvSize[4];
+  mat4 camFrom[4];  // hoisted: uniform-block reads in the sample loop cost llvmpipe dearly
+  float camNP[4], camMinK[4];
+  for (int c = 0; c < kCameras; ++c) {
+    mat4 toC = ssdo.cameras[c].toCamera;
+    mat3 rot = mat3(toC);
+    vec4 q = ssdo.cameras[c].proj;
+    q.x = abs(q.x) > 1e-30 ? q.x : 1e-30;
+    q.y = abs(q.y) > 1e-30 ? q.y : 1e-30;
+    camProj[c] = q;
+    vec4 sz = ssdo.cameras[c].size;
+    camSize[c] = sz.xy;
+    camInvSize[c] = sz.zw;
+    camFrom[c] = ssdo.cameras[c].fromCamera;
+    vec2 hs = 0.5 * sz.xy;
+    vec3 Pc = (toC * vec4(P, 1.0)).xyz, Nc = rot * N;
+    camP[c] = clipToPixels(Pc, q.x, q.y, q.z, q.w, hs);
+    camT[c] = clipToPixels(R * (rot * T), q.x, q.y, q.z, q.w, hs);
+    camB[c] = clipToPixels(R * (rot * B), q.x, q.y, q.z, q.w, hs);
+    camN[c] = clipToPixels(R * Nc, q.x, q.y, q.z, q.w, hs);
+    camG[c] = vec2(Nc.x / q.x, Nc.y / q.y) * 2.0 * sz.zw;
+    camNP[c] = dot(Nc, Pc);
+    camMinK[c] = -kSlideMinK * max(-Pc.z, 1e-20);
+  }
   vec3 direct = vec3(0.0), bounce = vec3(0.0);
   vec3 m1 = vec3(0.0), m2 = vec3(0.0), m2x = vec3(0.0);  // kind 2: sums of k, k_i^2, k_i k_j
   for (int i = 0; i < kSamples; ++i) {
@@ -141,7 +203,49 @@ void main() {
     float iQ = (K < minK && slid > 0.0) ? slid : invW;
     // max(bias, resolution x zQ) < zQ - zS < R (range guard), in inverse distances.
     float diff = iS - iQ, prod = iS * iQ;
-    bool blocked = valid && diff > max(bias * prod, kDepthResolution * iS) && diff < R * prod;
+    bool inFront = valid && diff > max(bias * prod, kDepthResolution * iS);
+    // Two layers: inside the solid interval [front, back] (1/z between them), wherever a back
+    // layer exists; else the range guard.
+    float iB = kLayers > 1 ? unpackHalf2x16(surface.w).y : 0.0;
+    bool blocked = inFront && (iB > 0.0 ? iQ > iB : diff < R * prod);
+    vec3 send = vec3(0.0);
+    if (kBounce) {
+      vec3 S = ssdoViewPosition(vec2(t) + 0.5, max(iS, 1e-30), invSize, p00, p11, p20, p21);
+      vec3 Ls = vec3(unpackHalf2x16(surface.z), unpackHalf2x16(surface.w).x);
+      send = blocked ? sendFrom(S, unpackNormal(surface.y), Ls, P, N, dMin2) : vec3(0.0);
+    }
+    for (int cam = 0; cam < kCameras; ++cam) {
+      // The same test in camera `cam`'s image (one layer, range guard, texel-centre slide).
+      vec4 q = camProj[cam];
+      vec3 cc = camP[cam] + (camT[cam] * kx + camB[cam] * ky + camN[cam] * kz) * s;
+      float Kq = camNP[cam] + R * s * kz;
+      float Kcl = min(Kq, camMinK[cam]), wc = max(cc.z, kMinClipW);
+      float rc = 1.0 / (wc * Kcl);
+      float invWc = rc * Kcl, invKc = rc * wc;
+      vec2 pc = cc.xy * invWc;
+      vec2 szc = camSize[cam];
+      bool validC = cc.z > kMinClipW && pc.x >= 0.0 && pc.y >= 0.0 && pc.x < szc.x &&
+                    pc.y < szc.y;
+      ivec2 tc = ivec2(clamp(pc, vec2(0.0), szc - 1.0));
+      uvec4 sc = fetchCamera(cam, tc);
+      float iSc = uintBitsToFloat(sc.x);
+      float slidC = invWc + dot(camG[cam], vec2(tc) + 0.5 - pc) * invKc;
+      float iQc = (Kq < camMinK[cam] && slidC > 0.0) ? slidC : invWc;
+      float diffC = iSc - iQc, prodC = iSc * iQc;
+      bool blockedC = validC && diffC > max(bias * prodC, kDepthResolution * iSc) &&
+                      diffC < R * prodC;
+      if (kBounce) {
+        // The first view that blocks the sample gives its sender (main view first).
+        vec3 Sc = ssdoViewPosition(vec2(tc) + 0.5, max(iSc, 1e-30), camInvSize[cam], q.x, q.y,
+                                   q.z, q.w);
+        mat4 fromC = camFrom[cam];
+        vec3 S = (fromC * vec4(Sc, 1.0)).xyz;
+        vec3 Ns = mat3(fromC) * unpackNormal(sc.y);
+        vec3 Ls = vec3(unpackHalf2x16(sc.z), unpackHalf2x16(sc.w).x);
+        send = (!blocked && blockedC) ? sendFrom(S, Ns, Ls, P, N, dMin2) : send;
+      }
+      blocked = blocked || blockedC;
+    }
 
     if (kEnvironmentKind == 1) {
       direct.x += blocked ? 0.0 : 1.0;  // constant: count the open directions
@@ -158,18 +262,7 @@ void main() {
       vec3 sky = mix(skyHorizon, y >= 0.0 ? skyZenith : skyGround, sqrt(abs(y)));
       direct += blocked ? vec3(0.0) : sky;
     }
-    if (kBounce) {
-      vec3 S = ssdoViewPosition(vec2(t) + 0.5, max(iS, 1e-30), invSize, p00, p11, p20, p21);
-      vec3 d = S - P;
-      float d2 = dot(d, d);
-      // Guard: a sender at P (d -> 0) has no direction: r = N, then cos_s decides; the
-      // distance clamp d_min keeps 1 / d^2 finite (seed 000: the paper clamps d to 1).
-      vec3 rdir = safeNormalize(d, N);
-      float cosR = max(dot(N, rdir), 0.0);
-      float cosS = max(-dot(unpackNormal(surface.y), rdir), 0.0);  // back-facing: 0
-      vec3 Ls = vec3(unpackHalf2x16(surface.z), unpackHalf2x16(surface.w).x);
-      bounce += blocked ? Ls * (cosS * cosR / max(d2, dMin2)) : vec3(0.0);
-    }
+    bounce += send;
   }
   if (kEnvironmentKind == 1) direct = direct.x * frame.skyGround.rgb * frame.skyZenith.w;
   if (kEnvironmentKind == 2) direct = shFromMoments(direct.x, m1, m2, m2x, mat3(Tw, Bw, Nw));

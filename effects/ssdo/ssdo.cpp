@@ -3,12 +3,21 @@
 // radiance: ssdo_surface.comp), the samples (ssdo.comp), a geometry-aware separable blur whose
 // y half multiplies by the diffuse albedo (ssdo_blur_x.comp, ssdo_resolve.comp). Publishes
 // "ambient" (alpha 1: replaces the engine's environment x AO term) and "indirect" (added).
+// Optional (seed 000 §4), only built when asked: a second depth layer peeled through the
+// engine's layered-depth draw (`layers` 2, pass ssdo_peel), and `cameras` low-resolution
+// views whose G-buffers add occluders and senders (passes ssdo_cameras, ssdo_camera_surface).
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstddef>
+#include <cstring>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/type_ptr.hpp>
 
 #include "gi/effect.h"
 #include "gi/effect_registry.h"
@@ -66,8 +75,9 @@ class SsdoEffect : public gi::Effect {
         gi::SettingDesc::length("radius", 0.5, 1e-6, 1e9,
                                 "world-space length r_max of the sample steps (and the range "
                                 "beyond which an occluder is ignored)"),
-        {"samples", SettingType::Int, 12, 1, gi::ssdo::kMaxSamples,
-         "samples N per pixel (a specialization constant: the loop unrolls)", true},
+        gi::SettingDesc::samples(
+            "samples", 12, 1, gi::ssdo::kMaxSamples,
+            "samples N per pixel (a specialization constant: the loop unrolls)", true),
         {"pattern_sets", SettingType::Int, 16, 1, gi::ssdo::kPhases,
          "M precomputed sample sets spread over the 4x4 pixel pattern (16: every phase its "
          "own set; the blur averages them)",
@@ -87,6 +97,20 @@ class SsdoEffect : public gi::Effect {
          true},
         {"blur_radius", SettingType::Int, 2, 0, gi::ssdo::kMaxBlurRadius,
          "geometry-aware blur radius in pixels (0: none; even radii cancel the 4x4 pattern)", true},
+        {"layers", SettingType::Int, 1, 1, gi::ssdo::kMaxLayers,
+         "depth layers (2: depth peeling, a sample is blocked only between the front and the "
+         "back layer: thin objects stop shadowing what is behind them)",
+         true},
+        {"cameras", SettingType::Int, 0, 0, gi::ssdo::kMaxCameras,
+         "additional low-resolution cameras (right, left, above, below the viewer, aimed at the "
+         "centre of interest) whose G-buffers add occluders and senders the main view misses",
+         true},
+        {"camera_resolution", SettingType::Float, 0.5, 0.125, 1.0,
+         "resolution of the additional cameras relative to the output", true},
+        {"camera_displacement", SettingType::Float, 0.5, 0.0, 4.0,
+         "distance of the additional cameras from the viewer, in radii of the scene's bounding "
+         "sphere",
+         false},
     };
   }
 
@@ -98,12 +122,12 @@ class SsdoEffect : public gi::Effect {
                img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
     bounce_ = settings.flag("bounce");
     senderShadows_ = settings.flag("sender_shadows");
+    samples_ = uint32_t(std::clamp(settings.integer("samples"), 1, gi::ssdo::kMaxSamples));
+    layers_ = uint32_t(std::clamp(settings.integer("layers"), 1, gi::ssdo::kMaxLayers));
+    cameras_ = uint32_t(std::clamp(settings.integer("cameras"), 0, gi::ssdo::kMaxCameras));
     buildSurface(ctx, lightMasks(ctx.lights()));
-    ssdo_ = gi::vk::Pipeline::compute(
-        vk, {std::begin(ssdo_comp), std::end(ssdo_comp)}, {{0, ubo}, {1, ubo}, {2, tex}, {3, img}},
-        0,
-        {uint32_t(std::clamp(settings.integer("samples"), 1, gi::ssdo::kMaxSamples)),
-         bounce_ ? 1u : 0u});
+    buildSsdo(ctx, environmentKind(ctx.frame()));
+    while (views_.size() < cameras_) views_.push_back(ctx.createView());
     const std::vector<uint32_t> radius = {
         uint32_t(std::clamp(settings.integer("blur_radius"), 0, gi::ssdo::kMaxBlurRadius))};
     blurX_ =
@@ -117,12 +141,52 @@ class SsdoEffect : public gi::Effect {
           gi::vk::Buffer(vk, sizeof(gi::ssdo::Uniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true);
   }
 
+  // The additional cameras (seed 000 §4): displaced from the viewer by camera_displacement x
+  // the scene's bounding radius (right, left, up, down in the viewer's frame), aimed at the
+  // centre of interest (the point of the view axis nearest the scene's centre), the viewer's
+  // projection, camera_resolution x its image.
+  void update(gi::EffectContext& ctx, const gi::SettingValues& s) override {
+    if (cameras_ == 0) return;
+    glm::vec3 lo, hi;
+    ctx.scene().bounds(lo, hi);
+    const glm::vec3 centre = 0.5f * (lo + hi);
+    float radius = 0.5f * glm::length(hi - lo);
+    if (!std::isfinite(radius) || radius <= 0.0f) radius = 1.0f;  // guard: degenerate bounds
+    const gi::CameraView& main = ctx.camera();
+    const glm::mat4 inv = glm::inverse(main.view);
+    const glm::vec3 eye(inv[3]), right = glm::normalize(glm::vec3(inv[0])),
+                                 up = glm::normalize(glm::vec3(inv[1])),
+                                 forward = -glm::normalize(glm::vec3(inv[2]));
+    // Guard: a centre behind (or at) the viewer puts the centre of interest one radius ahead.
+    float dist = glm::dot(centre - eye, forward);
+    if (!(dist > 1e-3f * radius)) dist = radius;
+    const glm::vec3 interest = eye + forward * dist;
+    const float shift = float(s.number("camera_displacement")) * radius;
+    const std::array<glm::vec3, 4> dirs = {right, -right, up, -up};
+    const VkExtent2D e = cameraExtent(ctx, s);
+    for (uint32_t c = 0; c < cameras_ && c < views_.size(); ++c) {
+      gi::CameraView cam = main;
+      cam.position = eye + dirs[c] * shift;
+      const glm::vec3 f = interest - cam.position;
+      // Guard: looking straight along the world's y, take z as the up vector.
+      const glm::vec3 worldUp = std::abs(glm::dot(glm::normalize(f), glm::vec3(0, 1, 0))) > 0.999f
+                                    ? glm::vec3(0, 0, 1)
+                                    : glm::vec3(0, 1, 0);
+      cam.view = glm::lookAt(cam.position, interest, worldUp);
+      views_[c]->setCamera(cam, e);
+    }
+  }
+
   void addPasses(gi::FrameGraph& graph, gi::EffectContext& ctx,
                  const gi::SettingValues& settings) override {
     struct Io {
       gi::TextureHandle depth, normal, albedo, material, emission, shadowMaps;
       gi::BufferHandle lights, shadowViews;
       gi::TextureHandle surface, raw, half, ambient, indirect;
+      gi::TextureHandle layer1;  // the peeled depth layer (layers 2)
+      // Per additional camera: its depth, G-buffer colours and surface texels.
+      std::vector<gi::TextureHandle> camDepth, camSurface;
+      std::vector<std::vector<gi::TextureHandle>> camG;
     };
     auto io = std::make_shared<Io>();
     gi::Blackboard& bb = graph.blackboard();
@@ -130,6 +194,97 @@ class SsdoEffect : public gi::Effect {
     const VkBuffer frame = ctx.frameUniforms();
     const VkSampler nearest = ctx.nearestSampler();
     const VkDescriptorType ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
+    gi::GpuScene& scene = ctx.scene();
+
+    if (layers_ > 1) {
+      // The second depth layer: the nearest surface strictly behind the G-buffer's depth.
+      graph.addPass(
+          "ssdo_peel",
+          [&](gi::PassBuilder& b) {
+            scene.declareRead(b);
+            io->depth = b.read(bb.texture(res::kDepth));
+            io->layer1 = b.write(b.create("ssdo_layer1", gi::TextureDesc{gi::kSceneDepthFormat}),
+                                 gi::TextureUsage::DepthAttachment);
+          },
+          [io, &scene, c = &ctx](gi::PassContext& pc) {
+            gi::SceneView v;
+            v.view = c->frame().view;  // exactly the G-buffer's camera
+            v.proj = c->frame().proj;
+            const gi::SceneTargets t{pc.view(io->layer1), {}, pc.extent(io->layer1)};
+            scene.drawDepthPeeled(pc, t, {&v, 1}, pc.view(io->depth));
+          });
+    }
+
+    if (cameras_ > 0) {
+      const VkExtent2D ce = cameraExtent(ctx, settings);
+      const uint32_t n = cameras_;
+      graph.addPass(
+          "ssdo_cameras",
+          [&](gi::PassBuilder& b) {
+            scene.declareRead(b);
+            auto target = [&](const std::string& name, VkFormat f, gi::TextureUsage u) {
+              return b.write(b.create(name, gi::TextureDesc{f, gi::SizeClass::Absolute, 1.0f,
+                                                            ce.width, ce.height}),
+                             u);
+            };
+            const auto formats = gi::sceneColorFormats(gi::SceneOutputs::GBuffer);
+            for (uint32_t c = 0; c < n; ++c) {
+              const std::string tag = "ssdo_camera" + std::to_string(c);
+              io->camDepth.push_back(
+                  target(tag + "_depth", gi::kSceneDepthFormat, gi::TextureUsage::DepthAttachment));
+              io->camG.emplace_back();
+              for (size_t i = 0; i < formats.size(); ++i)
+                io->camG.back().push_back(target(tag + "_g" + std::to_string(i), formats[i],
+                                                 gi::TextureUsage::ColorAttachment));
+            }
+          },
+          [this, io, &scene, n](gi::PassContext& pc) {
+            for (uint32_t c = 0; c < n; ++c) {
+              gi::SceneTargets t{pc.view(io->camDepth[c]), {}, pc.extent(io->camDepth[c])};
+              for (gi::TextureHandle g : io->camG[c]) t.colors.push_back(pc.view(g));
+              scene.drawGBuffer(pc, t, views_[c]->buffer());
+            }
+          });
+      // Their surface texels, as the main view's (one layer), through their own uniforms.
+      graph.addPass(
+          "ssdo_camera_surface",
+          [&](gi::PassBuilder& b) {
+            for (uint32_t c = 0; c < n; ++c) {
+              io->camDepth[c] = b.read(io->camDepth[c]);
+              for (gi::TextureHandle& g : io->camG[c]) g = b.read(g);
+              io->camSurface.push_back(
+                  b.write(b.create("ssdo_camera" + std::to_string(c) + "_surface",
+                                   gi::TextureDesc{kPackedFormat, gi::SizeClass::Absolute, 1.0f,
+                                                   ce.width, ce.height}),
+                          gi::TextureUsage::StorageWrite));
+            }
+            io->lights = b.read(bb.buffer(res::kLights));
+            io->shadowViews = b.read(bb.buffer(res::kShadowViews));
+            io->shadowMaps = b.read(bb.texture(res::kShadowMaps));
+          },
+          [this, io, values = &settings, nearest, ubo, n, c = &ctx](gi::PassContext& pc) {
+            upload(*values);
+            const auto masks = lightMasks(c->lights());
+            if (masks != surfaceMasks_) buildSurface(*c, masks);
+            for (uint32_t k = 0; k < n; ++k) {
+              const std::vector<gi::TextureHandle>& g = io->camG[k];
+              gi::vk::DescriptorWriter w;
+              w.buffer(0, ubo, views_[k]->buffer())
+                  .buffer(1, ubo, uniforms_.handle())
+                  .sampled(2, pc.view(io->camDepth[k]), nearest)
+                  .sampled(3, pc.view(g[0]), nearest)  // normal, albedo, material, emission
+                  .sampled(4, pc.view(g[1]), nearest)
+                  .sampled(5, pc.view(g[2]), nearest)
+                  .sampled(6, pc.view(g[3]), nearest)
+                  .buffer(7, ubo, pc.buffer(io->lights))
+                  .buffer(8, ubo, pc.buffer(io->shadowViews))
+                  .sampled(9, pc.view(io->shadowMaps), nearest)
+                  .storageImage(10, pc.view(io->camSurface[k]))
+                  .sampled(11, pc.view(io->camDepth[k]), nearest);  // unused: one layer
+              pc.dispatch(cameraSurface_, w, pc.extent(io->camSurface[k]), kGroupX, kGroupY);
+            }
+          });
+    }
 
     graph.addPass(
         "ssdo_surface",
@@ -142,6 +297,7 @@ class SsdoEffect : public gi::Effect {
           io->lights = b.read(bb.buffer(res::kLights));
           io->shadowViews = b.read(bb.buffer(res::kShadowViews));
           io->shadowMaps = b.read(bb.texture(res::kShadowMaps));
+          if (layers_ > 1) io->layer1 = b.read(io->layer1);
           io->surface = b.write(b.create("ssdo_surface", gi::TextureDesc{kPackedFormat}),
                                 gi::TextureUsage::StorageWrite);
         },
@@ -164,7 +320,9 @@ class SsdoEffect : public gi::Effect {
               .buffer(7, ubo, pc.buffer(io->lights))
               .buffer(8, ubo, pc.buffer(io->shadowViews))
               .sampled(9, pc.view(io->shadowMaps), nearest)
-              .storageImage(10, pc.view(io->surface));
+              .storageImage(10, pc.view(io->surface))
+              // The peeled layer (unused with one layer: the depth stands in).
+              .sampled(11, pc.view(layers_ > 1 ? io->layer1 : io->depth), nearest);
           const VkExtent2D e = pc.extent(io->surface);
           pc.dispatch(surface_, w, e, kGroupX, kGroupY);
         });
@@ -173,15 +331,20 @@ class SsdoEffect : public gi::Effect {
         "ssdo",
         [&](gi::PassBuilder& b) {
           io->surface = b.read(io->surface);
+          for (gi::TextureHandle& t : io->camSurface) t = b.read(t);
           io->raw = b.write(b.create("ssdo_raw", gi::TextureDesc{kPackedFormat}),
                             gi::TextureUsage::StorageWrite);
         },
-        [this, io, frame, nearest, ubo](gi::PassContext& pc) {
+        [this, io, frame, nearest, ubo, c = &ctx](gi::PassContext& pc) {
+          uploadCameras(c->frame());
           gi::vk::DescriptorWriter w;
           w.buffer(0, ubo, frame)
               .buffer(1, ubo, uniforms_.handle())
               .sampled(2, pc.view(io->surface), nearest)
               .storageImage(3, pc.view(io->raw));
+          for (uint32_t k = 0; k < gi::ssdo::kMaxCameras; ++k)
+            w.sampled(4 + k, pc.view(k < io->camSurface.size() ? io->camSurface[k] : io->surface),
+                      nearest);
           pc.dispatch(ssdo_, w, pc.extent(io->raw), kGroupX, kGroupY);
         });
 
@@ -240,31 +403,63 @@ class SsdoEffect : public gi::Effect {
     const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
                tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
                img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-    ssdo_ = gi::vk::Pipeline::compute(ctx.vulkan(), {std::begin(ssdo_comp), std::end(ssdo_comp)},
-                                      {{0, ubo}, {1, ubo}, {2, tex}, {3, img}}, 0,
-                                      {samples_, bounce_ ? 1u : 0u, kind});
+    ssdo_ = gi::vk::Pipeline::compute(
+        ctx.vulkan(), {std::begin(ssdo_comp), std::end(ssdo_comp)},
+        {{0, ubo}, {1, ubo}, {2, tex}, {3, img}, {4, tex}, {5, tex}, {6, tex}, {7, tex}}, 0,
+        {samples_, bounce_ ? 1u : 0u, kind, layers_, cameras_});
     environmentKind_ = kind;
   }
 
+  // The surface pipelines of the main view (with its layers) and of the additional cameras
+  // (one layer), specialized to the light types present.
   void buildSurface(gi::EffectContext& ctx, std::array<uint32_t, 2> masks) {
     const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
                tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
                img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-    surface_ = gi::vk::Pipeline::compute(
-        ctx.vulkan(), {std::begin(ssdo_surface_comp), std::end(ssdo_surface_comp)},
-        {{0, ubo},
-         {1, ubo},
-         {2, tex},
-         {3, tex},
-         {4, tex},
-         {5, tex},
-         {6, tex},
-         {7, ubo},
-         {8, ubo},
-         {9, tex},
-         {10, img}},
-        0, {bounce_ ? 1u : 0u, masks[0], senderShadows_ ? masks[1] : 0u});
+    auto build = [&](uint32_t layers) {
+      return gi::vk::Pipeline::compute(
+          ctx.vulkan(), {std::begin(ssdo_surface_comp), std::end(ssdo_surface_comp)},
+          {{0, ubo},
+           {1, ubo},
+           {2, tex},
+           {3, tex},
+           {4, tex},
+           {5, tex},
+           {6, tex},
+           {7, ubo},
+           {8, ubo},
+           {9, tex},
+           {10, img},
+           {11, tex}},
+          0, {bounce_ ? 1u : 0u, masks[0], senderShadows_ ? masks[1] : 0u, layers});
+    };
+    surface_ = build(layers_);
+    if (cameras_ > 0) cameraSurface_ = build(1);
     surfaceMasks_ = masks;
+  }
+
+  VkExtent2D cameraExtent(gi::EffectContext& ctx, const gi::SettingValues& s) const {
+    const VkExtent2D e = ctx.outputExtent();
+    const double k = std::clamp(s.number("camera_resolution"), 0.125, 1.0);
+    return {std::max(1u, uint32_t(std::lround(e.width * k))),
+            std::max(1u, uint32_t(std::lround(e.height * k)))};
+  }
+
+  // The additional cameras' transforms and projections of this frame, into the uniforms.
+  void uploadCameras(const gi::FrameUniforms& main) {
+    if (cameras_ == 0) return;
+    std::array<gi::ssdo::Camera, gi::ssdo::kMaxCameras> cams{};
+    for (uint32_t c = 0; c < cameras_ && c < views_.size(); ++c) {
+      const gi::FrameUniforms& v = views_[c]->current();
+      const glm::mat4 to = v.view * main.invView, from = glm::inverse(to);
+      std::memcpy(cams[c].toCamera, glm::value_ptr(to), sizeof cams[c].toCamera);
+      std::memcpy(cams[c].fromCamera, glm::value_ptr(from), sizeof cams[c].fromCamera);
+      const float p[4] = {v.proj[0][0], v.proj[1][1], v.proj[2][0], v.proj[2][1]};
+      std::memcpy(cams[c].proj, p, sizeof p);
+      const float sz[4] = {v.viewport.x, v.viewport.y, v.viewport.z, v.viewport.w};
+      std::memcpy(cams[c].size, sz, sizeof sz);
+    }
+    uniforms_.write(cams.data(), sizeof cams, offsetof(gi::ssdo::Uniforms, cameras));
   }
 
   // Host-visible, written while recording: the renderer waits for each frame before it records
@@ -296,10 +491,11 @@ class SsdoEffect : public gi::Effect {
     vkCmdPipelineBarrier2(cmd, &dep);
   }
 
-  gi::vk::Pipeline surface_, ssdo_, blurX_, resolve_;
+  gi::vk::Pipeline surface_, cameraSurface_, ssdo_, blurX_, resolve_;
   gi::vk::Buffer uniforms_;
+  std::vector<std::shared_ptr<gi::ViewUniforms>> views_;  // the additional cameras
   bool bounce_ = true, senderShadows_ = true;
-  uint32_t samples_ = 12, environmentKind_ = 0;
+  uint32_t samples_ = 12, environmentKind_ = 0, layers_ = 1, cameras_ = 0;
   std::array<uint32_t, 2> surfaceMasks_{7, 7};
   std::optional<std::array<double, 5>> uploaded_;
 };

@@ -3,15 +3,25 @@
 //
 // "ssdo_surface" texel (RGBA32UI), written by ssdo_surface.comp, read once per tap by ssdo.comp:
 //   x 1 / view distance (float bits; 0: sky or no geometry), y view normal (octahedral,
-//   snorm 16x2), z, w the sender's outgoing radiance (half rg, half b).
+//   snorm 16x2), z, w the sender's outgoing radiance (half rg, half b) and, with depth peeling,
+//   w's high half the 1 / view distance of the second depth layer (half; 0: none).
 // Raw / x-blurred texel (RGBA32UI), written by ssdo.comp and the x blur, read by the blur:
 //   x directional term (rgb9e5), y bounce term (rgb9e5), z 1 / view distance, w view normal.
 #ifndef SSDO_COMMON_GLSL
 #define SSDO_COMMON_GLSL
 
+// An additional camera (seed 000 §4): its view space relative to the main one and its image.
+struct SsdoCamera {
+  mat4 toCamera;    // main view space -> this camera's view space
+  mat4 fromCamera;  // its inverse
+  vec4 proj;        // p00, p11, p20, p21 of its (perspective, reverse-Z) projection
+  vec4 size;        // width, height, 1 / width, 1 / height of its image
+};
+
 layout(set = 0, binding = 1, std140) uniform SsdoParams {
   vec4 params;      // R, bias (world), bounce scale A_s / pi, d_min^2
   vec4 blur;        // plane tolerance (world), min normal cosine
+  SsdoCamera cameras[4];  // the `cameras` first are valid (gi::ssdo::kMaxCameras)
   uvec4 samples[128];  // [phase][i] at flat phase * 32 + i (gi::ssdo::pack)
 } ssdo;
 

@@ -33,6 +33,18 @@ inline constexpr float kBias = 0.025f;
 inline constexpr float kBlurPlaneTolerance = 0.25f;
 inline constexpr float kBlurMinCos = 0.8f;
 
+inline constexpr int kMaxLayers = 2;   // depth layers: the front one and one peeled
+inline constexpr int kMaxCameras = 4;  // additional cameras
+
+// std140 mirror of `SsdoCamera` in ssdo_common.glsl (column-major matrices).
+struct Camera {
+  float toCamera[16];    // main view space -> the camera's view space
+  float fromCamera[16];  // its inverse
+  float proj[4];         // p00, p11, p20, p21
+  float size[4];         // width, height, 1 / width, 1 / height
+};
+static_assert(sizeof(Camera) == 160, "std140 layout");
+
 // std140 mirror of `SsdoParams` in ssdo_common.glsl.
 struct Uniforms {
   float radius;          // R, world units
@@ -42,9 +54,11 @@ struct Uniforms {
   float blurTolerance;   // absolute (kBlurPlaneTolerance x R)
   float blurMinCos;
   float pad[2];
+  Camera cameras[kMaxCameras];                     // written every frame by the plugin
   uint32_t samples[kPhases * kMaxSamples / 4][4];  // [phase][i] at flat phase * kMaxSamples + i
 };
-static_assert(sizeof(Uniforms) == 32 + kPhases * kMaxSamples * 4, "std140 layout");
+static_assert(sizeof(Uniforms) == 32 + kMaxCameras * 160 + kPhases * kMaxSamples * 4,
+              "std140 layout");
 
 inline double radicalInverse(uint32_t i, uint32_t base) {
   double inv = 1.0 / base, f = inv, r = 0.0;

@@ -14,6 +14,8 @@ layout(local_size_x = 32, local_size_y = 16) in;
 layout(constant_id = 0) const bool kBounce = true;
 layout(constant_id = 1) const int kLightTypes = 7;   // bit mask: 1 directional, 2 point, 4 spot
 layout(constant_id = 2) const int kShadowTypes = 7;  // the same for shadowed lights
+// Depth layers (1 or 2): with 2, the peeled layer's 1 / view distance goes into the texel.
+layout(constant_id = 3) const int kLayers = 1;
 #define GI_LIGHT_TYPES kLightTypes
 #define GI_SHADOW_TYPES kShadowTypes
 #define GI_PCF_RADIUS 0
@@ -31,6 +33,7 @@ layout(set = 0, binding = 6) uniform sampler2D gEmission;
 #define GI_SHADOW_MAPS_BINDING 9
 #include "lights.glsl"
 layout(set = 0, binding = 10, rgba32ui) uniform writeonly uimage2D outSurface;
+layout(set = 0, binding = 11) uniform sampler2D gLayer1;  // the peeled layer (kLayers 2)
 
 void main() {
   ivec2 p = ivec2(gl_GlobalInvocationID.xy);
@@ -72,7 +75,16 @@ void main() {
     radiance = vec3(isnan(radiance.r) ? 0.0 : radiance.r, isnan(radiance.g) ? 0.0 : radiance.g,
                     isnan(radiance.b) ? 0.0 : radiance.b);
   }
+  // The second layer (GpuScene::drawDepthPeeled: strictly behind the first), as a half float:
+  // 2^-11 relative, enough to tell a sample inside a solid from one behind it. Guard: none
+  // there, or beyond the half range, reads 0 (no interval: the one-layer test).
+  float iz1 = 0.0;
+  if (kLayers > 1) {
+    float d1 = texelFetch(gLayer1, p, 0).r;
+    iz1 = abs(p32) > 1e-30 ? (d1 + p22) / p32 : 0.0;
+    iz1 = geometry && d1 > 0.0 && iz1 > 0.0 && iz1 < 65000.0 ? iz1 : 0.0;
+  }
   imageStore(outSurface, p,
              uvec4(floatBitsToUint(iz), packNormal(n), packHalf2x16(radiance.rg),
-                   packHalf2x16(vec2(radiance.b, 0.0))));
+                   packHalf2x16(vec2(radiance.b, iz1))));
 }

@@ -19,7 +19,7 @@
 
 // Bumped whenever this header, settings.h, frame_graph.h or the shader interface change in a
 // way that breaks compiled modules; the registry refuses modules built against another value.
-#define GI_EFFECT_ABI_VERSION 5u
+#define GI_EFFECT_ABI_VERSION 6u
 
 namespace gi {
 
@@ -90,6 +90,10 @@ struct EstimatedQuantity {
   // Alchemy (seed 003 eq. 10): falloff g(t) = sigma t / (max(u^2, t^2) + epsilon).
   double sigma = 1.0, u = 0.0, epsilon = 1e-4, contrast = 1.0;
 };
+// "obscurance(r=0.5, membership=linear)", "alchemy(r=0.5, sigma=1, u=0, epsilon=0.0001,
+// contrast=1)", "ao(r=0.5)", "direct light", "direct+indirect light": the parameters the kind
+// uses, nothing else (gi-render --list-effects, reports).
+std::string describe(const EstimatedQuantity& q);
 
 // Camera uniforms of an extra view (EffectContext::createView): a FrameUniforms buffer the engine
 // refreshes every frame (time, environment, light count from the main view) with this view's

@@ -32,6 +32,9 @@ struct Preset {
 // Folders searched for presets by name: $GI_PRESET_PATH (':'-separated), then
 // <executable dir>/../share/gi/presets (the build tree and installs both have it).
 std::vector<std::string> presetLocations();
+// The names of every preset found there (an earlier folder's file hides a later one's of the
+// same name), sorted.
+std::vector<std::string> presetNames();
 // `nameOrPath`: a preset name ("medium") or a .json path. Throws gi::Error naming the file.
 Preset loadPreset(const std::string& nameOrPath);
 // The preset in `text` (the contents of the file `path`, named in errors); what loadPreset

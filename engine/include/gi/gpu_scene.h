@@ -114,6 +114,14 @@ class GpuScene {
   // sees all the light's output onto a white surface sums to the light's power.
   virtual void drawRsm(PassContext& pc, const SceneTargets& targets, const SceneView& view,
                        const LightInfo& light) = 0;
+  // Layered depth (depth peeling, Everitt 2001): as drawDepth, keeping only the fragments
+  // strictly behind `previous` at their pixel (reverse-Z depth below it by more than a relative
+  // 2^-20, so the layer before is never drawn again; sky 0 keeps nothing), so that drawing layer
+  // k+1 against layer k gives the nearest surface behind it. `previous` is a D32 view of the
+  // layer before (the main "depth", or the last peeled layer) with the targets' extent, drawn
+  // with the same views, read with texelFetch; the pass declares it a Sampled read.
+  virtual void drawDepthPeeled(PassContext& pc, const SceneTargets& targets,
+                               std::span<const SceneView> views, VkImageView previous) = 0;
 };
 
 }  // namespace gi

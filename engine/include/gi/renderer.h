@@ -4,6 +4,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -104,8 +105,12 @@ class Renderer {
 
   ImageRGBA8 readOutput();                           // tonemapped 8-bit image (view "output")
   ImageRGBA32F readTarget(const std::string& name);  // any produced resource as float RGBA
-  std::vector<std::string> viewNames() const;        // resources that can be viewed / read
+  std::vector<std::string> viewNames() const;        // images that can be viewed / read
   const CameraView& camera() const;
+  // A free camera (gi-demo's) in place of the scene's: `view` (rigid), `position`, `yfov`,
+  // `znear`, `zfar` are kept; `proj` is rebuilt for the output's aspect (also on resize).
+  // nullopt returns to the scene's camera. Lights and shadow views are re-planned for it.
+  void setCameraOverride(const std::optional<CameraView>& camera);
   // The tonemapped RGBA8 image; after renderFrame() it is in VK_IMAGE_LAYOUT_GENERAL and all
   // writes are complete (a presenter copies it into a swapchain image).
   VkImage outputImage() const;

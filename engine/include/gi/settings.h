@@ -31,12 +31,18 @@ struct SettingDesc {
   // A length in world units (Float): for a model loaded without a scene file its default is
   // scaled by the model's size (Scene::lengthScale), so an AO radius fits a bunny or a city.
   bool worldLength = false;
+  // A count of samples (taps, directions, steps, slices...) on an Int: more costs more time
+  // and buys accuracy. gi-bench --calibrate searches powers of two of these; UIs may group them.
+  bool sampleCount = false;
 
   static SettingDesc enumeration(std::string name, std::vector<std::string> options,
                                  int defaultIndex, std::string help, bool changesGraph = false);
   // A Float length in world units (worldLength set).
   static SettingDesc length(std::string name, double def, double min, double max, std::string help,
                             bool changesGraph = false);
+  // An Int count of samples (sampleCount set).
+  static SettingDesc samples(std::string name, int def, int min, int max, std::string help,
+                             bool changesGraph = false);
   static SettingDesc vec3(std::string name, std::array<double, 3> def, double min, double max,
                           std::string help, bool changesGraph = false);
   static SettingDesc color(std::string name, std::array<double, 3> def, std::string help,

@@ -168,6 +168,29 @@ SettingValues EffectRegistry::defaultSettings(const std::string& name) const {
   return SettingValues(e.info.name, e.settings);
 }
 
+std::string describe(const EstimatedQuantity& q) {
+  auto num = [](double v) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%g", v);
+    return std::string(b);
+  };
+  using K = EstimatedQuantity::Kind;
+  switch (q.kind) {
+    case K::AmbientOcclusion:
+      return "ao(r=" + num(q.radius) + ")";
+    case K::Obscurance:
+      return "obscurance(r=" + num(q.radius) + ", membership=" + q.membership + ")";
+    case K::Alchemy:
+      return "alchemy(r=" + num(q.radius) + ", sigma=" + num(q.sigma) + ", u=" + num(q.u) +
+             ", epsilon=" + num(q.epsilon) + ", contrast=" + num(q.contrast) + ")";
+    case K::DirectLight:
+      return "direct light";
+    case K::DirectIndirect:
+      return "direct+indirect light";
+  }
+  return "unknown";
+}
+
 std::string EffectRegistry::describe() const {
   std::ostringstream s;
   if (entries_.empty()) s << "no effects found (searched:";
@@ -189,6 +212,10 @@ std::string EffectRegistry::describe() const {
       << (e.info.estimates == GroundTruth::AmbientOcclusion ? "ambient occlusion"
           : e.info.estimates == GroundTruth::IndirectLight  ? "indirect light"
                                                             : "direct light")
+      << "\n";
+    // What its output is exactly, at its default settings (gi-bench's declared quantity).
+    s << "  declares at its defaults: "
+      << gi::describe(e.factory()->estimatedQuantity(SettingValues(e.info.name, e.settings)))
       << "\n";
     s << describeSettings(name, e.settings);
   }

@@ -31,6 +31,17 @@ std::vector<std::string> presetLocations() {
   return dirs;
 }
 
+std::vector<std::string> presetNames() {
+  std::set<std::string> names;
+  for (const std::string& dir : presetLocations()) {
+    std::error_code ec;
+    for (const auto& e : fs::directory_iterator(dir, ec))
+      if (e.path().extension() == ".json" && e.is_regular_file(ec))
+        names.insert(e.path().stem().string());
+  }
+  return {names.begin(), names.end()};
+}
+
 namespace {
 
 std::string findPreset(const std::string& nameOrPath) {
@@ -69,8 +80,13 @@ Preset parsePreset(std::string_view text, const std::string& path) {
     throw Error(ErrorKind::EmptyFile, p.path, "preset file is empty");
   const json j = parseJsonText(text, p.path);
   if (!j.is_object()) throw Error(ErrorKind::Schema, p.path, "a preset must be a JSON object");
-  onlyKeys(j, {"name", "description", "platform", "target_ms", "reference_resolution", "effects"},
+  // "calibration": gi-bench --calibrate's record of its search (read by people, not here).
+  onlyKeys(j,
+           {"name", "description", "platform", "target_ms", "reference_resolution", "effects",
+            "calibration"},
            "", p.path);
+  if (j.contains("calibration") && !j["calibration"].is_object())
+    throw Error(ErrorKind::Schema, p.path, "calibration: expected an object");
   auto str = [&](const char* key, std::string& out) {
     if (!j.contains(key)) return;
     if (!j[key].is_string())

@@ -129,6 +129,7 @@ struct Renderer::Impl : EffectContext {
   const Scene& source;  // the scene as loaded (scene() is the GPU service)
   const EffectRegistry* registry;
   CameraView cameraView;
+  std::optional<CameraView> cameraOverride;  // a free camera instead of the scene's
   std::unique_ptr<SceneGpu> sceneGpu;
   LightSetup lightSetup;
   std::unique_ptr<EnvironmentGpu> environment;
@@ -217,6 +218,14 @@ struct Renderer::Impl : EffectContext {
   }
 
   float aspect() const { return float(settings.width) / float(settings.height); }
+  // The free camera when one is set, else the scene's (posed when animated).
+  CameraView currentCamera() const {
+    if (!cameraOverride)
+      return activeCamera(source.activeCameraNode >= 0 ? sceneGpu->pose() : source, aspect());
+    CameraView v = *cameraOverride;
+    v.proj = perspectiveReverseZ(v.yfov, aspect(), v.znear, v.zfar);
+    return v;
+  }
   std::vector<Effect*> builtins() const {
     return {skinningPass.get(), gbufferPass.get(), surfacePointsPass.get(), shadowPass.get(),
             lightingPass.get(), tonemapPass.get(), floorPass.get()};
@@ -307,7 +316,7 @@ struct Renderer::Impl : EffectContext {
     sceneGpu->setTime(seconds);
     // Animated cameras and lights. The motion vectors compare with the camera of the last
     // rendered frame (renderFrame keeps it); before the first frame nothing moved.
-    if (source.activeCameraNode >= 0) cameraView = activeCamera(sceneGpu->pose(), aspect());
+    if (source.activeCameraNode >= 0 || cameraOverride) cameraView = currentCamera();
     if (framesRendered == 0) prevViewProj = cameraView.proj * cameraView.view;
     updateLights();
   }
@@ -632,7 +641,7 @@ struct Renderer::Impl : EffectContext {
   // Size-dependent state: the output image, the camera's aspect, motion history.
   void resize() {
     output = makeOutputImage(ctx, settings.width, settings.height);
-    cameraView = activeCamera(source.activeCameraNode >= 0 ? sceneGpu->pose() : source, aspect());
+    cameraView = currentCamera();
     prevViewProj = cameraView.proj * cameraView.view;
     for (const auto& v : views)
       if (auto view = v.lock()) view->forgetHistory();
@@ -766,12 +775,27 @@ bool Renderer::graphRecompiledByLastChange() const {
 const CameraView& Renderer::camera() const {
   return impl_->cameraView;
 }
+void Renderer::setCameraOverride(const std::optional<CameraView>& camera) {
+  if (camera && !(camera->znear > 0.0f && camera->zfar > camera->znear && camera->yfov > 0.0f &&
+                  camera->yfov < 3.14f))
+    throw Error(ErrorKind::InvalidData, "",
+                "camera override: needs 0 < znear < zfar and a vertical fov in (0, 3.14)");
+  impl_->cameraOverride = camera;
+  impl_->cameraView = impl_->currentCamera();
+  if (impl_->framesRendered == 0)
+    impl_->prevViewProj = impl_->cameraView.proj * impl_->cameraView.view;
+  impl_->updateLights();
+}
 ImageRGBA32F Renderer::readTarget(const std::string& name) {
   const FrameGraph::TextureState t = impl_->stateOf(name);
   return texelsToFloat(readTexels(impl_->ctx, t), t, name);
 }
 std::vector<std::string> Renderer::viewNames() const {
-  return impl_->graph.blackboard().names();
+  // Images only: a buffer (lights, sampling tables) can be neither shown nor read back.
+  std::vector<std::string> names;
+  for (const std::string& n : impl_->graph.blackboard().names())
+    if (impl_->graph.blackboard().texture(n).valid()) names.push_back(n);
+  return names;
 }
 VkImage Renderer::outputImage() const {
   return impl_->output.handle();

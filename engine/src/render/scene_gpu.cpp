@@ -311,6 +311,13 @@ void SceneGpu::createPipelines() {
   d.depthFormat = kSceneDepthFormat;
   depthPipeline_ = Pipeline::graphics(ctx_, d);
 
+  // Depth peeling: the depth draw whose fragments not behind the previous layer are discarded.
+  GraphicsDesc peel = d;
+  peel.fragment = loadSpirv("scene_depth_peel.frag");
+  peel.bindings = {{0, ubo}, {1, tex}};
+  peelPipeline_ = Pipeline::graphics(ctx_, peel);
+  nearestClamp_ = Sampler(ctx_, VK_FILTER_NEAREST, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE);
+
   GraphicsDesc r = g;
   r.vertex = loadSpirv("scene_rsm.vert");
   r.fragment = loadSpirv("scene_rsm.frag");
@@ -592,6 +599,28 @@ void SceneGpu::drawDepth(PassContext& pc, const SceneTargets& t, std::span<const
     pc.descriptors().bind(c, depthPipeline_, w);
     for (const SceneDrawItem& d : draws_) {
       pushDraw(c, depthPipeline_, d, true);
+      vkCmdDrawIndexed(c, d.indexCount, 1, d.firstIndex, d.vertexOffset, 0);
+    }
+  }
+  vkCmdEndRendering(c);
+}
+
+void SceneGpu::drawDepthPeeled(PassContext& pc, const SceneTargets& t,
+                               std::span<const SceneView> views, VkImageView previous) {
+  if (previous == VK_NULL_HANDLE)
+    throw Error(ErrorKind::Usage, "", "GpuScene::drawDepthPeeled: no previous depth layer");
+  VkCommandBuffer c = pc.cmd();
+  beginRendering(pc, t, 0);
+  if (!draws_.empty()) bindGeometry(c);
+  for (const SceneView& v : views) {
+    const VkDescriptorBufferInfo slot = viewSlot(v, nullptr, t.extent);
+    setViewport(c, v, t.extent);
+    DescriptorWriter w;
+    w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, slot.buffer, slot.offset, slot.range)
+        .sampled(1, previous, nearestClamp_.handle());
+    pc.descriptors().bind(c, peelPipeline_, w);
+    for (const SceneDrawItem& d : draws_) {
+      pushDraw(c, peelPipeline_, d, true);
       vkCmdDrawIndexed(c, d.indexCount, 1, d.firstIndex, d.vertexOffset, 0);
     }
   }

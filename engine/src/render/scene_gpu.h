@@ -36,6 +36,8 @@ class SceneGpu final : public GpuScene {
   void drawGBuffer(PassContext& pc, const SceneTargets& targets, VkBuffer viewUniforms) override;
   void drawRsm(PassContext& pc, const SceneTargets& targets, const SceneView& view,
                const LightInfo& light) override;
+  void drawDepthPeeled(PassContext& pc, const SceneTargets& targets,
+                       std::span<const SceneView> views, VkImageView previous) override;
 
   // The deformed vertices' current version in the graph being built (invalid: no skinning
   // pass), which declareRead() makes passes read.
@@ -100,7 +102,8 @@ class SceneGpu final : public GpuScene {
   vk::Image whiteTexture_;
   vk::Sampler linearRepeat_;
   mutable std::map<int, std::vector<std::pair<glm::vec3, glm::vec3>>> morphBounds_;
-  vk::Pipeline gbufferPipeline_, depthPipeline_, rsmPipeline_;
+  vk::Pipeline gbufferPipeline_, depthPipeline_, peelPipeline_, rsmPipeline_;
+  vk::Sampler nearestClamp_;  // the peeled layer's previous depth (texelFetch)
   // Per-view uniform slots of drawDepth/drawRsm, host-visible, recycled every frame.
   std::vector<vk::Buffer> viewChunks_;
   size_t viewSlotsUsed_ = 0;

@@ -58,6 +58,20 @@ SettingDesc SettingDesc::length(std::string name, double def, double min, double
   return d;
 }
 
+SettingDesc SettingDesc::samples(std::string name, int def, int min, int max, std::string help,
+                                 bool changesGraph) {
+  SettingDesc d;
+  d.name = std::move(name);
+  d.type = SettingType::Int;
+  d.defaultValue = def;
+  d.minValue = min;
+  d.maxValue = max;
+  d.help = std::move(help);
+  d.changesGraph = changesGraph;
+  d.sampleCount = true;
+  return d;
+}
+
 SettingDesc SettingDesc::vec3(std::string name, std::array<double, 3> def, double min, double max,
                               std::string help, bool changesGraph) {
   SettingDesc d;
@@ -156,6 +170,7 @@ void checkDesc(const SettingDesc& d) {
     fail("range [" + num(d.minValue) + ", " + num(d.maxValue) + "] is empty or not finite");
   if (d.logScale && !(d.minValue > 0)) fail("logScale needs min > 0");
   if (d.worldLength && d.type != SettingType::Float) fail("worldLength needs a float setting");
+  if (d.sampleCount && d.type != SettingType::Int) fail("sampleCount needs an int setting");
   auto inRange = [&](double v) { return std::isfinite(v) && d.minValue <= v && v <= d.maxValue; };
   if (isVector(d.type)) {
     for (size_t i = 0; i < 3; ++i)
@@ -402,6 +417,7 @@ std::string describeSettings(const std::string& owner, const std::vector<Setting
     if (d.step > 0) s << ", step " << d.step;
     if (d.logScale) s << ", log scale";
     if (d.worldLength) s << ", world length (a bare model scales the default)";
+    if (d.sampleCount) s << ", sample count";
     s << (d.changesGraph ? ", changes the graph" : ", uniform only") << "): " << d.help << "\n";
   }
   return s.str();

@@ -1,5 +1,5 @@
-// The window of `gi-render --window`: opens it with GLFW (or says why there is no display) and
-// tells the frame loop when the user has closed it.
+// The window of `gi-render --window` and gi-demo: opens it with GLFW (or says why there is no
+// display) and tells the frame loop when the user has closed it.
 #pragma once
 
 #include <cstdint>

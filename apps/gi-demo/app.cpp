@@ -1,0 +1,414 @@
+#include "app.h"
+
+#include <GLFW/glfw3.h>
+#include <imgui.h>
+#include <imgui_impl_glfw.h>
+#include <imgui_impl_vulkan.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+#include <thread>
+
+#include "gi/errors.h"
+#include "gi/image_io.h"
+#include "gi/scene_io.h"
+
+namespace demo {
+
+namespace {
+
+constexpr double kScriptStep = 1.0 / 30.0;  // seconds per scripted frame: reproducible runs
+
+double ms(std::chrono::steady_clock::duration d) {
+  return std::chrono::duration<double, std::milli>(d).count();
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+}  // namespace
+
+// Dear ImGui's context and GLFW backend (before the Vulkan backend, gone after it).
+struct App::ImguiContext {
+  explicit ImguiContext(GLFWwindow* window) {
+    IMGUI_CHECKVERSION();
+    ImGui::CreateContext();
+    ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini left in the working directory
+    ImGui::StyleColorsDark();
+    ImGui_ImplGlfw_InitForVulkan(window, true);
+  }
+  ~ImguiContext() {
+    ImGui_ImplGlfw_Shutdown();
+    ImGui::DestroyContext();
+  }
+};
+
+App::App(const AppOptions& o) : options_(o) {
+  // Everything that can be wrong with the input fails before a window opens.
+  scene_ = gi::loadScene(o.scene);
+  for (const std::string& w : scene_.warnings)
+    std::fprintf(stderr, "gi-demo: warning: %s\n", w.c_str());
+  registry_.scanDefaultLocations();
+  if (!o.script.empty()) script_ = loadScript(o.script);
+
+  window_ =
+      std::make_unique<AppWindow>(o.controller.width, o.controller.height, "gi-demo: " + o.scene);
+  gi::vk::ContextOptions ctxOptions = o.context;
+  ctxOptions.instanceExtensions = AppWindow::instanceExtensions();
+  ctxOptions.swapchain = true;
+  ctx_ = std::make_unique<gi::vk::Context>(ctxOptions);
+  // The renderer draws at the window's framebuffer size (HiDPI may differ from the request).
+  ControllerOptions co = o.controller;
+  int w = 0, h = 0;
+  glfwGetFramebufferSize(window_->handle(), &w, &h);
+  if (w > 0 && h > 0) co.width = uint32_t(w), co.height = uint32_t(h);
+  controller_ = std::make_unique<Controller>(*ctx_, scene_, registry_, co);
+  imgui_ = std::make_unique<ImguiContext>(window_->handle());
+  presenter_ = std::make_unique<Presenter>(*ctx_, window_->handle());
+
+  glm::vec3 lo, hi;
+  scene_.worldBounds(lo, hi);
+  camera_ = std::make_unique<FreeCamera>(controller_->renderer().camera(), o.floor.value_or(lo.y));
+  state_.time = o.time;
+  state_.paused = o.paused;
+  glfwGetCursorPos(window_->handle(), &lastX_, &lastY_);
+  last_ = std::chrono::steady_clock::now();
+}
+
+App::~App() {
+  presenter_.reset();  // the Vulkan backend before ImGui's context
+  imgui_.reset();
+  preview_.reset();
+  controller_.reset();
+}
+
+int App::run() {
+  int rendered = 0;
+  while (!window_->closed()) {
+    if (!script_.empty()) {
+      if (!advanceScript()) break;
+    } else if (options_.frames > 0 && rendered >= options_.frames) {
+      break;
+    }
+    frame();
+    ++rendered;
+  }
+  ctx_->savePipelineCache();
+  if (ctx_->validationErrors() > 0) {
+    std::fprintf(stderr, "gi-demo: error: %u Vulkan validation error(s)\n",
+                 ctx_->validationErrors());
+    return 3;
+  }
+  return 0;
+}
+
+CameraInput App::readInput() {
+  CameraInput in;
+  GLFWwindow* w = window_->handle();
+  const ImGuiIO& io = ImGui::GetIO();
+  double x = 0, y = 0;
+  glfwGetCursorPos(w, &x, &y);
+  if (!io.WantCaptureMouse && glfwGetMouseButton(w, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS) {
+    in.lookX = float(x - lastX_);
+    in.lookY = float(y - lastY_);
+  }
+  lastX_ = x, lastY_ = y;
+  if (io.WantCaptureKeyboard) return in;
+  auto down = [&](int key) { return glfwGetKey(w, key) == GLFW_PRESS ? 1.0f : 0.0f; };
+  in.forward = down(GLFW_KEY_W) - down(GLFW_KEY_S);
+  in.right = down(GLFW_KEY_D) - down(GLFW_KEY_A);
+  in.up = down(GLFW_KEY_E) - down(GLFW_KEY_Q);
+  in.fast = down(GLFW_KEY_LEFT_SHIFT) + down(GLFW_KEY_RIGHT_SHIFT) > 0;
+  in.slow = down(GLFW_KEY_LEFT_CONTROL) + down(GLFW_KEY_RIGHT_CONTROL) > 0;
+  return in;
+}
+
+// One-shot keys (ImGui 1.86 indexes keys by the GLFW key code).
+void App::handleKeys() {
+  if (ImGui::GetIO().WantCaptureKeyboard) return;
+  if (ImGui::IsKeyPressed(GLFW_KEY_P, false)) state_.paused = !state_.paused;
+  if (ImGui::IsKeyPressed(GLFW_KEY_N)) state_.stepOnce = true;
+  if (ImGui::IsKeyPressed(GLFW_KEY_F2, false)) state_.screenshot = true;
+  if (ImGui::IsKeyPressed(GLFW_KEY_R, false))
+    for (const std::string& e : controller_->effects())
+      if (controller_->enabled(e)) {
+        state_.accuracyRequest = e;
+        break;
+      }
+  if (ImGui::IsKeyPressed(GLFW_KEY_F1, false)) state_.help = !state_.help;
+  if (ImGui::IsKeyPressed(GLFW_KEY_TAB, false)) state_.panel = !state_.panel;
+  if (ImGui::IsKeyPressed(GLFW_KEY_ESCAPE, false))
+    glfwSetWindowShouldClose(window_->handle(), GLFW_TRUE);
+}
+
+void App::frame() {
+  const auto start = std::chrono::steady_clock::now();
+  const double wallDt = std::min(std::chrono::duration<double>(start - last_).count(), 0.1);
+  last_ = start;
+  const double dt = script_.empty() ? wallDt : kScriptStep;
+  gi::Renderer& renderer = controller_->renderer();
+
+  // The renderer follows the window's size.
+  int w = 0, h = 0;
+  glfwGetFramebufferSize(window_->handle(), &w, &h);
+  const VkExtent2D size = renderer.outputExtent();
+  if (w > 0 && h > 0 && (uint32_t(w) != size.width || uint32_t(h) != size.height))
+    controller_->resize(uint32_t(w), uint32_t(h));
+
+  CameraInput input = script_.empty() ? readInput() : held_;
+  input.lookX += lookX_;
+  input.lookY += lookY_;
+  lookX_ = lookY_ = 0;
+  // The scene's own camera until the user moves: an untouched view equals gi-render's.
+  if (camera_->update(input, float(dt)) || cameraMoved_) {
+    renderer.setCameraOverride(camera_->view());
+    cameraMoved_ = false;
+  }
+  if (!state_.paused || state_.stepOnce) state_.time += dt;
+  state_.stepOnce = false;
+  renderer.setTime(state_.time);
+  renderer.renderFrame();
+  stats_.passes = renderer.lastTimings();
+  stats_.deviceBytes = ctx_->allocator().bytesInUse();
+
+  const auto uiStart = std::chrono::steady_clock::now();
+  ImGui_ImplVulkan_NewFrame();
+  ImGui_ImplGlfw_NewFrame();
+  ImGui::NewFrame();
+  if (script_.empty()) handleKeys();
+  drawPanel(*controller_, stats_, state_, *camera_, accuracy_);
+  drawHelp(state_);
+  ImGui::Render();
+  stats_.uiCpuMs = ms(std::chrono::steady_clock::now() - uiStart);
+
+  // An accuracy check compares with the frame just rendered (same clock and camera).
+  if (!state_.accuracyRequest.empty()) {
+    startAccuracy(state_.accuracyRequest, uint32_t(state_.accuracySpp));
+    state_.accuracyRequest.clear();
+  }
+  accuracy_.poll();
+  if (state_.screenshot) {
+    std::ostringstream name;
+    name << options_.outDir << "/gi-demo-" << ++screenshots_ << ".png";
+    screenshot(name.str());
+    state_.screenshot = false;
+  }
+  // The panel may have changed the view or the effects: show what the renderer holds now.
+  // A resource that cannot be previewed sends the view back to the output, with the reason.
+  std::optional<gi::ImageRGBA8> image;
+  if (state_.showError && accuracy_.result()) {
+    image = accuracy_.result()->error;
+  } else if (controller_->view() != gi::resources::kOutput) {
+    try {
+      image = controller_->image();
+    } catch (const std::exception& e) {
+      state_.message = "cannot show '" + controller_->view() + "': " + e.what();
+      if (!script_.empty()) std::fprintf(stderr, "gi-demo: %s\n", state_.message.c_str());
+      controller_->setView(gi::resources::kOutput);
+    }
+  }
+  if (!image) {
+    if (preview_) {  // back from another view: its image goes (memory back to where it was)
+      vkDeviceWaitIdle(ctx_->device());
+      preview_.reset();
+    }
+    presenter_->present(renderer.outputImage(), renderer.outputExtent(), VK_IMAGE_LAYOUT_GENERAL,
+                        ImGui::GetDrawData());
+  } else {
+    if (!preview_ || preview_.desc().width != uint32_t(image->width) ||
+        preview_.desc().height != uint32_t(image->height)) {
+      gi::vk::ImageDesc d;
+      d.width = uint32_t(image->width);
+      d.height = uint32_t(image->height);
+      d.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT |
+                VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+      vkDeviceWaitIdle(ctx_->device());  // the previous preview may still be read
+      preview_ = gi::vk::Image(*ctx_, d);
+    }
+    vkDeviceWaitIdle(ctx_->device());
+    gi::vk::uploadImage(*ctx_, preview_, image->pixels.data(), image->pixels.size());
+    presenter_->present(preview_.handle(), {uint32_t(image->width), uint32_t(image->height)},
+                        VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, ImGui::GetDrawData());
+  }
+  stats_.uiGpuMs = presenter_->uiGpuMs();
+  stats_.uiCpuMs += presenter_->uiRecordMs();
+
+  const double frameMs = ms(std::chrono::steady_clock::now() - start);
+  stats_.frameMs.push_back(float(frameMs));
+  if (stats_.frameMs.size() > 300) stats_.frameMs.pop_front();
+  double gpu = 0.0;
+  for (const auto& p : stats_.passes) gpu += p.ms;
+  timingFrames_.push_back(frameMs);
+  timingGpu_.push_back(gpu);
+  timingUiCpu_.push_back(stats_.uiCpuMs);
+  timingUiGpu_.push_back(std::max(stats_.uiGpuMs, 0.0));
+}
+
+void App::screenshot(const std::string& path) {
+  const std::filesystem::path p(path);
+  if (p.has_parent_path()) std::filesystem::create_directories(p.parent_path());
+  gi::writePng(path, controller_->image());
+  state_.message = "wrote " + path;
+  std::printf("wrote %s\n", path.c_str());
+  std::fflush(stdout);
+}
+
+void App::resizeWindow(int width, int height) {
+  glfwSetWindowSize(window_->handle(), width, height);
+  // The window system answers asynchronously: wait (bounded) for the new framebuffer size.
+  for (int i = 0; i < 200; ++i) {
+    glfwWaitEventsTimeout(0.01);
+    int w = 0, h = 0;
+    glfwGetFramebufferSize(window_->handle(), &w, &h);
+    if (w == width && h == height) return;
+  }
+  throw gi::Error(
+      gi::ErrorKind::Unsupported, options_.script,
+      "the window did not take the size " + std::to_string(width) + "x" + std::to_string(height));
+}
+
+void App::startAccuracy(const std::string& effect, uint32_t spp) {
+  try {
+    // The frame holds one image per resource: with two writers of the same output, the
+    // comparison would not be of this effect's.
+    for (const std::string& other : controller_->effects()) {
+      if (other == effect || !controller_->enabled(other)) continue;
+      for (const std::string& w : registry_.info(other).writes)
+        for (const std::string& mine : registry_.info(effect).writes)
+          if (w == mine) {
+            std::string why = other;
+            why += " also writes '" + w + "': switch it off to check ";
+            why += effect;
+            throw gi::Error(gi::ErrorKind::Usage, "", why);
+          }
+    }
+    accuracy_.start(controller_->renderer(), scene_, state_.time, registry_, effect,
+                    controller_->settings(effect), spp);
+    state_.message = "accuracy check of " + effect + " started";
+  } catch (const std::exception& e) {
+    state_.message = std::string("accuracy: ") + e.what();
+  }
+}
+
+void App::printTimings() {
+  std::printf(
+      "timings: %zu frames at %ux%u, frame %.2f ms (wall, median), GPU passes %.3f ms, UI GPU "
+      "%.3f ms, UI CPU %.3f ms\n",
+      timingFrames_.size(), controller_->renderer().outputExtent().width,
+      controller_->renderer().outputExtent().height, median(timingFrames_), median(timingGpu_),
+      median(timingUiGpu_), median(timingUiCpu_));
+  timingFrames_.clear();
+  timingGpu_.clear();
+  timingUiCpu_.clear();
+  timingUiGpu_.clear();
+}
+
+bool App::advanceScript() {
+  while (framesLeft_ == 0) {
+    if (scriptNext_ == script_.size()) return false;
+    execute(script_[scriptNext_++]);
+  }
+  --framesLeft_;
+  return true;
+}
+
+void App::execute(const ScriptStep& s) {
+  const std::string& path = options_.script;
+  auto number = [&](size_t i) { return scriptNumber(s, i, path); };
+  auto must = [&](bool ok) {
+    if (!ok)
+      throw gi::Error(gi::ErrorKind::Usage, path,
+                      "line " + std::to_string(s.line) + ": " + controller_->lastError());
+  };
+  gi::Renderer& renderer = controller_->renderer();
+  if (s.verb == "frames") {
+    held_ = {};
+    framesLeft_ = int(number(0));
+  } else if (s.verb == "key") {
+    held_ = {};
+    std::stringstream keys(s.args[0]);
+    for (std::string k; std::getline(keys, k, '+');) {
+      if (k == "w")
+        held_.forward += 1;
+      else if (k == "s")
+        held_.forward -= 1;
+      else if (k == "d")
+        held_.right += 1;
+      else if (k == "a")
+        held_.right -= 1;
+      else if (k == "e")
+        held_.up += 1;
+      else if (k == "q")
+        held_.up -= 1;
+      else if (k == "shift")
+        held_.fast = true;
+      else if (k == "ctrl")
+        held_.slow = true;
+      else
+        throw gi::Error(gi::ErrorKind::Parse, path,
+                        "line " + std::to_string(s.line) + ": unknown key '" + k + "'");
+    }
+    framesLeft_ = int(number(1));
+  } else if (s.verb == "look") {
+    lookX_ += float(number(0));
+    lookY_ += float(number(1));
+  } else if (s.verb == "camera") {
+    camera_->place({number(0), number(1), number(2)}, float(number(3)), float(number(4)));
+    cameraMoved_ = true;
+  } else if (s.verb == "effect") {
+    must(controller_->setEnabled(s.args[0], s.args[1] == "on"));
+  } else if (s.verb == "set") {
+    must(controller_->setFromString(s.args[0]));
+  } else if (s.verb == "preset") {
+    must(controller_->setPreset(s.args[0] == "none" ? "" : s.args[0]));
+  } else if (s.verb == "view") {
+    must(controller_->setView(s.args[0]));
+  } else if (s.verb == "resize") {
+    resizeWindow(int(number(0)), int(number(1)));
+  } else if (s.verb == "pause") {
+    state_.paused = s.args[0] == "on";
+  } else if (s.verb == "step") {
+    state_.stepOnce = true;
+  } else if (s.verb == "time") {
+    state_.time = number(0);
+  } else if (s.verb == "accuracy") {
+    startAccuracy(s.args[0], uint32_t(number(1)));
+    accuracy_.wait();
+    const auto& r = accuracy_.result();
+    if (!accuracy_.error().empty() || !r || r->effect != s.args[0])
+      throw gi::Error(gi::ErrorKind::Usage, path,
+                      "line " + std::to_string(s.line) + ": " +
+                          (accuracy_.error().empty() ? state_.message : accuracy_.error()));
+    std::printf("accuracy: %s nrmse %.6f pixels %zu spp %u seconds %.2f quantity %s\n",
+                r->effect.c_str(), r->nrmse, r->pixels, r->spp, r->seconds, r->quantity.c_str());
+  } else if (s.verb == "screenshot") {
+    screenshot(s.args[0]);
+  } else if (s.args[0] == "passes") {
+    std::string executed, culled;
+    for (const std::string& p : renderer.passNames()) executed += " " + p;
+    for (const std::string& p : renderer.culledPassNames()) culled += " " + p;
+    std::printf("passes:%s\nculled:%s\n", executed.c_str(), culled.c_str());
+  } else if (s.args[0] == "views") {
+    std::string views;
+    for (const std::string& v : renderer.viewNames()) views += " " + v;
+    std::printf("views:%s\n", views.c_str());
+  } else if (s.args[0] == "timings") {
+    printTimings();
+  } else if (s.args[0] == "memory") {
+    std::printf("device memory: %llu bytes in %zu blocks\n",
+                static_cast<unsigned long long>(ctx_->allocator().bytesInUse()),
+                ctx_->allocator().blockCount());
+  } else {  // print camera
+    const glm::vec3 p = camera_->position();
+    std::printf("camera: %.4f %.4f %.4f %.3f %.3f\n", p.x, p.y, p.z, camera_->yawDeg(),
+                camera_->pitchDeg());
+  }
+  std::fflush(stdout);
+}
+
+}  // namespace demo
