@@ -236,7 +236,11 @@ TEST(BenchCli, BadInputFailsBeforeRendering) {
       {"--effects none --grid nodot=1", "nodot"},
       {"--effects none --grid ssao.samples=4", "ssao"},
       {"--frames 0", "--frames"},
-      {"--metric ssim", "--metric"},  // only with --calibrate
+      {"--metric ssim", "--metric"},                                 // only with --calibrate
+      {"--effects ssao,ssao", "--effects: 'ssao' is listed twice"},  // as gi-render refuses it
+      {"--effects none,ssao+ssao", "'ssao' appears twice in 'ssao+ssao'"},
+      {"--width 1.5", "--width: expects an integer in [1, 16384], got '1.5'"},
+      {"--ref-seed 0x20", "which is hexadecimal"},
   };
   for (const auto& [args, needle] : cases) {
     auto r = test::runCommand(
@@ -247,6 +251,15 @@ TEST(BenchCli, BadInputFailsBeforeRendering) {
     EXPECT_NE(r.output.find(needle), std::string::npos) << args << ": " << r.output;
     EXPECT_FALSE(fs::exists(out)) << args << ": output written";
     EXPECT_FALSE(fs::exists(dir + "/cache")) << args << ": references computed";
+  }
+  // An output folder that cannot be written is found before the sweep, not after it.
+  for (const char* bad : {"/sys/gi-bench-out", "/sys"}) {
+    auto r =
+        test::runCommand(bench(std::string("--quick --cache '") + dir + "/cache' --out " + bad));
+    EXPECT_EQ(r.exitCode, 1) << bad << ": " << r.output;
+    EXPECT_NE(r.output.find("cannot write in the output folder /sys"), std::string::npos)
+        << r.output;
+    EXPECT_FALSE(fs::exists(dir + "/cache")) << bad << ": references computed";
   }
   if (hasSsao()) {
     for (const char* grid : {"ssao.no_such_key=1", "ssao.samples=100000", "ssao.samples=abc"}) {

@@ -2,6 +2,9 @@
 // non-zero with a message naming the file, and leaves no output file behind.
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -164,6 +167,48 @@ TEST(Cli, UsageErrors) {
   r = test::runCommand(test::binPath("gi-render") + " --scene default --out x.png --bogus");
   EXPECT_EQ(r.exitCode, 2) << r.output;
   EXPECT_NE(r.output.find("--bogus"), std::string::npos);
+}
+
+// Numbers, lists and outputs follow apps/common/cli.h (test_cli_args tests it in detail); here
+// the app itself: each ends with exit 2 (usage) or 1 and one line naming the flag or file, and
+// an output that cannot be written is found before anything is rendered.
+TEST(Cli, StrictNumbersListsAndOutputsBeforeRendering) {
+  const std::string dir = test::makeTempDir("cli-strict");
+  const std::string out = dir + "/x.png";
+  struct Case {
+    std::string args, mention;
+    int exitCode;
+  };
+  ::mkfifo((dir + "/fifo.json").c_str(), 0600);
+  fs::create_directories(dir + "/presetdir");
+  const std::vector<Case> cases = {
+      {"--width 1.5", "--width: expects an integer in [1, 16384], got '1.5'", 2},
+      {"--width 0x20", "which is hexadecimal", 2},
+      {"--height 12abc", "--height: expects an integer", 2},
+      {"--time 1e400", "which is out of range (beyond +-1.8e308", 2},
+      {"--exposure inf", "which is not a finite number", 2},
+      {"--effects ssao,ssao", "--effects: 'ssao' is listed twice", 2},
+      {"--scene '" + dir + "/fifo.json'", "fifo.json: is not a regular file", 1},
+      {"--preset '" + dir + "/presetdir'", "presetdir: is a directory, not a preset file", 1},
+  };
+  for (const Case& c : cases) {
+    auto r = test::runCommand(render("default", out, c.args));
+    EXPECT_EQ(r.exitCode, c.exitCode) << c.args << "\n" << r.output;
+    EXPECT_NE(r.output.find(c.mention), std::string::npos) << c.args << "\n" << r.output;
+    EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+    EXPECT_FALSE(fs::exists(out)) << c.args;
+  }
+  // /sys exists and cannot be written (also as root): refused before the Vulkan device starts,
+  // so no validation layer or device line is printed and it ends at once.
+  for (const char* bad : {"/sys/gi-test.png", "--graph-dot /sys/gi-test.dot"}) {
+    const std::string args = bad[0] == '-' ? std::string(bad) : "";
+    auto r = test::runCommand(render("default", bad[0] == '-' ? out : bad, args));
+    EXPECT_EQ(r.exitCode, 1) << r.output;
+    EXPECT_NE(r.output.find("cannot write in the output folder /sys: "), std::string::npos)
+        << r.output;
+    EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+    EXPECT_FALSE(fs::exists(out));
+  }
 }
 
 }  // namespace

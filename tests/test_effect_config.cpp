@@ -171,6 +171,16 @@ TEST(EffectConfig, BadPresetsAndSettingsNameFileKeyAndRange) {
   expectError(withPreset("empty.json", ""), ErrorKind::EmptyFile, {"empty.json"});
   expectError([&] { loadPreset("no-such-preset-anywhere"); }, ErrorKind::FileNotFound,
               {"no-such-preset-anywhere"});
+  // The input standard of every file (gi/input_file.h): named as what it is, never read on.
+  std::filesystem::create_directories(dir + "/folder.json");
+  expectError([&] { loadPreset(dir + "/folder.json"); }, ErrorKind::FileNotFound,
+              {"folder.json", "is a directory, not a preset file"});
+  std::filesystem::create_symlink("/dev/zero", dir + "/zero.json");
+  expectError([&] { loadPreset(dir + "/zero.json"); }, ErrorKind::FileNotFound,
+              {"zero.json", "is not a regular file"});
+  expectError([&] { parsePreset(R"({"target_ms": 1e400})", "huge.json"); }, ErrorKind::InvalidData,
+              {"huge.json", "number '1e400' is out of range"});
+  EXPECT_EQ(parsePreset(R"({"name": "n", "target_ms": 16})", "p.json").targetMs, 16.0);
 
   Scene badScene = sceneWith({{"const_ao", {{"value", 7}}}});
   expectError([&] { resolveEffects(badScene, nullptr, {}, reg); }, ErrorKind::InvalidData,

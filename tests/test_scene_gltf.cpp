@@ -7,10 +7,12 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <string>
 #include <vector>
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <gtest/gtest.h>
@@ -777,3 +779,173 @@ TEST(GltfFeatures, MeshInstancesShareGeometry) {
 }
 
 }  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// The value rules of a JSON scene hold for glTF too (issue 15): the same values are refused,
+// each with "<file>: <where in the glTF>: <problem>".
+
+// A one-triangle file with `edit` applied, expected to fail with InvalidData naming `where`.
+void expectValueRule(const std::function<void(GltfBuilder&)>& edit, const std::string& where,
+                     const std::string& problem) {
+  TempDir dir;
+  GltfBuilder b;
+  b.node({{"mesh", b.triangle()}});
+  edit(b);
+  const std::string msg = expectError(b.write(dir), gi::ErrorKind::InvalidData);
+  EXPECT_TRUE(contains(msg, ".gltf: " + where + ": " + problem)) << msg;
+}
+
+json perspective(double yfov, double znear, double zfar) {
+  json p = {{"yfov", yfov}, {"znear", znear}};
+  if (zfar != 0.0) p["zfar"] = zfar;
+  return json::array({{{"type", "perspective"}, {"perspective", p}}});
+}
+
+void withLight(GltfBuilder& b, const json& light) {
+  b.doc["extensionsUsed"] = {"KHR_lights_punctual"};
+  b.doc["extensions"] = {{"KHR_lights_punctual", {{"lights", json::array({light})}}}};
+  b.node({{"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+}
+
+TEST(GltfValueRules, CamerasLightsAndMaterialsAsInJsonScenes) {
+  expectValueRule([](GltfBuilder& b) { b.doc["cameras"] = perspective(0.0, 0.1, 10); },
+                  "cameras[0].perspective.yfov", "must be in (0, pi) radians, got 0");
+  expectValueRule([](GltfBuilder& b) { b.doc["cameras"] = perspective(3.5, 0.1, 10); },
+                  "cameras[0].perspective.yfov", "must be in (0, pi) radians, got 3.5");
+  expectValueRule([](GltfBuilder& b) { b.doc["cameras"] = perspective(0.7, 0.0, 10); },
+                  "cameras[0].perspective.znear", "must be positive, got 0");
+  expectValueRule([](GltfBuilder& b) { b.doc["cameras"] = perspective(0.7, 1.0, 0.5); },
+                  "cameras[0].perspective.zfar", "must be greater than znear (1), got 0.5");
+  expectValueRule(
+      [](GltfBuilder& b) {
+        b.doc["cameras"] = {
+            {{"type", "orthographic"},
+             {"orthographic", {{"xmag", 1}, {"ymag", 1}, {"znear", 2}, {"zfar", 1}}}}};
+      },
+      "cameras[0].orthographic.zfar", "must be greater than znear (2), got 1");
+  expectValueRule(
+      [](GltfBuilder& b) {
+        withLight(b, {{"type", "point"}, {"intensity", -5}});
+      },
+      "KHR_lights_punctual.lights[0].intensity", "must not be negative, got -5");
+  expectValueRule(
+      [](GltfBuilder& b) {
+        withLight(b, {{"type", "point"}, {"range", -1}});
+      },
+      "KHR_lights_punctual.lights[0].range", "must not be negative, got -1");
+  expectValueRule(
+      [](GltfBuilder& b) {
+        withLight(b, {{"type", "point"}, {"color", {1, -0.5, 1}}});
+      },
+      "KHR_lights_punctual.lights[0].color", "colour components must not be negative");
+  expectValueRule(
+      [](GltfBuilder& b) {
+        withLight(b,
+                  {{"type", "spot"}, {"spot", {{"innerConeAngle", 0.8}, {"outerConeAngle", 0.5}}}});
+      },
+      "KHR_lights_punctual.lights[0].spot.innerConeAngle",
+      "must be in [0, outerConeAngle] (0.5), got 0.8");
+  expectValueRule(
+      [](GltfBuilder& b) {
+        withLight(b, {{"type", "spot"}, {"spot", {{"outerConeAngle", 2.0}}}});
+      },
+      "KHR_lights_punctual.lights[0].spot.outerConeAngle", "must be in (0, pi/2] radians, got 2");
+  expectValueRule(
+      [](GltfBuilder& b) {
+        b.doc["materials"] = {{{"emissiveFactor", {-1, 0, 0}}}};
+        b.doc["meshes"][0]["primitives"][0]["material"] = 0;
+      },
+      "materials[0].emissiveFactor", "colour components must not be negative");
+  expectValueRule(
+      [](GltfBuilder& b) {
+        b.doc["materials"] = {
+            {{"emissiveFactor", {1, 1, 1}},
+             {"extensions", {{"KHR_materials_emissive_strength", {{"emissiveStrength", -2}}}}}}};
+        b.doc["extensionsUsed"] = {"KHR_materials_emissive_strength"};
+      },
+      "materials[0].extensions.KHR_materials_emissive_strength.emissiveStrength",
+      "must not be negative, got -2");
+  expectValueRule(
+      [](GltfBuilder& b) {
+        b.doc["materials"] = {{{"pbrMetallicRoughness", {{"baseColorFactor", {1, 1, -1, 1}}}}}};
+      },
+      "materials[0].pbrMetallicRoughness.baseColorFactor",
+      "colour components must not be negative");
+}
+
+TEST(GltfValueRules, BoundaryValuesStillLoad) {
+  TempDir dir;
+  GltfBuilder b;
+  b.node({{"mesh", b.triangle()}});
+  b.doc["cameras"] = perspective(0.7, 0.1, 0);  // no zfar: infinite projection, allowed
+  withLight(b, {{"type", "spot"},
+                {"intensity", 0},
+                {"spot", {{"innerConeAngle", 0.5}, {"outerConeAngle", 0.5}}}});
+  const gi::Scene scene = gi::loadGltf(b.write(dir));
+  ASSERT_EQ(scene.lights.size(), 1u);
+  EXPECT_FLOAT_EQ(scene.lights[0].innerConeAngle, 0.5f);
+  EXPECT_FLOAT_EQ(scene.lights[0].intensity, 0.0f);
+  ASSERT_EQ(scene.cameras.size(), 1u);
+  EXPECT_GT(scene.cameras[0].zfar, scene.cameras[0].znear);
+}
+
+TEST(GltfFiles, Version1IsNamedAsUnsupported) {
+  TempDir dir;
+  for (const char* text :
+       {R"({"asset": {"version": "1.0"}, "scene": "defaultScene", "scenes": {}})",
+        R"({"scene": "defaultScene", "meshes": {}, "nodes": {}})"}) {
+    const std::string msg = expectError(dir.write("v1.gltf", text), gi::ErrorKind::Unsupported);
+    EXPECT_TRUE(contains(msg, "glTF 1.0 is not supported")) << msg;
+  }
+  // Binary glTF 1: magic, version 1, length, content length, content format 0 (JSON).
+  std::string glb("glTF\x01\0\0\0\x20\0\0\0\x0c\0\0\0\0\0\0\0{\"scene\":1}\n", 32);
+  const std::string msg = expectError(dir.write("v1.glb", glb), gi::ErrorKind::Unsupported);
+  EXPECT_TRUE(contains(msg, "glTF 1.0 is not supported")) << msg;
+  expectError(dir.write("v3.gltf", R"({"asset": {"version": "3.0"}})"), gi::ErrorKind::Unsupported);
+}
+
+TEST(GltfFiles, BufferOrImageUriThatIsNotAFileIsNamed) {
+  TempDir dir;
+  fs::create_directories(dir.file("folder"));
+  {
+    GltfBuilder b;
+    b.node({{"mesh", b.triangle()}});
+    const std::string path = b.write(dir);
+    json doc = readGltfJson(path);
+    doc["buffers"][0]["uri"] = "folder";
+    const std::string msg =
+        expectError(dir.write("dirbuf.gltf", doc.dump()), gi::ErrorKind::MissingResource);
+    EXPECT_TRUE(contains(msg, "is a directory")) << msg;
+    EXPECT_FALSE(contains(msg, "bad_alloc")) << msg;
+    ASSERT_EQ(::mkfifo(dir.file("fifo.bin").c_str(), 0600), 0);
+    doc["buffers"][0]["uri"] = "fifo.bin";  // read until a writer comes, before: forever
+    const std::string fifo =
+        expectError(dir.write("fifobuf.gltf", doc.dump()), gi::ErrorKind::MissingResource);
+    EXPECT_TRUE(contains(fifo, "not a regular file")) << fifo;
+  }
+  {
+    GltfBuilder b;
+    int pos = b.accessor(b.view(std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0}), GltfBuilder::kFloat,
+                         3, "VEC3");
+    int uv =
+        b.accessor(b.view(std::vector<float>{0, 0, 1, 0, 0, 1}), GltfBuilder::kFloat, 3, "VEC2");
+    b.mesh({{"attributes", {{"POSITION", pos}, {"TEXCOORD_0", uv}}}, {"material", 0}});
+    b.node({{"mesh", 0}});
+    b.doc["images"] = {{{"uri", "folder"}}};
+    b.doc["textures"] = {{{"source", 0}}};
+    b.doc["materials"] = {{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}}};
+    const std::string msg = expectError(b.write(dir, "dirimg"), gi::ErrorKind::MissingResource);
+    EXPECT_TRUE(contains(msg, "image 0 ('folder')")) << msg;
+    EXPECT_TRUE(contains(msg, "is a directory")) << msg;
+  }
+}
+
+TEST(GltfFiles, DevicesAndFifosAreRefusedAtOnce) {
+  TempDir dir;
+  fs::create_symlink("/dev/zero", dir.file("zero.glb"));
+  std::string msg = expectError(dir.file("zero.glb"), gi::ErrorKind::FileNotFound);
+  EXPECT_TRUE(contains(msg, "not a regular file")) << msg;
+  ASSERT_EQ(::mkfifo(dir.file("fifo.gltf").c_str(), 0600), 0);
+  msg = expectError(dir.file("fifo.gltf"), gi::ErrorKind::FileNotFound);
+  EXPECT_TRUE(contains(msg, "not a regular file")) << msg;
+}

@@ -8,9 +8,11 @@
 #include <string>
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "gi/errors.h"
+#include "gi/input_file.h"
 #include "gi/scene_io.h"
 #include "test_support.h"
 
@@ -650,3 +652,131 @@ TEST(SceneIo, ExampleScenes) {
 }
 
 }  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// One standard for every input file (issue 15): only regular files are read, numbers are
+// named when out of range, indices are reported as written.
+
+TEST(SceneInputs, OnlyRegularFilesAreRead) {
+  TempDir dir;
+  fs::create_directories(dir.path("folder.json"));
+  expectError([&] { gi::loadScene(dir.path("folder.json")); }, gi::ErrorKind::FileNotFound,
+              "folder.json", "is a directory, not a file");
+  // A FIFO would block until a writer comes; /dev/zero would be read until memory runs out.
+  for (const char* name : {"fifo.json", "fifo.obj", "fifo.ply", "fifo.gltf"}) {
+    ASSERT_EQ(::mkfifo(dir.path(name).c_str(), 0600), 0);
+    expectError([&] { gi::loadScene(dir.path(name)); }, gi::ErrorKind::FileNotFound, name,
+                "is not a regular file");
+  }
+  for (const char* name : {"zero.json", "zero.obj", "zero.ply", "zero.glb"}) {
+    fs::create_symlink("/dev/zero", dir.path(name));
+    expectError([&] { gi::loadScene(dir.path(name)); }, gi::ErrorKind::FileNotFound, name,
+                "is not a regular file");
+  }
+  // A material library that is a FIFO: named, not waited on.
+  ASSERT_EQ(::mkfifo(dir.path("lib.mtl").c_str(), 0600), 0);
+  const std::string obj = dir.write("withlib.obj", std::string(kTriangleObj) + "mtllib lib.mtl\n");
+  expectError([&] { gi::loadScene(obj); }, gi::ErrorKind::FileNotFound, "lib.mtl",
+              "is not a regular file");
+}
+
+TEST(SceneInputs, SizeLimitAndReader) {
+  TempDir dir;
+  const std::string path = dir.write("ten.txt", "0123456789");
+  EXPECT_EQ(gi::readInputFile(path), "0123456789");
+  EXPECT_EQ(gi::checkInputFile(path), 10u);
+  expectError([&] { gi::readInputFile(path, "file", 9); }, gi::ErrorKind::Unsupported, "ten.txt",
+              "is 10 bytes; input files larger than 9 bytes are not read");
+  std::vector<unsigned char> bytes;
+  std::string problem;
+  EXPECT_FALSE(gi::tryReadInputFile(dir.path("none"), bytes, problem));
+  EXPECT_EQ(problem, "file does not exist");
+}
+
+TEST(SceneInputs, NumbersOutOfRangeAreNamed) {
+  TempDir dir;
+  const std::string json = dir.write("huge.json", R"({"camera": {"position": [0, 0, 1e400]}})");
+  expectError([&] { gi::loadScene(json); }, gi::ErrorKind::InvalidData, "huge.json",
+              "number '1e400' is out of range");
+  const std::string obj = dir.write("huge.obj", "v 0 0 1e39\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  expectError([&] { gi::loadScene(obj); }, gi::ErrorKind::InvalidData, "huge.obj",
+              "line 1: 1e39 is out of range for a float");
+  // Below float range is zero, not an error; a word is still "not a number".
+  const std::string tiny = dir.write("tiny.obj", "v 0 0 1e-60\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  EXPECT_EQ(gi::loadScene(tiny).triangleCount(), 1u);
+  const std::string word = dir.write("word.obj", "v 0 0 x\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  expectError([&] { gi::loadScene(word); }, gi::ErrorKind::Parse, "word.obj",
+              "line 1: x is not a number");
+}
+
+TEST(SceneInputs, PlyNegativeIndexIsReportedAsWritten) {
+  TempDir dir;
+  const std::string ply = dir.write("neg.ply",
+                                    "ply\nformat ascii 1.0\nelement vertex 3\n"
+                                    "property float x\nproperty float y\nproperty float z\n"
+                                    "element face 1\nproperty list uchar int vertex_indices\n"
+                                    "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 -1\n");
+  expectError([&] { gi::loadScene(ply); }, gi::ErrorKind::IndexOutOfRange, "neg.ply",
+              "face 0 uses vertex index -1 but there are only 3 vertices");
+}
+
+// Found by tools/fuzz: OpenMesh's header reader loops forever on a format line with extra
+// words; every header line must now hold exactly its tokens.
+TEST(SceneInputs, PlyHeaderLinesHoldExactlyTheirTokens) {
+  TempDir dir;
+  const std::string body =
+      "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+      "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  EXPECT_EQ(gi::loadScene(dir.write("ok.ply", "ply\nformat ascii 1.0\n" + body)).triangleCount(),
+            1u);
+  expectError(
+      [&] { gi::loadScene(dir.write("loop.ply", "ply\nformat ascii format ascii 1.0\n" + body)); },
+      gi::ErrorKind::Parse, "loop.ply", "line 2: format version must be 1.0, got 'format'");
+  expectError([&] { gi::loadScene(dir.write("extra.ply", "ply\nformat ascii 1.0 x\n" + body)); },
+              gi::ErrorKind::Parse, "extra.ply", "line 2: format line: unexpected 'x'");
+  expectError(
+      [&] {
+        gi::loadScene(dir.write("twice.ply", "ply\nformat ascii 1.0\nformat ascii 1.0\n" + body));
+      },
+      gi::ErrorKind::Parse, "twice.ply", "line 3: format line repeated");
+  expectError(
+      [&] {
+        gi::loadScene(dir.write("prop.ply",
+                                "ply\nformat ascii 1.0\nelement vertex 3\n"
+                                "property float x junk\n" +
+                                    body.substr(17)));
+      },
+      gi::ErrorKind::Parse, "prop.ply", "line 4: property line: unexpected 'junk'");
+}
+
+TEST(SceneInputs, ZeroSizeSceneIsAnErrorAndExtremeSizesWarn) {
+  TempDir dir;
+  // A hand-written glTF: one triangle under a node scaled by `s`.
+  const std::string bin = std::string("\0\0\0\0\0\0\0\0\0\0\0\0", 12) +
+                          std::string("\0\0\x80\x3f\0\0\0\0\0\0\0\0", 12) +
+                          std::string("\0\0\0\0\0\0\x80\x3f\0\0\0\0", 12);
+  dir.write("tri.bin", bin);
+  auto gltf = [&](const std::string& name, const std::string& scale) {
+    return dir.write(
+        name, R"({"asset": {"version": "2.0"}, "buffers": [{"uri": "tri.bin", "byteLength": 36}],
+          "bufferViews": [{"buffer": 0, "byteLength": 36}],
+          "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3"}],
+          "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+          "nodes": [{"mesh": 0, "scale": [)" +
+                  scale + ", " + scale + ", " + scale + R"(]}], "scenes": [{"nodes": [0]}]})");
+  };
+  expectError([&] { gi::loadScene(gltf("zero.gltf", "0")); }, gi::ErrorKind::InvalidData,
+              "zero.gltf", "the scene's geometry has zero size");
+  expectError([&] { gi::loadScene(gltf("inf.gltf", "1e38")); }, gi::ErrorKind::NonFinite,
+              "inf.gltf", "the scene's size is not finite");
+  for (const char* scale : {"1e-6", "1e8"}) {
+    const gi::Scene s = gi::loadScene(gltf("extreme.gltf", scale));
+    std::string all;
+    for (const std::string& w : s.warnings) all += w + "\n";
+    EXPECT_NE(all.find("extreme.gltf: the scene is "), std::string::npos) << scale << ": " << all;
+    EXPECT_NE(all.find(" units across"), std::string::npos) << all;
+  }
+  for (const std::string& w : gi::loadScene(gltf("unit.gltf", "1")).warnings)
+    EXPECT_EQ(w.find("units across"), std::string::npos) << w;
+}

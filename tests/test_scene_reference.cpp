@@ -813,6 +813,9 @@ TEST(ReferenceSettings, InvalidSettingsAreUsageErrors) {
   s = smallSettings(ref::Quantity::Alchemy, 4);
   s.alchemy.contrast = 0.0f;
   expectUsage(s);
+  s = smallSettings(ref::Quantity::Alchemy, 4);
+  s.alchemy.epsilon = 0.0f;  // with u = 0: an unbounded falloff (standard error 6.6e9 before)
+  expectUsage(s);
   EXPECT_THROW(ref::parseQuantity("bent"), Error);
   EXPECT_EQ(ref::parseQuantity("direct+indirect"), ref::Quantity::DirectIndirect);
   EXPECT_EQ(ref::parseMembership("sqrt"), ref::Membership::Sqrt);
@@ -858,6 +861,13 @@ TEST(ReferenceCli, BadInputFailsWithOneLineAndNoOutput) {
        std::vector<Case>{{"--scene '" + dir + "/missing.json'" + out, "missing.json", 1},
                          {"--scene default --quantity bent" + out, "bent", 2},
                          {"--scene default --radius -1" + out, "--radius", 2},
+                         {"--scene default --radius 0" + out,
+                          "--radius: expects a number in (0, 1e9], got '0'", 2},
+                         {"--scene default --spp 1.5" + out, "is not an integer", 2},
+                         {"--scene default --width 0x20" + out, "is hexadecimal", 2},
+                         {"--scene default --quantity alchemy --alchemy-epsilon 0" + out,
+                          "epsilon must be > 0 when u = 0", 2},
+                         {"--scene default --out /sys/gi-test.pfm", "cannot write in", 1},
                          {"--scene default --out '" + dir + "/nodir/x.pfm'", "nodir", 1},
                          {"--scene default --out '" + dir + "/x.png'", "x.png", 2},
                          {"--scene default", "--out", 2}}) {

@@ -1,30 +1,79 @@
-// What the command-line apps share: number arguments and the error convention of main()
-// (one line naming the app, the error kind and the problem; exit 2 for usage errors, else 1).
+// What the command-line apps (gi-render, gi-reference, gi-bench) share: the argument loop,
+// strict numbers, lists, output checks, atomic writes and the error convention of main() (one
+// line naming the app, the error kind, the file or flag and the problem; exit 2 for usage
+// errors, else 1).
 #pragma once
 
+#include <cstdint>
 #include <cstdio>
-#include <cstdlib>
 #include <exception>
 #include <optional>
 #include <string>
+#include <string_view>
+#include <vector>
 
 #include "gi/errors.h"
 
 namespace gi::cli {
 
-// `text` as a number in [lo, hi]; nullopt when it is not one (trailing characters included).
-inline std::optional<double> numberIn(const char* text, double lo, double hi) {
-  char* end = nullptr;
-  const double v = std::strtod(text, &end);
-  if (end == text || *end != '\0' || !(v >= lo && v <= hi)) return std::nullopt;
-  return v;
-}
+// A number as it would be written in source: shortest round-trip form (16384, 1e-09, 0.5).
+std::string formatNumber(double v);
 
-// "expects a number in [lo, hi], got 'text'"
-inline std::string rangeMessage(const char* text, double lo, double hi) {
-  return "expects a number in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got '" +
-         text + "'";
-}
+// Strict parsing. Decimal only: no hex (0x20), no inf/nan, no leading space, no trailing
+// characters; a leading '+' is allowed. On failure `problem` says why ("is not a number",
+// "is not an integer", "is out of range ...").
+std::optional<double> parseDouble(std::string_view text, std::string* problem = nullptr);
+std::optional<int64_t> parseInteger(std::string_view text, std::string* problem = nullptr);
+
+// "a,b,c" -> {a, b, c}. Empty items are refused (usage error naming `flag`), as are duplicates
+// unless `allowDuplicates`. An empty `text` gives an empty list.
+std::vector<std::string> splitList(const std::string& flag, const std::string& text,
+                                   bool allowDuplicates = false);
+
+// Throws a usage error "<where>: <message> (see <app> --help)"; `where` may be empty.
+[[noreturn]] void usageError(const std::string& app, const std::string& where,
+                             const std::string& message);
+
+// The argument loop: for (Args a(app, argc, argv); a.next();) if (a.is("--width")) ...
+class Args {
+ public:
+  Args(const char* app, int argc, char** argv) : app_(app), argc_(argc), argv_(argv) {}
+  bool next() { return ++i_ < argc_ && (flag_ = argv_[i_], true); }
+  const std::string& flag() const { return flag_; }
+  bool is(std::string_view name) const { return flag_ == name; }
+  // The flag's value (the next argument); usage error when there is none.
+  const char* value();
+  // The value as a number in [lo, hi] / an integer in [lo, hi]; usage errors say the range as
+  // written: "--width: expects an integer in [1, 16384], got '1.5'".
+  double number(double lo, double hi);
+  int64_t integer(int64_t lo, int64_t hi);
+  // A number > lo (open below) and <= hi: "expects a number in (0, 1e+09]".
+  double numberAbove(double lo, double hi);
+  std::vector<std::string> list(bool allowDuplicates = false) {
+    return splitList(flag_, value(), allowDuplicates);
+  }
+  [[noreturn]] void fail(const std::string& message) const { usageError(app_, flag_, message); }
+  [[noreturn]] void unknown() const;
+  const char* app() const { return app_; }
+
+ private:
+  const char* app_;
+  int argc_;
+  char** argv_;
+  int i_ = 0;
+  std::string flag_;
+};
+
+// An output file that will be written later: its folder must exist and be writable and the
+// path must not be a folder. Checked before any work, so a long render never ends in "cannot
+// write". Throws FileNotFound naming `path`.
+void checkOutputWritable(const std::string& path);
+// A folder that will be created or filled (gi-bench --out DIR): as checkOutputWritable for the
+// folder's nearest existing ancestor; an existing non-folder is refused.
+void checkOutputFolder(const std::string& dir);
+
+// Writes `text` to `path` through `path`.partial and a rename: a failure leaves nothing behind.
+void writeFileAtomic(const std::string& path, const std::string& text);
 
 // Runs the app's body and turns exceptions into its one-line error and exit code.
 template <class Body>

@@ -73,8 +73,6 @@ struct RunInfo {
   double seconds = 0.0;
 };
 
-// Writes `text` to `path` through a temporary file and a rename.
-void writeFileAtomic(const std::string& path, const std::string& text);
 // results.csv, results.json, report.md and plots/<scene>_<effect>.svg under `dir`.
 void writeResults(const std::string& dir, const std::vector<Row>& rows, const RunInfo& info);
 // Indices of the rows on the Pareto front of (plotted time with its interval, nrmse against

@@ -30,6 +30,7 @@
 #include "gi/engine_settings.h"
 #include "gi/errors.h"
 #include "gi/image_io.h"
+#include "gi/input_file.h"
 #include "gi/reference/reference.h"
 #include "gi/renderer.h"
 #include "gi/scene_io.h"
@@ -107,87 +108,68 @@ struct Options {
 };
 
 [[noreturn]] void usageError(const std::string& where, const std::string& message) {
-  throw gi::Error(gi::ErrorKind::Usage, where, message + " (see gi-bench --help)");
-}
-
-double parseNumber(const std::string& flag, const char* text, double lo, double hi) {
-  if (const auto v = gi::cli::numberIn(text, lo, hi)) return *v;
-  usageError(flag, gi::cli::rangeMessage(text, lo, hi));
-}
-
-std::vector<std::string> splitList(const std::string& text) {
-  std::vector<std::string> out;
-  std::string item;
-  std::istringstream in(text);
-  while (std::getline(in, item, ','))
-    if (!item.empty()) out.push_back(item);
-  return out;
+  gi::cli::usageError("gi-bench", where, message);
 }
 
 Options parseArgs(int argc, char** argv) {
   Options o;
   o.validation = gi::vk::ContextOptions::fromEnvironment().validation;
   for (int i = 0; i < argc; ++i) o.commandLine += (i ? " " : "") + std::string(argv[i]);
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto value = [&]() -> const char* {
-      if (i + 1 >= argc) usageError(a, "needs a value");
-      return argv[++i];
-    };
-    if (a == "--help" || a == "-h") {
+  for (gi::cli::Args a("gi-bench", argc, argv); a.next();) {
+    if (a.is("--help") || a.is("-h")) {
       std::fputs(kUsage, stdout);
       std::exit(0);
-    } else if (a == "--out")
-      o.out = value();
-    else if (a == "--scenes" || a == "--scene")
-      o.scenes = splitList(value());
-    else if (a == "--effects")
-      o.effects = splitList(value());
-    else if (a == "--presets" || a == "--preset")
-      o.presets = splitList(value());
-    else if (a == "--grid")
-      o.grids.push_back(value());
-    else if (a == "--frames") {
-      o.frames = int(parseNumber(a, value(), 1, 10000));
+    } else if (a.is("--out"))
+      o.out = a.value();
+    else if (a.is("--scenes") || a.is("--scene"))
+      o.scenes = a.list();
+    else if (a.is("--effects"))
+      o.effects = a.list();  // a set twice is refused, as gi-render refuses an effect twice
+    else if (a.is("--presets") || a.is("--preset"))
+      o.presets = a.list();
+    else if (a.is("--grid"))
+      o.grids.push_back(a.value());
+    else if (a.is("--frames")) {
+      o.frames = int(a.integer(1, 10000));
       o.framesGiven = true;
-    } else if (a == "--reps")
-      o.reps = int(parseNumber(a, value(), 1, 1000));
-    else if (a == "--width") {
-      o.width = uint32_t(parseNumber(a, value(), 1, 16384));
+    } else if (a.is("--reps"))
+      o.reps = int(a.integer(1, 1000));
+    else if (a.is("--width")) {
+      o.width = uint32_t(a.integer(1, 16384));
       o.sizeGiven = true;
-    } else if (a == "--height") {
-      o.height = uint32_t(parseNumber(a, value(), 1, 16384));
+    } else if (a.is("--height")) {
+      o.height = uint32_t(a.integer(1, 16384));
       o.sizeGiven = true;
-    } else if (a == "--ref-spp") {
-      o.refSpp = uint32_t(parseNumber(a, value(), 1, 1 << 20));
+    } else if (a.is("--ref-spp")) {
+      o.refSpp = uint32_t(a.integer(1, 1 << 20));
       o.sppGiven = true;
-    } else if (a == "--ref-seed")
-      o.refSeed = uint64_t(parseNumber(a, value(), 0, 1e15));
-    else if (a == "--cache")
-      o.cache = value();
-    else if (a == "--budget-ms")
-      o.budgetMs = parseNumber(a, value(), 1e-6, 1e7);
-    else if (a == "--headroom")
-      o.headroom = parseNumber(a, value(), 0, 0.9);
-    else if (a == "--quick")
+    } else if (a.is("--ref-seed"))
+      o.refSeed = uint64_t(a.integer(0, 1000000000000000));
+    else if (a.is("--cache"))
+      o.cache = a.value();
+    else if (a.is("--budget-ms"))
+      o.budgetMs = a.numberAbove(0, 1e7);
+    else if (a.is("--headroom"))
+      o.headroom = a.number(0, 0.9);
+    else if (a.is("--quick"))
       o.quick = true;
-    else if (a == "--ao-split")
+    else if (a.is("--ao-split"))
       o.aoSplit = true;
-    else if (a == "--calibrate")
+    else if (a.is("--calibrate"))
       o.calibrate = true;
-    else if (a == "--metric") {
-      o.metric = value();
+    else if (a.is("--metric")) {
+      o.metric = a.value();
       o.metricGiven = true;
       if (o.metric != "ssim" && o.metric != "nrmse")
-        usageError(a, "expects ssim or nrmse, got '" + o.metric + "'");
-    } else if (a == "--no-progress")
+        a.fail("expects ssim or nrmse, got '" + o.metric + "'");
+    } else if (a.is("--no-progress"))
       o.progress = false;
-    else if (a == "--validation")
+    else if (a.is("--validation"))
       o.validation = true;
-    else if (a == "--device")
-      o.device = value();
+    else if (a.is("--device"))
+      o.device = a.value();
     else
-      usageError("", "unknown argument '" + a + "'");
+      a.unknown();
   }
   if (o.out.empty()) usageError("", "--out is required");
   if (o.scenes.empty()) usageError("--scenes", "no scene given");
@@ -208,6 +190,12 @@ Options parseArgs(int argc, char** argv) {
     const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
     o.cache = ec ? "bench-cache" : (exe.parent_path().parent_path() / "bench-cache").string();
   }
+  // Where results go is checked now, not after the sweep and its references.
+  if (o.calibrate)
+    gi::cli::checkOutputWritable(o.out);
+  else
+    gi::cli::checkOutputFolder(o.out);
+  gi::cli::checkOutputFolder(o.cache);
   return o;
 }
 
@@ -357,7 +345,7 @@ Reference computeReference(const Options& o, const LoadedScene& s, const Referen
                          {"seed", o.refSeed},
                          {"mean_stderr", r.meanStdError},
                          {"seconds", r.seconds}};
-  gi::bench::writeFileAtomic(stem + ".json", meta.dump(2) + "\n");
+  gi::cli::writeFileAtomic(stem + ".json", meta.dump(2) + "\n");
   return r;
 }
 
@@ -670,12 +658,7 @@ void loadInputs(const Options& o, Setup& s) {
   s.registry.scanDefaultLocations();
   for (const std::string& name : o.scenes) {
     LoadedScene ls{name, gi::loadScene(name), "default"};
-    if (name != "default") {
-      std::ifstream in(name, std::ios::binary);
-      std::ostringstream ss;
-      ss << in.rdbuf();
-      ls.contents = ss.str();
-    }
+    if (name != "default") ls.contents = gi::readInputFile(name, "scene file");
     for (const std::string& w : ls.scene.warnings)
       std::fprintf(stderr, "gi-bench: warning: %s\n", w.c_str());
     s.scenes.push_back(std::move(ls));
@@ -714,6 +697,12 @@ std::vector<std::string> effectItems(const Options& o, const gi::EffectRegistry&
   } else
     items = {registry.has("ssao") ? "ssao" : "none"};
   if (items.empty()) items = {"none"};
+  for (const std::string& item : items) {
+    const std::vector<std::string> set = splitPlus(item);
+    for (size_t k = 0; k < set.size(); ++k)
+      if (std::find(set.begin(), set.begin() + long(k), set[k]) != set.begin() + long(k))
+        usageError("--effects", "'" + set[k] + "' appears twice in '" + item + "'");
+  }
   for (const std::string& item : items)
     for (const std::string& e : splitPlus(item))
       if (!registry.has(e))
@@ -733,7 +722,8 @@ std::vector<Grid> parseGrids(const Options& o, const gi::EffectRegistry& registr
     if (dot == std::string::npos || eq == std::string::npos || dot > eq || dot == 0 ||
         eq == dot + 1)
       usageError("--grid", "'" + g + "': expected EFFECT.KEY=V1,V2,...");
-    Grid grid{g.substr(0, dot), g.substr(dot + 1, eq - dot - 1), splitList(g.substr(eq + 1))};
+    Grid grid{g.substr(0, dot), g.substr(dot + 1, eq - dot - 1),
+              gi::cli::splitList("--grid", g.substr(eq + 1))};
     if (grid.values.empty()) usageError("--grid", "'" + g + "': no values");
     if (!registry.has(grid.effect))
       usageError("--grid", "'" + g + "': unknown effect '" + grid.effect +
@@ -1189,7 +1179,7 @@ int runCalibrate(const Options& o) {
       {"items", record}};
   // Written, then checked by the engine's own loader, then moved into place.
   const std::string tmp = o.out + ".check.json";
-  gi::bench::writeFileAtomic(tmp, preset.dump(2) + "\n");
+  gi::cli::writeFileAtomic(tmp, preset.dump(2) + "\n");
   try {
     gi::validatePreset(gi::loadPreset(tmp), s.registry);
   } catch (...) {

@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bench.h"
+#include "cli.h"
 #include "gi/errors.h"
 #include "gi/image_io.h"
 #include "plot.h"
@@ -22,20 +23,7 @@ namespace gi::bench {
 
 namespace fs = std::filesystem;
 
-void writeFileAtomic(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".partial";
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    out << text;
-    out.flush();
-    if (!out) {
-      std::error_code ec;
-      fs::remove(tmp, ec);
-      throw Error(ErrorKind::FileNotFound, path, "cannot write file");
-    }
-  }
-  fs::rename(tmp, path);
-}
+using gi::cli::writeFileAtomic;
 
 double plotTime(const Row& row) {
   return row.effectMs > 0.0 ? row.effectMs : row.totalMs;

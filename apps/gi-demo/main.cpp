@@ -28,61 +28,47 @@ const char* kUsage =
     "keys: WASD walk, Q/E down/up, Shift run, Ctrl creep, right-drag look, P pause, N step,\n"
     "      R accuracy check, F2 screenshot, Tab panel, F1 help, Esc quit\n";
 
-[[noreturn]] void usageError(const std::string& message) {
-  throw gi::Error(gi::ErrorKind::Usage, "", message + " (see gi-demo --help)");
-}
-
-double number(const std::string& flag, const char* text, double lo, double hi) {
-  if (const auto v = gi::cli::numberIn(text, lo, hi)) return *v;
-  usageError(flag + " " + gi::cli::rangeMessage(text, lo, hi));
-}
-
 demo::AppOptions parseArgs(int argc, char** argv) {
   demo::AppOptions o;
   o.context = gi::vk::ContextOptions::fromEnvironment();
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto value = [&]() -> const char* {
-      if (i + 1 >= argc) usageError(a + " needs a value");
-      return argv[++i];
-    };
-    if (a == "--help" || a == "-h") {
+  for (gi::cli::Args a("gi-demo", argc, argv); a.next();) {
+    if (a.is("--help") || a.is("-h")) {
       std::fputs(kUsage, stdout);
       std::exit(0);
-    } else if (a == "--scene")
-      o.scene = value();
-    else if (a == "--width")
-      o.controller.width = uint32_t(number(a, value(), 16, 16384));
-    else if (a == "--height")
-      o.controller.height = uint32_t(number(a, value(), 16, 16384));
-    else if (a == "--preset")
-      o.controller.preset = value();
-    else if (a == "--effects")
-      o.controller.overrides.effects = gi::splitEffectList(value());
-    else if (a == "--set")
-      o.controller.overrides.sets.push_back(value());
-    else if (a == "--view")
-      o.controller.view = value();
-    else if (a == "--time")
-      o.time = number(a, value(), -1e9, 1e9);
-    else if (a == "--paused")
+    } else if (a.is("--scene"))
+      o.scene = a.value();
+    else if (a.is("--width"))
+      o.controller.width = uint32_t(a.integer(16, 16384));
+    else if (a.is("--height"))
+      o.controller.height = uint32_t(a.integer(16, 16384));
+    else if (a.is("--preset"))
+      o.controller.preset = a.value();
+    else if (a.is("--effects"))
+      o.controller.overrides.effects = a.list();  // a name twice is refused
+    else if (a.is("--set"))
+      o.controller.overrides.sets.push_back(a.value());
+    else if (a.is("--view"))
+      o.controller.view = a.value();
+    else if (a.is("--time"))
+      o.time = a.number(-1e9, 1e9);
+    else if (a.is("--paused"))
       o.paused = true;
-    else if (a == "--floor")
-      o.floor = float(number(a, value(), -1e6, 1e6));
-    else if (a == "--script")
-      o.script = value();
-    else if (a == "--frames")
-      o.frames = int(number(a, value(), 1, 1e9));
-    else if (a == "--out-dir")
-      o.outDir = value();
-    else if (a == "--validation")
+    else if (a.is("--floor"))
+      o.floor = float(a.number(-1e6, 1e6));
+    else if (a.is("--script"))
+      o.script = a.value();
+    else if (a.is("--frames"))
+      o.frames = int(a.integer(1, 1000000000));
+    else if (a.is("--out-dir"))
+      o.outDir = a.value();
+    else if (a.is("--validation"))
       o.context.validation = true;
-    else if (a == "--device")
-      o.context.device = value();
+    else if (a.is("--device"))
+      o.context.device = a.value();
     else
-      usageError("unknown argument '" + a + "'");
+      a.unknown();
   }
-  if (o.scene.empty()) usageError("--scene is required");
+  if (o.scene.empty()) gi::cli::usageError("gi-demo", "", "--scene is required");
   return o;
 }
 

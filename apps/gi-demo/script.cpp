@@ -2,11 +2,13 @@
 
 #include <cmath>
 #include <cstdlib>
-#include <fstream>
 #include <map>
+#include <optional>
 #include <sstream>
 
+#include "cli.h"
 #include "gi/errors.h"
+#include "gi/input_file.h"
 
 namespace demo {
 
@@ -26,16 +28,16 @@ const std::map<std::string, int> kVerbs = {
 
 double scriptNumber(const ScriptStep& step, size_t arg, const std::string& path) {
   const std::string& text = step.args.at(arg);
-  char* end = nullptr;
-  const double v = std::strtod(text.c_str(), &end);
-  if (end == text.c_str() || *end != '\0' || !std::isfinite(v))
-    fail(path, step.line, step.verb + ": expected a number, got '" + text + "'");
-  return v;
+  std::string problem;  // decimal and finite, as every command-line number (cli.h)
+  const std::optional<double> v = gi::cli::parseDouble(text, &problem);
+  if (!v)
+    fail(path, step.line, step.verb + ": expected a number, got '" + text + "', which " + problem);
+  return *v;
 }
 
 std::vector<ScriptStep> loadScript(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw gi::Error(gi::ErrorKind::FileNotFound, path, "cannot open the script");
+  // Regular files only, size-limited (gi/input_file.h): a FIFO is refused, not waited on.
+  std::istringstream in(gi::readInputFile(path, "script file", 64ull << 20));
   std::vector<ScriptStep> steps;
   std::string text;
   for (int line = 1; std::getline(in, text); ++line) {

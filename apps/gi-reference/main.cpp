@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -59,83 +60,63 @@ struct Options {
   bool quiet = false;
 };
 
-[[noreturn]] void usageError(const std::string& message) {
-  throw gi::Error(gi::ErrorKind::Usage, "", message + " (see gi-reference --help)");
-}
-
-double parseNumber(const std::string& flag, const char* text, double lo, double hi) {
-  if (const auto v = gi::cli::numberIn(text, lo, hi)) return *v;
-  usageError(flag + " " + gi::cli::rangeMessage(text, lo, hi));
-}
-
-uint64_t parseSeed(const char* text) {
-  char* end = nullptr;
-  errno = 0;
-  unsigned long long v = std::strtoull(text, &end, 10);
-  if (end == text || *end != '\0' || errno != 0 || text[0] == '-')
-    usageError(std::string("--seed expects a non-negative integer, got '") + text + "'");
-  return v;
-}
-
 Options parseArgs(int argc, char** argv) {
   Options o;
   ref::Settings& s = o.settings;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto value = [&]() -> const char* {
-      if (i + 1 >= argc) usageError(a + " needs a value");
-      return argv[++i];
-    };
-    if (a == "--help" || a == "-h") {
+  for (gi::cli::Args a("gi-reference", argc, argv); a.next();) {
+    if (a.is("--help") || a.is("-h")) {
       std::fputs(kUsage, stdout);
       std::exit(0);
-    } else if (a == "--scene")
-      o.scene = value();
-    else if (a == "--out")
-      o.out = value();
-    else if (a == "--png")
-      o.png = value();
-    else if (a == "--stderr-out")
-      o.stderrOut = value();
-    else if (a == "--gbuffer")
-      o.gbuffer = value();
-    else if (a == "--quantity")
-      s.quantity = ref::parseQuantity(value());
-    else if (a == "--membership")
-      s.membership = ref::parseMembership(value());
-    else if (a == "--radius")
-      s.radius = float(parseNumber(a, value(), 1e-9, 1e9));
-    else if (a == "--spp")
-      s.spp = uint32_t(parseNumber(a, value(), 1, 1 << 24));
-    else if (a == "--min-spp")
-      s.minSpp = uint32_t(parseNumber(a, value(), 1, 1 << 24));
-    else if (a == "--noise-target")
-      s.noiseTarget = parseNumber(a, value(), 0, 1e9);
-    else if (a == "--width")
-      s.width = uint32_t(parseNumber(a, value(), 1, 16384));
-    else if (a == "--height")
-      s.height = uint32_t(parseNumber(a, value(), 1, 16384));
-    else if (a == "--seed")
-      s.seed = parseSeed(value());
-    else if (a == "--threads")
-      s.threads = unsigned(parseNumber(a, value(), 1, 1024));
-    else if (a == "--time")
-      o.time = parseNumber(a, value(), -1e9, 1e9);
-    else if (a == "--alchemy-sigma")
-      s.alchemy.sigma = float(parseNumber(a, value(), 0, 1e9));
-    else if (a == "--alchemy-u")
-      s.alchemy.u = float(parseNumber(a, value(), 0, 1e9));
-    else if (a == "--alchemy-epsilon")
-      s.alchemy.epsilon = float(parseNumber(a, value(), 0, 1e9));
-    else if (a == "--alchemy-contrast")
-      s.alchemy.contrast = float(parseNumber(a, value(), 1e-6, 1e6));
-    else if (a == "--exposure")
-      o.exposure = float(parseNumber(a, value(), 0, 1e6));
-    else if (a == "--quiet")
+    } else if (a.is("--scene"))
+      o.scene = a.value();
+    else if (a.is("--out"))
+      o.out = a.value();
+    else if (a.is("--png"))
+      o.png = a.value();
+    else if (a.is("--stderr-out"))
+      o.stderrOut = a.value();
+    else if (a.is("--gbuffer"))
+      o.gbuffer = a.value();
+    else if (a.is("--quantity"))
+      s.quantity = ref::parseQuantity(a.value());
+    else if (a.is("--membership"))
+      s.membership = ref::parseMembership(a.value());
+    else if (a.is("--radius"))
+      s.radius = float(a.numberAbove(0, 1e9));
+    else if (a.is("--spp"))
+      s.spp = uint32_t(a.integer(1, 1 << 24));
+    else if (a.is("--min-spp"))
+      s.minSpp = uint32_t(a.integer(1, 1 << 24));
+    else if (a.is("--noise-target"))
+      s.noiseTarget = a.number(0, 1e9);
+    else if (a.is("--width"))
+      s.width = uint32_t(a.integer(1, 16384));
+    else if (a.is("--height"))
+      s.height = uint32_t(a.integer(1, 16384));
+    else if (a.is("--seed"))
+      s.seed = uint64_t(a.integer(0, std::numeric_limits<int64_t>::max()));
+    else if (a.is("--threads"))
+      s.threads = unsigned(a.integer(1, 1024));
+    else if (a.is("--time"))
+      o.time = a.number(-1e9, 1e9);
+    else if (a.is("--alchemy-sigma"))
+      s.alchemy.sigma = float(a.number(0, 1e9));
+    else if (a.is("--alchemy-u"))
+      s.alchemy.u = float(a.number(0, 1e9));
+    else if (a.is("--alchemy-epsilon"))  // 0 only with --alchemy-u > 0 (checked by render)
+      s.alchemy.epsilon = float(a.number(0, 1));
+    else if (a.is("--alchemy-contrast"))
+      s.alchemy.contrast = float(a.number(1e-6, 1e6));
+    else if (a.is("--exposure"))
+      o.exposure = float(a.number(0, 1e6));
+    else if (a.is("--quiet"))
       o.quiet = true;
     else
-      usageError("unknown argument '" + a + "'");
+      a.unknown();
   }
+  auto usageError = [](const std::string& message) {
+    gi::cli::usageError("gi-reference", "", message);
+  };
   if (o.scene.empty()) usageError("--scene is required");
   if (o.out.empty()) usageError("--out is required");
   auto requireExt = [](const std::string& path, const char* ext) {
@@ -148,16 +129,6 @@ Options parseArgs(int argc, char** argv) {
   if (o.stderrOut.empty())
     o.stderrOut = (std::filesystem::path(o.out).replace_extension(".stderr.pfm")).string();
   return o;
-}
-
-// Fails before any work when an output cannot be created (missing or non-directory parent).
-void checkWritable(const std::string& path) {
-  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
-  std::error_code ec;
-  if (!parent.empty() && !std::filesystem::is_directory(parent, ec))
-    throw gi::Error(gi::ErrorKind::FileNotFound, path, "output folder does not exist");
-  if (std::filesystem::is_directory(path, ec))
-    throw gi::Error(gi::ErrorKind::FileNotFound, path, "output path is a folder");
 }
 
 // "dir/x.pfm" + ".visible" -> "dir/x.visible.pfm".
@@ -191,7 +162,7 @@ int run(const Options& o) {
   if (!o.gbuffer.empty())
     for (const char* suffix : {"_depth.pfm", "_normal.pfm", "_position.pfm"})
       outputs.push_back(o.gbuffer + suffix);
-  for (const std::string& path : outputs) checkWritable(path);
+  for (const std::string& path : outputs) gi::cli::checkOutputWritable(path);
 
   gi::Scene scene = gi::loadScene(o.scene);
   for (const std::string& w : scene.warnings)

@@ -67,77 +67,65 @@ struct Options {
   bool timings = false, validation = false, window = false, isolatePasses = false;
 };
 
-[[noreturn]] void usageError(const std::string& message) {
-  throw gi::Error(gi::ErrorKind::Usage, "", message + " (see gi-render --help)");
-}
-
-double parseNumber(const std::string& flag, const char* text, double lo, double hi) {
-  if (const auto v = gi::cli::numberIn(text, lo, hi)) return *v;
-  usageError(flag + " " + gi::cli::rangeMessage(text, lo, hi));
-}
-
 Options parseArgs(int argc, char** argv) {
   Options o;
   o.validation = gi::vk::ContextOptions::fromEnvironment().validation;
-  for (int i = 1; i < argc; ++i) {
-    std::string a = argv[i];
-    auto value = [&]() -> const char* {
-      if (i + 1 >= argc) usageError(a + " needs a value");
-      return argv[++i];
-    };
-    if (a == "--help" || a == "-h") {
+  for (gi::cli::Args a("gi-render", argc, argv); a.next();) {
+    if (a.is("--help") || a.is("-h")) {
       std::fputs(kUsage, stdout);
       std::exit(0);
-    } else if (a == "--scene")
-      o.scene = value();
-    else if (a == "--out")
-      o.out = value();
-    else if (a == "--width")
-      o.width = uint32_t(parseNumber(a, value(), 1, 16384));
-    else if (a == "--height")
-      o.height = uint32_t(parseNumber(a, value(), 1, 16384));
-    else if (a == "--frames")
-      o.frames = int(parseNumber(a, value(), 1, 100000));
-    else if (a == "--time")
-      o.time = parseNumber(a, value(), -1e9, 1e9);
-    else if (a == "--time-step")
-      o.timeStep = parseNumber(a, value(), -1e6, 1e6);
-    else if (a == "--exposure" || a == "--surface-points") {
+    } else if (a.is("--scene"))
+      o.scene = a.value();
+    else if (a.is("--out"))
+      o.out = a.value();
+    else if (a.is("--width"))
+      o.width = uint32_t(a.integer(1, 16384));
+    else if (a.is("--height"))
+      o.height = uint32_t(a.integer(1, 16384));
+    else if (a.is("--frames"))
+      o.frames = int(a.integer(1, 100000));
+    else if (a.is("--time"))
+      o.time = a.number(-1e9, 1e9);
+    else if (a.is("--time-step"))
+      o.timeStep = a.number(-1e6, 1e6);
+    else if (a.is("--exposure") || a.is("--surface-points")) {
       // Shorthands for --set engine.*: same place in the order, same validation.
-      const char* text = value();
-      parseNumber(a, text, 0, a == "--exposure" ? 1e6 : double(1 << 24));
+      const bool exposure = a.is("--exposure");
+      const std::string text = gi::cli::formatNumber(
+          exposure ? a.number(0, 1e6) : double(a.integer(0, int64_t(1) << 24)));
       o.overrides.sets.push_back(std::string("engine.") +
-                                 (a == "--exposure" ? "exposure=" : "surface_points=") + text);
-    } else if (a == "--view")
-      o.view = value();
-    else if (a == "--device")
-      o.device = value();
-    else if (a == "--timings")
+                                 (exposure ? "exposure=" : "surface_points=") + text);
+    } else if (a.is("--view"))
+      o.view = a.value();
+    else if (a.is("--device"))
+      o.device = a.value();
+    else if (a.is("--timings"))
       o.timings = true;
-    else if (a == "--isolate-passes")
+    else if (a.is("--isolate-passes"))
       o.isolatePasses = true;
-    else if (a == "--validation")
+    else if (a.is("--validation"))
       o.validation = true;
-    else if (a == "--window")
+    else if (a.is("--window"))
       o.window = true;
-    else if (a == "--effects")
-      o.overrides.effects = gi::splitEffectList(value());
-    else if (a == "--preset")
-      o.preset = value();
-    else if (a == "--set")
-      o.overrides.sets.push_back(value());
-    else if (a == "--list-effects")
+    else if (a.is("--effects"))
+      o.overrides.effects = a.list();  // a name twice is refused
+    else if (a.is("--preset"))
+      o.preset = a.value();
+    else if (a.is("--set"))
+      o.overrides.sets.push_back(a.value());
+    else if (a.is("--list-effects"))
       o.listEffects = true;
-    else if (a == "--print-graph")
+    else if (a.is("--print-graph"))
       o.printGraph = true;
-    else if (a == "--graph-dot")
-      o.graphDot = value();
+    else if (a.is("--graph-dot"))
+      o.graphDot = a.value();
     else
-      usageError("unknown argument '" + a + "'");
+      a.unknown();
   }
   if (o.listEffects) return o;
-  if (o.scene.empty()) usageError("--scene is required");
-  if (o.out.empty() && !o.window) usageError("--out is required (or --window)");
+  if (o.scene.empty()) gi::cli::usageError("gi-render", "", "--scene is required");
+  if (o.out.empty() && !o.window)
+    gi::cli::usageError("gi-render", "", "--out is required (or --window)");
   return o;
 }
 
@@ -166,17 +154,6 @@ void writeImage(const std::string& path, const std::string& view, gi::Renderer& 
     gi::writePng(path, toPreview(renderer.readTarget(view), view));
 }
 
-// Writes `text` to `path` through a temporary file (no partial output on failure).
-void writeText(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".partial";
-  {
-    std::ofstream out(tmp);
-    out << text;
-    if (!out) throw gi::Error(gi::ErrorKind::FileNotFound, path, "cannot write file");
-  }
-  std::filesystem::rename(tmp, path);
-}
-
 int listEffects() {
   gi::EffectRegistry registry;
   registry.scanDefaultLocations();
@@ -192,6 +169,9 @@ int run(const Options& o) {
   const std::string ext = std::filesystem::path(o.out).extension().string();
   if (!o.out.empty() && ext != ".png" && ext != ".pfm")
     throw gi::Error(gi::ErrorKind::Usage, o.out, "output must end in .png or .pfm");
+  // Outputs are checked before any work: a long render never ends in "cannot write".
+  if (!o.out.empty()) gi::cli::checkOutputWritable(o.out);
+  if (!o.graphDot.empty()) gi::cli::checkOutputWritable(o.graphDot);
   // Load and validate everything (scene, effects, preset, settings) before any Vulkan work,
   // so bad input fails fast.
   gi::Scene scene = gi::loadScene(o.scene);
@@ -236,7 +216,7 @@ int run(const Options& o) {
   settings.effects = effects;
   gi::Renderer renderer(ctx, scene, settings, &registry);
   if (o.printGraph) std::printf("%s", renderer.graphDescription().c_str());
-  if (!o.graphDot.empty()) writeText(o.graphDot, renderer.graphDot());
+  if (!o.graphDot.empty()) gi::cli::writeFileAtomic(o.graphDot, renderer.graphDot());
   std::optional<gi::vk::Swapchain> swapchain;
   if (window) swapchain.emplace(ctx, window->handle());
 

@@ -9,6 +9,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -36,6 +37,9 @@ std::vector<std::string> presetLocations();
 std::vector<std::string> presetNames();
 // `nameOrPath`: a preset name ("medium") or a .json path. Throws gi::Error naming the file.
 Preset loadPreset(const std::string& nameOrPath);
+// The preset in `text` (the contents of the file `path`, named in errors); what loadPreset
+// does after reading the file.
+Preset parsePreset(std::string_view text, const std::string& path);
 // Checks every effect and setting a preset names against the registry ("engine": against the
 // engine's settings).
 void validatePreset(const Preset& preset, const EffectRegistry& registry);

@@ -445,6 +445,10 @@ void validate(const Settings& s) {
       !(a.epsilon >= 0.0f && std::isfinite(a.epsilon)) ||
       !(a.contrast > 0.0f && std::isfinite(a.contrast)))
     usage("Alchemy parameters must be finite, sigma/u/epsilon >= 0 and contrast > 0");
+  // With u = 0 the falloff sigma t / (t^2 + epsilon) peaks at sigma / (2 sqrt(epsilon)):
+  // epsilon = 0 makes it unbounded near t = 0 and the estimate's variance with it.
+  if (s.quantity == Quantity::Alchemy && a.u == 0.0f && a.epsilon == 0.0f)
+    usage("Alchemy epsilon must be > 0 when u = 0 (the falloff is unbounded at distance 0)");
 }
 
 void setPixel(ImageRGBA32F& img, size_t i, const glm::vec3& v, float a) {

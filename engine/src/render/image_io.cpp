@@ -3,6 +3,7 @@
 #include <stb_image.h>
 #include <stb_image_write.h>
 
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -32,11 +33,14 @@ std::string tempName(const std::string& path) {
 
 void writePng(const std::string& path, const ImageRGBA8& image) {
   const std::string tmp = tempName(path);
+  errno = 0;
   if (!stbi_write_png(tmp.c_str(), image.width, image.height, 4, image.pixels.data(),
                       image.width * 4)) {
+    const int err = errno;  // stb opens the file with fopen
     std::error_code ec;
     std::filesystem::remove(tmp, ec);
-    throw Error(ErrorKind::FileNotFound, path, "cannot write PNG (does the folder exist?)");
+    throw Error(ErrorKind::FileNotFound, path,
+                std::string("cannot write PNG: ") + (err ? std::strerror(err) : "write failed"));
   }
   commitFile(tmp, path);
 }
@@ -55,9 +59,12 @@ ImageRGBA8 readPng(const std::string& path) {
 void writePfm(const std::string& path, const ImageRGBA32F& image) {
   const std::string tmp = tempName(path);
   {
+    errno = 0;
     std::ofstream out(tmp, std::ios::binary);
     if (!out)
-      throw Error(ErrorKind::FileNotFound, path, "cannot write PFM (does the folder exist?)");
+      throw Error(
+          ErrorKind::FileNotFound, path,
+          std::string("cannot write PFM: ") + (errno ? std::strerror(errno) : "open failed"));
     out << "PF\n" << image.width << " " << image.height << "\n-1.0\n";  // -1: little-endian
     std::vector<float> row(size_t(image.width) * 3);
     for (int y = image.height - 1; y >= 0; --y) {

@@ -132,7 +132,7 @@ void addDefaultCameraAndLight(Scene& scene) {
   glm::vec3 bmin, bmax;
   scene.worldBounds(bmin, bmax);
   const glm::vec3 centre = 0.5f * (bmin + bmax);
-  const float radius = std::max(0.5f * glm::length(bmax - bmin), 1e-3f);
+  const float radius = std::max(0.5f * glm::length(bmax - bmin), 1e-20f);  // as the framing
 
   int cameraNode = -1;
   for (size_t i = 0; i < scene.nodes.size() && cameraNode < 0; ++i)

@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 
 #include <stb_image.h>
 
 #include "gi/errors.h"
+#include "gi/input_file.h"
 
 namespace gi {
 
@@ -59,8 +61,13 @@ void loadEnvironmentMap(Environment& env, const std::string& file) {
   std::error_code ec;
   if (!std::filesystem::exists(file, ec))
     throw Error(ErrorKind::MissingResource, file, "environment map '" + file + "' does not exist");
+  // Read through the checked reader (regular files only, bounded), then decode from memory.
+  const std::string bytes = readInputFile(file, "environment map");
+  if (bytes.size() > size_t(std::numeric_limits<int>::max()))
+    throw Error(ErrorKind::Unsupported, file, "environment maps larger than 2 GiB are not read");
   int w = 0, h = 0, n = 0;
-  float* data = stbi_loadf(file.c_str(), &w, &h, &n, 3);
+  float* data = stbi_loadf_from_memory(reinterpret_cast<const stbi_uc*>(bytes.data()),
+                                       int(bytes.size()), &w, &h, &n, 3);
   if (!data || w <= 0 || h <= 0) {
     if (data) stbi_image_free(data);
     throw Error(ErrorKind::Parse, file,

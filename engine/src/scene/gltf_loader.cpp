@@ -18,17 +18,20 @@
 #include <initializer_list>
 #include <limits>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include <stb_image.h>
 #include <tiny_gltf.h>
+#include <glm/gtc/constants.hpp>
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/type_ptr.hpp>
 #include <nlohmann/json.hpp>
 
 #include "gi/errors.h"
+#include "gi/input_file.h"
 #include "gi/scene_io.h"
 
 namespace gi {
@@ -41,22 +44,37 @@ using nlohmann::json;
 // File and container
 
 std::vector<unsigned char> readWholeFile(const std::string& path) {
-  std::error_code ec;
-  if (!fs::exists(path, ec)) throw Error(ErrorKind::FileNotFound, path, "file does not exist");
-  if (fs::is_directory(path, ec))
-    throw Error(ErrorKind::FileNotFound, path, "is a directory, not a glTF file");
-  std::ifstream in(path, std::ios::binary | std::ios::ate);
-  if (!in) throw Error(ErrorKind::FileNotFound, path, "cannot open the file for reading");
-  const std::streamoff size = in.tellg();
-  if (size <= 0) throw Error(ErrorKind::EmptyFile, path, "file is empty");
   // tinygltf takes the size as a 32-bit unsigned (GLB's own limit too).
-  if (static_cast<uint64_t>(size) > std::numeric_limits<uint32_t>::max())
-    throw Error(ErrorKind::Unsupported, path, "glTF files larger than 4 GiB are not supported");
-  std::vector<unsigned char> bytes(static_cast<size_t>(size));
-  in.seekg(0);
-  if (!in.read(reinterpret_cast<char*>(bytes.data()), size))
-    throw Error(ErrorKind::FileNotFound, path, "cannot read the file");
+  const uint64_t size = checkInputFile(path, "glTF file", std::numeric_limits<uint32_t>::max());
+  if (size == 0) throw Error(ErrorKind::EmptyFile, path, "file is empty");
+  std::vector<unsigned char> bytes;
+  std::string problem;
+  if (!tryReadInputFile(path, bytes, problem, "glTF file", std::numeric_limits<uint32_t>::max()))
+    throw Error(ErrorKind::FileNotFound, path, problem);
+  if (bytes.empty()) throw Error(ErrorKind::EmptyFile, path, "file is empty");
   return bytes;
+}
+
+// tinygltf's file access for buffers and images: only regular files of bounded size (its own
+// reader turns a directory into a size of 2^64-1 and std::bad_alloc, and reads a FIFO forever),
+// and no shell-style expansion of the uri.
+bool fileExists(const std::string& path, void*) {
+  std::error_code ec;
+  return fs::exists(path, ec);
+}
+std::string expandNothing(const std::string& path, void*) {
+  return path;
+}
+bool readChecked(std::vector<unsigned char>* out, std::string* err, const std::string& path,
+                 void*) {
+  std::string problem;
+  if (tryReadInputFile(path, *out, problem, "file")) return true;
+  if (err) *err += problem;  // tinygltf adds "File read error : <path> : "
+  return false;
+}
+bool writeNothing(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
+  if (err) *err += "writing is not supported\n";
+  return false;
 }
 
 uint32_t readU32(const unsigned char* p) {  // GLB is little-endian
@@ -76,6 +94,9 @@ std::string_view glbJsonChunk(const std::vector<unsigned char>& bytes, const std
                 "truncated binary glTF: " + std::to_string(bytes.size()) +
                     " bytes, but the header and first chunk header need 20");
   const uint32_t version = readU32(&bytes[4]);
+  if (version == 1)
+    throw Error(ErrorKind::Unsupported, path,
+                "glTF 1.0 is not supported (binary glTF version 1; only glTF 2.x is read)");
   if (version != 2)
     throw Error(
         ErrorKind::Unsupported, path,
@@ -525,6 +546,15 @@ class GltfLoader {
   [[noreturn]] void fail(ErrorKind kind, const std::string& problem) const {
     throw Error(kind, path_, problem);
   }
+  // A value out of its range: "<file>: <where>: <problem>", as the JSON scene loader says it.
+  [[noreturn]] void invalid(const std::string& where, const std::string& problem) const {
+    fail(ErrorKind::InvalidData, where + ": " + problem);
+  }
+  static std::string num(double v) {
+    std::ostringstream s;
+    s << v;  // as written: 0.5, 1e+30, not 0.500000
+    return s.str();
+  }
   void warn(const std::string& message) { scene_.warnings.push_back(path_ + ": " + message); }
 
   // File -> checked JSON -> tinygltf model.
@@ -537,20 +567,14 @@ class GltfLoader {
         binary ? glbJsonChunk(bytes, path_)
                : std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size());
 
-    json doc;
-    try {
-      doc = json::parse(text.begin(), text.end());
-    } catch (const json::exception& e) {
-      fail(ErrorKind::Parse, std::string("invalid JSON: ") + e.what());
-    }
+    const json doc = parseJsonText(text, path_);
+    checkVersion(doc);
     SchemaCheck(path_).object(doc, kRoot, "");
-    const std::string version = doc["asset"]["version"].get<std::string>();
-    if (version.rfind("2.", 0) != 0)
-      fail(ErrorKind::Unsupported, "glTF version " + version + " (only 2.x is supported)");
     checkRequiredExtensions(doc);
 
     tinygltf::TinyGLTF loader;
     loader.SetImageLoader(&keepEncodedImage, nullptr);
+    loader.SetFsCallbacks({&fileExists, &expandNothing, &readChecked, &writeNothing, nullptr});
     std::string err, warnings;
     std::string baseDir = fs::path(path_).parent_path().string();
     if (baseDir.empty()) baseDir = ".";
@@ -565,6 +589,23 @@ class GltfLoader {
                      (kind == ErrorKind::MissingResource ? " (relative to " + baseDir + ")" : ""));
     }
     if (!trimmed(warnings).empty()) warn("tinygltf: " + trimmed(warnings));
+  }
+
+  // Before the schema check: a glTF 1.0 file fails it in ways that do not say what is wrong
+  // (its "scene" is a string, its meshes an object keyed by id).
+  void checkVersion(const json& doc) {
+    if (!doc.is_object()) return;  // the schema check names it
+    const auto asset = doc.find("asset");
+    const bool hasVersion = asset != doc.end() && asset->is_object() &&
+                            asset->contains("version") && (*asset)["version"].is_string();
+    const std::string version = hasVersion ? (*asset)["version"].get<std::string>() : "";
+    const bool v1Layout = (doc.contains("scene") && doc["scene"].is_string()) ||
+                          (doc.contains("meshes") && doc["meshes"].is_object()) ||
+                          (doc.contains("nodes") && doc["nodes"].is_object());
+    if (version.rfind("1.", 0) == 0 || (!hasVersion && v1Layout))
+      fail(ErrorKind::Unsupported, "glTF 1.0 is not supported (only glTF 2.x is read)");
+    if (hasVersion && version.rfind("2.", 0) != 0)
+      fail(ErrorKind::Unsupported, "glTF version " + version + " (only 2.x is supported)");
   }
 
   // A required extension changes what the file means; showing it without would be wrong.
@@ -585,7 +626,20 @@ class GltfLoader {
       const tinygltf::Camera& gc = model_.cameras[i];
       Camera cam;
       cam.name = gc.name.empty() ? "camera " + std::to_string(i) : gc.name;
+      const std::string where = "cameras[" + std::to_string(i) + "]";
       if (gc.type == "perspective") {
+        // The same rules as a JSON scene's camera (yfov in (0, 180) degrees, 0 < near < far).
+        const tinygltf::PerspectiveCamera& p = gc.perspective;
+        if (!(p.yfov > 0.0 && p.yfov < glm::pi<double>()))
+          invalid(where + ".perspective.yfov", "must be in (0, pi) radians, got " + num(p.yfov));
+        if (!(p.znear > 0.0))
+          invalid(where + ".perspective.znear", "must be positive, got " + num(p.znear));
+        if (p.zfar != 0.0 && !(p.zfar > p.znear))
+          invalid(where + ".perspective.zfar",
+                  "must be greater than znear (" + num(p.znear) + "), got " + num(p.zfar));
+        if (p.aspectRatio < 0.0)
+          invalid(where + ".perspective.aspectRatio",
+                  "must be positive, got " + num(p.aspectRatio));
         cam.yfov = static_cast<float>(gc.perspective.yfov);
         cam.aspect = static_cast<float>(gc.perspective.aspectRatio);  // 0 when absent
         cam.znear = static_cast<float>(gc.perspective.znear);
@@ -593,6 +647,12 @@ class GltfLoader {
         cam.zfar = gc.perspective.zfar > 0.0 ? static_cast<float>(gc.perspective.zfar)
                                              : std::max(cam.zfar, cam.znear * 1e4f);
       } else if (gc.type == "orthographic") {
+        const tinygltf::OrthographicCamera& o = gc.orthographic;
+        if (!(o.znear >= 0.0))
+          invalid(where + ".orthographic.znear", "must not be negative, got " + num(o.znear));
+        if (!(o.zfar > o.znear))
+          invalid(where + ".orthographic.zfar",
+                  "must be greater than znear (" + num(o.znear) + "), got " + num(o.zfar));
         cam.znear = static_cast<float>(gc.orthographic.znear);
         cam.zfar = static_cast<float>(gc.orthographic.zfar);
         warn(cam.name +
@@ -623,8 +683,26 @@ class GltfLoader {
         fail(ErrorKind::Schema, "KHR_lights_punctual light " + std::to_string(i) +
                                     " has unknown type '" + gl.type + "'");
       }
-      if (gl.color.size() == 3)
+      // The same rules as a JSON scene's light.
+      const std::string where = "KHR_lights_punctual.lights[" + std::to_string(i) + "]";
+      if (light.type == LightType::Spot) {
+        const double inner = gl.spot.innerConeAngle, outer = gl.spot.outerConeAngle;
+        if (!(outer > 0.0 && outer <= glm::half_pi<double>()))
+          invalid(where + ".spot.outerConeAngle",
+                  "must be in (0, pi/2] radians, got " + num(outer));
+        if (!(inner >= 0.0 && inner <= outer))
+          invalid(where + ".spot.innerConeAngle",
+                  "must be in [0, outerConeAngle] (" + num(outer) + "), got " + num(inner));
+      }
+      if (gl.color.size() == 3) {
+        if (gl.color[0] < 0 || gl.color[1] < 0 || gl.color[2] < 0)
+          invalid(where + ".color", "colour components must not be negative");
         light.color = glm::vec3(float(gl.color[0]), float(gl.color[1]), float(gl.color[2]));
+      }
+      if (!(gl.intensity >= 0.0))
+        invalid(where + ".intensity", "must not be negative, got " + num(gl.intensity));
+      if (!(gl.range >= 0.0))
+        invalid(where + ".range", "must not be negative, got " + num(gl.range));
       light.intensity = static_cast<float>(gl.intensity);
       light.range = static_cast<float>(gl.range);
       scene_.lights.push_back(light);
@@ -639,6 +717,10 @@ class GltfLoader {
       Material mat;
       mat.name = gm.name.empty() ? what : gm.name;
       const std::vector<double>& c = pbr.baseColorFactor;  // tinygltf fills the default
+      const std::string where = "materials[" + std::to_string(i) + "]";
+      if (c[0] < 0 || c[1] < 0 || c[2] < 0 || c[3] < 0)
+        invalid(where + ".pbrMetallicRoughness.baseColorFactor",
+                "colour components must not be negative");
       mat.baseColor = glm::vec4(float(c[0]), float(c[1]), float(c[2]), float(c[3]));
       // The spec limits both factors to [0, 1].
       mat.metallic = std::clamp(static_cast<float>(pbr.metallicFactor), 0.0f, 1.0f);
@@ -654,6 +736,12 @@ class GltfLoader {
       if (auto ext = gm.extensions.find("KHR_materials_emissive_strength");
           ext != gm.extensions.end() && ext->second.Has("emissiveStrength"))
         strength = static_cast<float>(ext->second.Get("emissiveStrength").GetNumberAsDouble());
+      // Negative emission would add negative radiance (a JSON scene's "emission" is refused too).
+      if (e[0] < 0 || e[1] < 0 || e[2] < 0)
+        invalid(where + ".emissiveFactor", "colour components must not be negative");
+      if (!(strength >= 0.0f))
+        invalid(where + ".extensions.KHR_materials_emissive_strength.emissiveStrength",
+                "must not be negative, got " + num(double(strength)));
       mat.emission = glm::vec3(float(e[0]), float(e[1]), float(e[2])) * strength;
       scene_.materials.push_back(mat);
     }
@@ -685,9 +773,18 @@ class GltfLoader {
         "image " + std::to_string(source) + (external ? " ('" + image.uri + "')" : std::string());
     if (image.image.empty()) {
       // tinygltf only warns when an image file is missing, leaving the image empty.
-      if (external)
+      if (external) {
+        // Say why: a directory, a device or a file too large is refused by readChecked.
+        const fs::path file = fs::path(path_).parent_path() / image.uri;
+        std::vector<unsigned char> probe;
+        std::string problem;
+        std::error_code ec;
+        if (fs::exists(file, ec) && !tryReadInputFile(file.string(), probe, problem, "file"))
+          fail(ErrorKind::MissingResource,
+               what + ": " + label + ": " + file.string() + " " + problem);
         fail(ErrorKind::MissingResource,
              what + ": " + label + " not found (looked next to the glTF file)");
+      }
       fail(ErrorKind::InvalidData, what + ": " + label + " has no data");
     }
     if (image.image.size() > size_t(std::numeric_limits<int>::max()))

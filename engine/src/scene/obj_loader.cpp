@@ -16,11 +16,13 @@
 #include <charconv>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <unordered_map>
 
 #include <stb_image.h>
 
 #include "gi/errors.h"
+#include "gi/input_file.h"
 #include "scene_io_util.h"
 
 namespace gi::detail {
@@ -52,10 +54,23 @@ std::string restOfLine(std::string_view line, std::string_view keyword) {
   return std::string(rest);
 }
 
-bool parseFloat(std::string_view s, float& out) {
+enum class FloatParse { Ok, NotANumber, OutOfRange };
+
+FloatParse parseFloat(std::string_view s, float& out) {
   if (!s.empty() && s.front() == '+') s.remove_prefix(1);  // from_chars rejects a '+'
-  auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
-  return ec == std::errc() && end == s.data() + s.size();
+  // Through double: a value beyond float range is named as such, one below it becomes 0.
+  double d = 0.0;
+  auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), d);
+  if (end != s.data() + s.size() || (ec != std::errc() && ec != std::errc::result_out_of_range))
+    return FloatParse::NotANumber;
+  const bool tiny =
+      s.find("e-") != std::string_view::npos || s.find("E-") != std::string_view::npos;
+  if (ec == std::errc::result_out_of_range && !tiny) return FloatParse::OutOfRange;
+  if (ec == std::errc::result_out_of_range) d = 0.0;
+  if (std::isfinite(d) && std::abs(d) > double(std::numeric_limits<float>::max()))
+    return FloatParse::OutOfRange;
+  out = static_cast<float>(d);
+  return FloatParse::Ok;
 }
 
 bool parseInt(std::string_view s, long& out) {
@@ -87,8 +102,15 @@ glm::vec<N, float> readVec(const std::vector<std::string_view>& tok, const LineE
         ErrorKind::Parse,
         std::string(tok[0]).append(" needs ").append(std::to_string(required)).append(" numbers"));
   for (int i = 0; i < N && i + 1 < static_cast<int>(tok.size()); ++i)
-    if (!parseFloat(tok[i + 1], v[i]))
-      err.fail(ErrorKind::Parse, std::string(tok[i + 1]).append(" is not a number"));
+    switch (parseFloat(tok[i + 1], v[i])) {
+      case FloatParse::Ok:
+        break;
+      case FloatParse::OutOfRange:
+        err.fail(ErrorKind::InvalidData,
+                 std::string(tok[i + 1]).append(" is out of range for a float (beyond 3.4e38)"));
+      case FloatParse::NotANumber:
+        err.fail(ErrorKind::Parse, std::string(tok[i + 1]).append(" is not a number"));
+    }
   return v;
 }
 
@@ -333,10 +355,19 @@ class ObjReader {
   int loadTexture(const std::string& file) {
     fs::path texPath = fs::path(path_).parent_path() / file;
     int w = 0, h = 0, n = 0;
-    unsigned char* pixels = stbi_load(texPath.string().c_str(), &w, &h, &n, 4);
+    // Read through the checked reader (regular files only), then decode from memory.
+    std::vector<unsigned char> bytes;
+    std::string problem;
+    unsigned char* pixels = nullptr;
+    if (tryReadInputFile(texPath.string(), bytes, problem, "texture") &&
+        bytes.size() <= size_t(std::numeric_limits<int>::max()))
+      pixels = stbi_load_from_memory(bytes.data(), int(bytes.size()), &w, &h, &n, 4);
+    else if (problem.empty())
+      problem = "larger than 2 GiB";
     if (!pixels) {
-      data_.warnings.push_back(path_ + ": texture '" + texPath.string() +
-                               "' could not be loaded; using the plain colour");
+      data_.warnings.push_back(path_ + ": texture '" + texPath.string() + "' could not be loaded" +
+                               (problem.empty() ? "" : " (" + problem + ")") +
+                               "; using the plain colour");
       return -1;
     }
     Texture t;

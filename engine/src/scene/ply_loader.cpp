@@ -18,6 +18,7 @@
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
 
 #include "gi/errors.h"
+#include "gi/input_file.h"
 #include "scene_io_util.h"
 
 namespace gi::detail {
@@ -75,11 +76,21 @@ PlyHeader readHeader(const std::string& path) {
       if (kw != "ply") fail(1, "not a PLY file (first line must be 'ply')");
       continue;
     }
+    // Every line has exactly its tokens: OpenMesh's own header reader loops forever on some
+    // malformed lines (fuzzing found "format binary_little_endian format ..."; regression input
+    // in tests/fuzz/regressions/ply).
+    auto noMoreTokens = [&](const char* what) {
+      std::string extra;
+      if (words >> extra) fail(lineNo, std::string(what) + ": unexpected '" + extra + "'");
+    };
     if (kw == "format") {
-      std::string fmt;
-      words >> fmt;
+      std::string fmt, version;
+      words >> fmt >> version;
       if (fmt != "ascii" && fmt != "binary_little_endian" && fmt != "binary_big_endian")
         fail(lineNo, "unknown format '" + fmt + "'");
+      if (version != "1.0") fail(lineNo, "format version must be 1.0, got '" + version + "'");
+      noMoreTokens("format line");
+      if (sawFormat || !h.elements.empty()) fail(lineNo, "format line repeated or too late");
       h.ascii = fmt == "ascii";
       sawFormat = true;
     } else if (kw == "element") {
@@ -87,6 +98,7 @@ PlyHeader readHeader(const std::string& path) {
       long long count = -1;
       words >> e.name >> count;
       if (e.name.empty() || !words || count < 0) fail(lineNo, "malformed element line");
+      noMoreTokens("element line");
       e.count = static_cast<size_t>(count);
       if (e.name == "vertex") h.vertexCount = e.count;
       if (e.name == "face") h.faceCount = e.count;
@@ -105,8 +117,10 @@ PlyHeader readHeader(const std::string& path) {
         prop = {false, scalarSize(type), 0};
         if (!prop.size || name.empty()) fail(lineNo, "unknown property type '" + type + "'");
       }
+      noMoreTokens("property line");
       h.elements.back().properties.push_back(prop);
     } else if (kw == "end_header") {
+      noMoreTokens("end_header line");
       ended = true;
     } else if (kw != "comment" && kw != "obj_info" && !kw.empty()) {
       fail(lineNo, "unknown keyword '" + kw + "'");
@@ -207,7 +221,7 @@ class CheckingImporter : public OpenMesh::IO::ImporterT<OmMesh> {
       if (vh.idx() < 0 || static_cast<size_t>(vh.idx()) >= vertices) {
         if (badFace < 0) {
           badFace = static_cast<long long>(facesSeen) - 1;
-          badIndex = static_cast<unsigned>(vh.idx());
+          badIndex = vh.idx();
         }
         return OpenMesh::FaceHandle();
       }
@@ -221,18 +235,15 @@ class CheckingImporter : public OpenMesh::IO::ImporterT<OmMesh> {
 
   size_t vertices = 0, facesSeen = 0, shortFaces = 0;
   long long badFace = -1;
-  unsigned badIndex = 0;
+  long long badIndex = 0;
   std::vector<uint32_t> indices;
 };
 
 }  // namespace
 
 MeshFileData readPly(const std::string& path) {
-  std::error_code ec;
-  if (!fs::exists(path, ec)) throw Error(ErrorKind::FileNotFound, path, "file does not exist");
-  if (fs::is_directory(path, ec))
-    throw Error(ErrorKind::FileNotFound, path, "is a directory, not a file");
-  if (fs::file_size(path, ec) == 0 || ec) throw Error(ErrorKind::EmptyFile, path, "file is empty");
+  // Regular files only (OpenMesh would read a FIFO or /dev/zero forever), size-limited.
+  if (checkInputFile(path) == 0) throw Error(ErrorKind::EmptyFile, path, "file is empty");
   const PlyHeader header = readHeader(path);
   if (header.ascii)
     checkAsciiBody(path, header);

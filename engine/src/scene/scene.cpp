@@ -124,7 +124,8 @@ CameraView cameraFromNode(const Scene& scene, int nodeIndex, float aspect) {
 CameraView cameraFramingBounds(const glm::vec3& bmin, const glm::vec3& bmax, float aspect) {
   CameraView v;
   glm::vec3 center = 0.5f * (bmin + bmax);
-  float radius = std::max(0.5f * glm::length(bmax - bmin), 1e-3f);
+  // Any size a float holds frames the same (a 1e-3 floor framed tiny models as a speck).
+  float radius = std::max(0.5f * glm::length(bmax - bmin), 1e-20f);
   v.yfov = glm::radians(45.0f);
   float fit = std::min(v.yfov, 2.0f * std::atan(std::tan(v.yfov * 0.5f) * aspect));
   float dist = radius / std::sin(fit * 0.5f);

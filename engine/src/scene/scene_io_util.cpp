@@ -3,10 +3,9 @@
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include "gi/errors.h"
+#include "gi/input_file.h"
 #include "gi/scene_io.h"
 
 namespace gi::detail {
@@ -14,15 +13,7 @@ namespace gi::detail {
 namespace fs = std::filesystem;
 
 std::string readTextFile(const std::string& path) {
-  std::error_code ec;
-  if (!fs::exists(path, ec)) throw Error(ErrorKind::FileNotFound, path, "file does not exist");
-  if (fs::is_directory(path, ec))
-    throw Error(ErrorKind::FileNotFound, path, "is a directory, not a file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(ErrorKind::FileNotFound, path, "cannot open the file for reading");
-  std::ostringstream text;
-  text << in.rdbuf();
-  std::string s = std::move(text).str();
+  std::string s = readInputFile(path);  // regular files only, size-limited
   if (std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isspace(c); }))
     throw Error(ErrorKind::EmptyFile, path, "file is empty");
   return s;

@@ -63,6 +63,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <optional>
+#include <sstream>
 
 #include <glm/gtc/constants.hpp>
 #include <glm/gtc/matrix_transform.hpp>
@@ -70,6 +71,7 @@
 
 #include "gi/environment.h"
 #include "gi/errors.h"
+#include "gi/input_file.h"
 #include "gi/scene_io.h"
 #include "json_check.h"
 #include "scene_io_util.h"
@@ -286,13 +288,7 @@ class SceneJsonLoader {
 
   Scene load() {
     const std::string text = detail::readTextFile(path_);
-    json root;
-    try {
-      root = json::parse(text, nullptr, true, /*ignore_comments=*/true);
-    } catch (const json::parse_error& e) {
-      // nlohmann's message carries "line L, column C".
-      throw Error(ErrorKind::Parse, path_, std::string("invalid JSON: ") + e.what());
-    }
+    const json root = parseJsonText(text, path_, /*allowComments=*/true);
     JsonObject top(root, "", path_);
     top.allowOnly({"description", "include_default_scene", "models", "camera", "lights",
                    "environment", "effects"});
@@ -726,8 +722,35 @@ Scene loadSceneJson(const std::string& path) {
   return SceneJsonLoader(path).load();
 }
 
-Scene loadScene(const std::string& pathOrDefault) {
-  if (pathOrDefault == "default") return makeDefaultScene();
+namespace {
+
+// A scene whose geometry collapses to a point (a node scale of 0) or to nothing finite renders
+// only sky: refused. One far outside the sizes the renderer's fixed epsilons suit is warned of.
+void checkSceneSize(Scene& s, const std::string& path) {
+  glm::vec3 lo, hi;
+  s.worldBounds(lo, hi);
+  const float diagonal = glm::length(hi - lo);
+  std::ostringstream b;
+  b << "bounds [" << lo.x << ", " << lo.y << ", " << lo.z << "] .. [" << hi.x << ", " << hi.y
+    << ", " << hi.z << "]";
+  const std::string bounds = b.str();
+  if (!std::isfinite(diagonal))
+    throw Error(ErrorKind::NonFinite, path,
+                "the scene's size is not finite (" + bounds +
+                    "): a transform overflows; nothing could be rendered");
+  if (diagonal == 0.0f)
+    throw Error(ErrorKind::InvalidData, path,
+                "the scene's geometry has zero size (" + bounds +
+                    "; a node scale of 0?): nothing would be visible");
+  std::ostringstream size;
+  size << diagonal;
+  if (diagonal < 1e-4f || diagonal > 1e7f)
+    s.warnings.push_back(path + ": the scene is " + size.str() +
+                         " units across; sizes far from 1 lose depth and shadow precision");
+}
+
+// The file, by its extension (the dispatch of loadScene).
+Scene loadSceneFile(const std::string& pathOrDefault) {
   std::error_code ec;
   if (!fs::exists(pathOrDefault, ec))
     throw Error(ErrorKind::FileNotFound, pathOrDefault, "file does not exist");
@@ -749,6 +772,15 @@ Scene loadScene(const std::string& pathOrDefault) {
               "unsupported scene format '" + ext +
                   "' (.json, .gltf, .glb, .obj, .ply or "
                   "\"default\")");
+}
+
+}  // namespace
+
+Scene loadScene(const std::string& pathOrDefault) {
+  if (pathOrDefault == "default") return makeDefaultScene();
+  Scene s = loadSceneFile(pathOrDefault);
+  checkSceneSize(s, pathOrDefault);
+  return s;
 }
 
 }  // namespace gi

@@ -1,0 +1,188 @@
+// The command-line apps' shared parsing (apps/common/cli.h): integers are integers, numbers are
+// decimal and finite, ranges are printed as written, lists refuse empty and repeated items,
+// outputs are checked before any work and written atomically.
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "cli.h"
+#include "test_support.h"
+
+namespace gi {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Runs `f` expecting gi::Error of `kind`; returns its message.
+std::string errorOf(const std::function<void()>& f, ErrorKind kind) {
+  try {
+    f();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.kind(), kind) << e.what();
+    return e.what();
+  }
+  ADD_FAILURE() << "no error";
+  return {};
+}
+
+// Parses one flag with its value through cli::Args, as the apps do.
+struct Parsed {
+  std::vector<std::string> argv;
+  std::vector<char*> ptrs;
+  explicit Parsed(std::vector<std::string> a) : argv(std::move(a)) {
+    argv.insert(argv.begin(), "app");
+    for (std::string& s : argv) ptrs.push_back(s.data());
+  }
+  cli::Args args() { return cli::Args("gi-test", int(ptrs.size()), ptrs.data()); }
+};
+
+int64_t integerArg(const std::string& text, int64_t lo, int64_t hi) {
+  Parsed p({"--width", text});
+  cli::Args a = p.args();
+  EXPECT_TRUE(a.next());
+  return a.integer(lo, hi);
+}
+
+double numberArg(const std::string& text, double lo, double hi) {
+  Parsed p({"--time", text});
+  cli::Args a = p.args();
+  EXPECT_TRUE(a.next());
+  return a.number(lo, hi);
+}
+
+TEST(CliArgs, IntegersAreDecimalIntegers) {
+  EXPECT_EQ(integerArg("640", 1, 16384), 640);
+  EXPECT_EQ(integerArg("+16384", 1, 16384), 16384);
+  const struct {
+    const char* text;
+    const char* why;
+  } bad[] = {{"1.5", "which is not an integer"},
+             {"2.0", "which is not an integer"},
+             {"1e3", "which is not an integer"},
+             {"0x20", "which is hexadecimal"},
+             {"12abc", "which is not a number"},
+             {" 12", "which is not a number"},
+             {"", "which is not a number"},
+             {"99999999999999999999", "which is out of range for an integer"},
+             {"1e400", "which is out of range (beyond +-1.8e308"}};
+  for (const auto& b : bad) {
+    const std::string msg = errorOf([&] { integerArg(b.text, 1, 16384); }, ErrorKind::Usage);
+    EXPECT_NE(msg.find("--width: expects an integer in [1, 16384], got '" + std::string(b.text) +
+                       "', " + b.why),
+              std::string::npos)
+        << msg;
+    EXPECT_NE(msg.find("(see gi-test --help)"), std::string::npos) << msg;
+  }
+  const std::string msg = errorOf([] { integerArg("0", 1, 16384); }, ErrorKind::Usage);
+  EXPECT_NE(msg.find("--width: expects an integer in [1, 16384], got '0' ("), std::string::npos)
+      << msg;
+}
+
+TEST(CliArgs, NumbersAreFiniteDecimalsAndRangesPrintAsWritten) {
+  EXPECT_DOUBLE_EQ(numberArg("-2.5", -1e9, 1e9), -2.5);
+  EXPECT_DOUBLE_EQ(numberArg("1e-500", 0, 1), 0.0);  // below the smallest double: zero
+  for (const char* bad : {"inf", "nan", "-inf", "0x1p3", "1,5", "1.5x"})
+    errorOf([&] { numberArg(bad, -1e9, 1e9); }, ErrorKind::Usage);
+  std::string msg = errorOf([] { numberArg("1e400", -1e9, 1e9); }, ErrorKind::Usage);
+  EXPECT_NE(msg.find("--time: expects a number in [-1e9, 1e9], got '1e400', which is out of "
+                     "range (beyond +-1.8e308, the largest double)"),
+            std::string::npos)
+      << msg;
+  msg = errorOf([] { numberArg("2", 1e-9, 1.5); }, ErrorKind::Usage);
+  EXPECT_NE(msg.find("in [1e-9, 1.5], got '2'"), std::string::npos) << msg;
+  EXPECT_EQ(msg.find("000000"), std::string::npos) << msg;
+  // An open lower bound is printed open: 0 itself is outside.
+  Parsed p({"--radius", "0"});
+  cli::Args a = p.args();
+  ASSERT_TRUE(a.next());
+  msg = errorOf([&] { a.numberAbove(0, 1e9); }, ErrorKind::Usage);
+  EXPECT_NE(msg.find("--radius: expects a number in (0, 1e9], got '0'"), std::string::npos) << msg;
+}
+
+TEST(CliArgs, FormatNumberIsTheShortestExactForm) {
+  EXPECT_EQ(cli::formatNumber(16384), "16384");
+  EXPECT_EQ(cli::formatNumber(0.5), "0.5");
+  EXPECT_EQ(cli::formatNumber(1e9), "1e9");
+  EXPECT_EQ(cli::formatNumber(1e-9), "1e-9");
+  EXPECT_EQ(cli::formatNumber(-1e15), "-1e15");
+  EXPECT_EQ(cli::formatNumber(double(1 << 24)), "16777216");
+  EXPECT_EQ(cli::formatNumber(1.25e-5), "1.25e-5");
+}
+
+TEST(CliArgs, ArgumentLoopAndUsageErrors) {
+  Parsed p({"--scene", "a.json", "--out"});
+  cli::Args a = p.args();
+  ASSERT_TRUE(a.next());
+  EXPECT_TRUE(a.is("--scene"));
+  EXPECT_STREQ(a.value(), "a.json");
+  ASSERT_TRUE(a.next());
+  EXPECT_TRUE(a.is("--out"));
+  std::string msg = errorOf([&] { a.value(); }, ErrorKind::Usage);
+  EXPECT_EQ(msg, "--out: needs a value (see gi-test --help)");
+  EXPECT_FALSE(a.next());
+  Parsed q({"--bogus"});
+  cli::Args b = q.args();
+  ASSERT_TRUE(b.next());
+  msg = errorOf([&] { b.unknown(); }, ErrorKind::Usage);
+  EXPECT_EQ(msg, "unknown argument '--bogus' (see gi-test --help)");
+}
+
+TEST(CliArgs, ListsRefuseEmptyAndRepeatedItems) {
+  EXPECT_EQ(cli::splitList("--effects", "ssao,gtao"), (std::vector<std::string>{"ssao", "gtao"}));
+  EXPECT_TRUE(cli::splitList("--effects", "").empty());
+  std::string msg = errorOf([] { cli::splitList("--effects", "ssao,ssao"); }, ErrorKind::Usage);
+  EXPECT_EQ(msg, "--effects: 'ssao' is listed twice in 'ssao,ssao'");
+  msg = errorOf([] { cli::splitList("--effects", "ssao,,gtao"); }, ErrorKind::Usage);
+  EXPECT_EQ(msg, "--effects: empty item in the list 'ssao,,gtao'");
+  errorOf([] { cli::splitList("--effects", "ssao,"); }, ErrorKind::Usage);
+  EXPECT_EQ(cli::splitList("--grid", "4,4", true).size(), 2u);
+}
+
+TEST(CliArgs, OutputsAreCheckedBeforeAnyWork) {
+  test::TempDir dir("test_cli_args");
+  const std::string ok = dir.path("x.png");
+  cli::checkOutputWritable(ok);
+  EXPECT_FALSE(fs::exists(ok)) << "the check leaves nothing behind";
+  EXPECT_FALSE(fs::exists(ok + ".partial"));
+  std::string msg =
+      errorOf([&] { cli::checkOutputWritable(dir.path("nodir/x.png")); }, ErrorKind::FileNotFound);
+  EXPECT_NE(msg.find("output folder " + dir.path("nodir") + " does not exist"), std::string::npos)
+      << msg;
+  fs::create_directories(dir.path("folder.png"));
+  msg = errorOf([&] { cli::checkOutputWritable(dir.path("folder.png")); }, ErrorKind::FileNotFound);
+  EXPECT_NE(msg.find("output path is a folder"), std::string::npos) << msg;
+  // A folder that exists but cannot be written (also as root: /sys refuses new files).
+  msg = errorOf([] { cli::checkOutputWritable("/sys/gi-test.png"); }, ErrorKind::FileNotFound);
+  EXPECT_NE(msg.find("cannot write in the output folder /sys: "), std::string::npos) << msg;
+  EXPECT_EQ(msg.find("does the folder exist"), std::string::npos) << msg;
+  // Folders to be created: the nearest existing ancestor must be writable.
+  cli::checkOutputFolder(dir.path("new/deeper"));
+  EXPECT_FALSE(fs::exists(dir.path("new")));
+  errorOf([] { cli::checkOutputFolder("/sys/gi-test-dir"); }, ErrorKind::FileNotFound);
+  const std::string file = dir.write("file", "x");
+  msg = errorOf([&] { cli::checkOutputFolder(file); }, ErrorKind::FileNotFound);
+  EXPECT_NE(msg.find("exists and is not a folder"), std::string::npos) << msg;
+}
+
+TEST(CliArgs, AtomicWritesLeaveNothingOnFailure) {
+  test::TempDir dir("test_cli_args_write");
+  const std::string path = dir.path("a.txt");
+  cli::writeFileAtomic(path, "hello");
+  std::ifstream in(path);
+  std::string text;
+  std::getline(in, text);
+  EXPECT_EQ(text, "hello");
+  EXPECT_FALSE(fs::exists(path + ".partial"));
+  errorOf([&] { cli::writeFileAtomic(dir.path("nodir/a.txt"), "x"); }, ErrorKind::FileNotFound);
+  EXPECT_FALSE(fs::exists(dir.path("nodir")));
+}
+
+}  // namespace
+}  // namespace gi
