@@ -23,7 +23,7 @@ namespace ref = gi::reference;
 const char* kUsage =
     "usage: gi-reference --scene FILE|default --out IMAGE.pfm [options]\n"
     "  --quantity Q           ao, obscurance, alchemy, direct, direct+indirect, depth, normal,\n"
-    "                         ao-split (default ao)\n"
+    "                         ao-split, alchemy-disk (default ao)\n"
     "  --radius R             AO / obscurance / Alchemy radius in world units (default 0.5)\n"
     "  --spp N                maximum samples per pixel (default 64)\n"
     "  --noise-target E       stop early once the mean per-pixel standard error is <= E\n"
@@ -38,6 +38,7 @@ const char* kUsage =
     "  --alchemy-u U          Alchemy falloff knee u (default 0: the paper's eq. 10 form)\n"
     "  --alchemy-epsilon E    Alchemy epsilon (default 1e-4)\n"
     "  --alchemy-contrast K   Alchemy contrast k (default 1)\n"
+    "  --alchemy-bias B       alchemy-disk bias beta: max(0, v.n - beta z) (default 0)\n"
     "  --out FILE.pfm         the estimate (float RGB)\n"
     "  --stderr-out FILE.pfm  per-pixel standard error (default: <out>.stderr.pfm)\n"
     "  --png FILE.png         8-bit preview (grey for AO-like quantities, tonemapped light)\n"
@@ -129,6 +130,8 @@ Options parseArgs(int argc, char** argv) {
       s.alchemy.epsilon = float(parseNumber(a, value(), 0, 1e9));
     else if (a == "--alchemy-contrast")
       s.alchemy.contrast = float(parseNumber(a, value(), 1e-6, 1e6));
+    else if (a == "--alchemy-bias")
+      s.alchemy.bias = float(parseNumber(a, value(), 0, 1e9));
     else if (a == "--exposure")
       o.exposure = float(parseNumber(a, value(), 0, 1e6));
     else if (a == "--quiet")
@@ -247,6 +250,7 @@ int run(const Options& o) {
   std::printf("scene %s, %ux%u, %zu triangles, quantity %s", o.scene.c_str(), settings.width,
               settings.height, r.triangles, ref::quantityName(settings.quantity));
   if (settings.quantity == ref::Quantity::AO || settings.quantity == ref::Quantity::Alchemy ||
+      settings.quantity == ref::Quantity::AlchemyDisk ||
       settings.quantity == ref::Quantity::Obscurance || split)
     std::printf(", radius %g", double(settings.radius));
   if (settings.quantity == ref::Quantity::Obscurance)
