@@ -4,7 +4,7 @@
 // zero-distance occluders finite, the cross-bilateral filter does not cross depth edges, the
 // guard band gives the edge pixels what a wider view sees, and nothing is NaN at grazing angles,
 // extreme clip planes or sky pixels; and, on the CPU, what the estimator converges to on a crease
-// (the screen-disk integral, not the hemisphere integral the effect declares).
+// (the screen-disk integral the effect declares, not the hemisphere integral of eq. 8-9).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -334,9 +334,13 @@ TEST_F(AlchemyTest, PassesAndLiveSettings) {
 // 90-degree crease seen from afar (nearly orthographic, all on the CPU), the estimator's
 // I = 1 - A matches the screen-disk integral
 //   I_disk = (sigma / (pi r)) int_0^r int_0^2pi max(0, v.n) H(r - |v|) / (v.v + eps) dphi drho
-// (taps uniform in radius and angle) within 5 %, and differs from the hemisphere integral that
-// the effect declares, (sigma / pi) int_Gamma t / (t^2 + eps) cos(theta) dw, by 25 % or more, in
-// either direction depending on the view.
+// (taps uniform in radius and angle) within 5 %: the quantity the effect declares
+// (EstimatedQuantity::Kind::AlchemyDisk, reference "alchemy-disk"; test_alchemy_reference
+// compares the plugin with that reference, test_scene_reference_alchemy_disk the reference with
+// this integral). It differs from the hemisphere integral of eq. 8-9 that the paper derives it
+// from (reference "alchemy", the effect's declaration before ABI 7),
+// (sigma / pi) int_Gamma t / (t^2 + eps) cos(theta) dw, by 25 % or more, in either direction
+// depending on the view.
 struct Crease {
   // Floor z = 0 (normal +z) for x <= d, wall x = d (normal -x) for z >= 0; the camera looks at
   // the origin from distance 40 at elevation `elev`, facing the wall.
@@ -365,7 +369,7 @@ struct Crease {
   glm::dvec3 toView(glm::dvec3 w) const { return {dot(w, right), dot(w, up), -dot(w, fwd)}; }
 };
 
-TEST(AlchemyExpectation, IsTheScreenDiskIntegralNotTheDeclaredHemisphereIntegral) {
+TEST(AlchemyExpectation, IsTheDeclaredScreenDiskIntegralNotTheHemisphereIntegral) {
   const int w = 256, h = 256, samples = 64;
   const double r = 0.5, sigma = 0.2, eps = 1e-4, pi = 3.14159265358979;
   glm::mat4 proj(0.0f);             // reverse-Z, infinite far: depth = near / distance
@@ -421,8 +425,8 @@ TEST(AlchemyExpectation, IsTheScreenDiskIntegralNotTheDeclaredHemisphereIntegral
     disk *= sigma / (pi * r) * (r / nr) * (2 * pi / na);
     hemi *= sigma / pi * (pi / 2 / nr) * (2 * pi / na);
     std::printf(
-        "crease d %.2f elevation %.0f: estimator I %.4f, screen-disk integral %.4f, "
-        "declared hemisphere integral %.4f\n",
+        "crease d %.2f elevation %.0f: estimator I %.4f, declared screen-disk integral %.4f, "
+        "hemisphere integral %.4f\n",
         c.d, c.elev, est, disk, hemi);
     EXPECT_NEAR(est, disk, 0.05 * disk);
     EXPECT_GT(std::abs(est / hemi - 1.0), 0.25);

@@ -188,6 +188,10 @@ TEST(Registry, DescribesEachDeclaredQuantityWithTheParametersItUses) {
   q.kind = K::Alchemy;
   q.epsilon = 1e-8;
   EXPECT_EQ(describe(q), "alchemy(r=0.25, sigma=1, u=0, epsilon=1e-08, contrast=1)");
+  q.kind = K::AlchemyDisk;  // the hemisphere form has no bias, the disk form does
+  q.bias = 2e-4;
+  EXPECT_EQ(describe(q),
+            "alchemy-disk(r=0.25, sigma=1, u=0, epsilon=1e-08, contrast=1, bias=0.0002)");
   q.kind = K::DirectIndirect;
   EXPECT_EQ(describe(q), "direct+indirect light");
   q.kind = K::DirectLight;

@@ -681,7 +681,8 @@ TEST(ReferenceDepth, PrimaryHitsFollowTheVulkanConventions) {
 
 TEST(ReferenceDeterminism, SameSeedAnyThreadCountGivesTheSameImage) {
   const Scene scene = loadScene("default");
-  for (ref::Quantity q : {ref::Quantity::AO, ref::Quantity::DirectIndirect}) {
+  for (ref::Quantity q :
+       {ref::Quantity::AO, ref::Quantity::DirectIndirect, ref::Quantity::AlchemyDisk}) {
     ref::Settings s = smallSettings(q, 8, 40, 30);
     s.seed = 7;
     s.threads = 1;
@@ -726,7 +727,7 @@ TEST(ReferenceRobustness, DegenerateInputGivesNoNan) {
   const std::vector<ref::Quantity> all = {
       ref::Quantity::AO,     ref::Quantity::Obscurance,     ref::Quantity::Alchemy,
       ref::Quantity::Direct, ref::Quantity::DirectIndirect, ref::Quantity::Depth,
-      ref::Quantity::Normal};
+      ref::Quantity::Normal, ref::Quantity::AlchemyDisk};
   auto renderAll = [&](const Scene& scene, const char* what) {
     for (ref::Quantity q : all) {
       ref::Settings s = smallSettings(q, 4, 24, 18);

@@ -42,7 +42,13 @@ ReferenceSpec declaredSpec(const EstimatedQuantity& q) {
       s.quantity = ref::Quantity::Alchemy;
       s.radius = checkedRadius(q.radius);
       s.alchemy =
-          ref::AlchemyParams{float(q.sigma), float(q.u), float(q.epsilon), float(q.contrast)};
+          ref::AlchemyParams{float(q.sigma), float(q.u), float(q.epsilon), float(q.contrast), 0.0f};
+      break;
+    case Kind::AlchemyDisk:
+      s.quantity = ref::Quantity::AlchemyDisk;
+      s.radius = checkedRadius(q.radius);
+      s.alchemy = ref::AlchemyParams{float(q.sigma), float(q.u), float(q.epsilon),
+                                     float(q.contrast), float(q.bias)};
       break;
     case Kind::DirectLight:
       s.quantity = ref::Quantity::Direct;
@@ -73,7 +79,7 @@ ReferenceSpec targetSpec(GroundTruth truth, const EstimatedQuantity& declared, b
 
 bool isAoLike(ref::Quantity q) {
   return q == ref::Quantity::AO || q == ref::Quantity::AOSplit || q == ref::Quantity::Obscurance ||
-         q == ref::Quantity::Alchemy;
+         q == ref::Quantity::Alchemy || q == ref::Quantity::AlchemyDisk;
 }
 
 std::string label(const ReferenceSpec& s) {
@@ -83,9 +89,10 @@ std::string label(const ReferenceSpec& s) {
   if (s.quantity == ref::Quantity::Obscurance)
     out += std::string(" ") + ref::membershipName(s.membership);
   if (isAoLike(s.quantity)) out += " r=" + num(s.radius, "%g");
-  if (s.quantity == ref::Quantity::Alchemy)
+  if (s.quantity == ref::Quantity::Alchemy || s.quantity == ref::Quantity::AlchemyDisk)
     out += " sigma=" + num(s.alchemy.sigma, "%g") + " u=" + num(s.alchemy.u, "%g") +
            " eps=" + num(s.alchemy.epsilon, "%g") + " k=" + num(s.alchemy.contrast, "%g");
+  if (s.quantity == ref::Quantity::AlchemyDisk) out += " bias=" + num(s.alchemy.bias, "%g");
   return out;
 }
 
@@ -94,9 +101,10 @@ std::string keyText(const ReferenceSpec& s) {
   if (isAoLike(s.quantity)) out += "|r=" + num(s.radius, "%a");
   if (s.quantity == ref::Quantity::Obscurance)
     out += std::string("|mu=") + ref::membershipName(s.membership);
-  if (s.quantity == ref::Quantity::Alchemy)
+  if (s.quantity == ref::Quantity::Alchemy || s.quantity == ref::Quantity::AlchemyDisk)
     out += "|sigma=" + num(s.alchemy.sigma, "%a") + "|u=" + num(s.alchemy.u, "%a") +
            "|eps=" + num(s.alchemy.epsilon, "%a") + "|k=" + num(s.alchemy.contrast, "%a");
+  if (s.quantity == ref::Quantity::AlchemyDisk) out += "|bias=" + num(s.alchemy.bias, "%a");
   return out;
 }
 

@@ -24,7 +24,7 @@ namespace ref = gi::reference;
 const char* kUsage =
     "usage: gi-reference --scene FILE|default --out IMAGE.pfm [options]\n"
     "  --quantity Q           ao, obscurance, alchemy, direct, direct+indirect, depth, normal,\n"
-    "                         ao-split (default ao)\n"
+    "                         ao-split, alchemy-disk (default ao)\n"
     "  --radius R             AO / obscurance / Alchemy radius in world units (default 0.5)\n"
     "  --spp N                maximum samples per pixel (default 64)\n"
     "  --noise-target E       stop early once the mean per-pixel standard error is <= E\n"
@@ -39,6 +39,7 @@ const char* kUsage =
     "  --alchemy-u U          Alchemy falloff knee u (default 0: the paper's eq. 10 form)\n"
     "  --alchemy-epsilon E    Alchemy epsilon (default 1e-4)\n"
     "  --alchemy-contrast K   Alchemy contrast k (default 1)\n"
+    "  --alchemy-bias B       alchemy-disk bias beta: max(0, v.n - beta z) (default 0)\n"
     "  --out FILE.pfm         the estimate (float RGB)\n"
     "  --stderr-out FILE.pfm  per-pixel standard error (default: <out>.stderr.pfm)\n"
     "  --png FILE.png         8-bit preview (grey for AO-like quantities, tonemapped light)\n"
@@ -107,6 +108,8 @@ Options parseArgs(int argc, char** argv) {
       s.alchemy.epsilon = float(a.number(0, 1));
     else if (a.is("--alchemy-contrast"))
       s.alchemy.contrast = float(a.number(1e-6, 1e6));
+    else if (a.is("--alchemy-bias"))
+      s.alchemy.bias = float(a.number(0, 1e9));
     else if (a.is("--exposure"))
       o.exposure = float(a.number(0, 1e6));
     else if (a.is("--quiet"))
@@ -218,6 +221,7 @@ int run(const Options& o) {
   std::printf("scene %s, %ux%u, %zu triangles, quantity %s", o.scene.c_str(), settings.width,
               settings.height, r.triangles, ref::quantityName(settings.quantity));
   if (settings.quantity == ref::Quantity::AO || settings.quantity == ref::Quantity::Alchemy ||
+      settings.quantity == ref::Quantity::AlchemyDisk ||
       settings.quantity == ref::Quantity::Obscurance || split)
     std::printf(", radius %g", double(settings.radius));
   if (settings.quantity == ref::Quantity::Obscurance)

@@ -62,12 +62,15 @@ class AlchemyEffect : public gi::Effect {
   // estimator's expectation really is"; test_alchemy's AlchemyExpectation measures the gap).
   gi::EstimatedQuantity estimatedQuantity(const gi::SettingValues& s) const override {
     gi::EstimatedQuantity q;
-    q.kind = gi::EstimatedQuantity::Kind::Alchemy;
+    // What eq. 10's sum converges to: the screen-disk integral (README "What the estimator's
+    // expectation really is"), not the hemisphere integral of eq. 8-9 (Kind::Alchemy).
+    q.kind = gi::EstimatedQuantity::Kind::AlchemyDisk;
     q.radius = s.number("radius");
     q.sigma = s.number("intensity");
     q.u = 0.0;
     q.epsilon = s.number("epsilon");
     q.contrast = s.number("contrast");
+    q.bias = s.number("bias");
     return q;
   }
 

@@ -19,7 +19,7 @@
 
 // Bumped whenever this header, settings.h, frame_graph.h or the shader interface change in a
 // way that breaks compiled modules; the registry refuses modules built against another value.
-#define GI_EFFECT_ABI_VERSION 6u
+#define GI_EFFECT_ABI_VERSION 7u
 
 namespace gi {
 
@@ -81,6 +81,8 @@ struct EstimatedQuantity {
     AmbientOcclusion,  // binary AO of radius r, cosine-weighted (reference "ao")
     Obscurance,        // (1/pi) int mu(t(w)) cos dw, mu = membership reaching 1 at r
     Alchemy,           // max(0, 1 - I)^contrast, I the Alchemy integral (reference "alchemy")
+    AlchemyDisk,       // max(0, 1 - I)^contrast, I the screen-disk Alchemy integral of eq. 10's
+                       // taps (reference "alchemy-disk"; uses bias too)
     DirectLight,       // the lit image: direct light (reference "direct")
     DirectIndirect,    // the lit image: direct light + one diffuse bounce ("direct+indirect")
   };
@@ -89,9 +91,11 @@ struct EstimatedQuantity {
   std::string membership = "sqrt";  // obscurance: sqrt, linear, smoothstep, step or exp
   // Alchemy (seed 003 eq. 10): falloff g(t) = sigma t / (max(u^2, t^2) + epsilon).
   double sigma = 1.0, u = 0.0, epsilon = 1e-4, contrast = 1.0;
+  double bias = 0.0;  // AlchemyDisk: beta of the numerator max(0, v.n - beta z) (ABI 7)
 };
 // "obscurance(r=0.5, membership=linear)", "alchemy(r=0.5, sigma=1, u=0, epsilon=0.0001,
-// contrast=1)", "ao(r=0.5)", "direct light", "direct+indirect light": the parameters the kind
+// contrast=1)", "alchemy-disk(r=0.5, sigma=1, u=0, epsilon=0.0001, contrast=1, bias=0.0001)",
+// "ao(r=0.5)", "direct light", "direct+indirect light": the parameters the kind
 // uses, nothing else (gi-render --list-effects, reports).
 std::string describe(const EstimatedQuantity& q);
 

@@ -317,10 +317,57 @@ glm::vec3 sampleQuantity(const Settings& s, const Shading& shading, const Primar
     }
     case Quantity::Depth:
     case Quantity::Normal:
-    case Quantity::AOSplit:  // sampleAoSplit
+    case Quantity::AOSplit:      // sampleAoSplit
+    case Quantity::AlchemyDisk:  // sampleAlchemyDisk
       break;
   }
   return glm::vec3(0.0f);
+}
+
+// The camera as the screen-disk samples of AlchemyDisk need it (view space, double).
+struct DiskCamera {
+  glm::dmat4 view{1.0}, invView{1.0};
+  bool orthographic = false;
+  double znear = 0.0, zfar = 0.0;
+};
+
+// The camera ray through view-space point x: origin and direction in world space, the direction
+// scaled so that the ray parameter is the view depth (the primary rays' convention).
+void cameraRay(const DiskCamera& cam, const glm::dvec3& x, glm::dvec3& origin, glm::dvec3& dir) {
+  if (cam.orthographic) {
+    origin = glm::dvec3(cam.invView * glm::dvec4(x.x, x.y, 0.0, 1.0));
+    dir = glm::dmat3(cam.invView) * glm::dvec3(0.0, 0.0, -1.0);
+  } else {
+    origin = glm::dvec3(cam.invView[3]);
+    dir = glm::dmat3(cam.invView) * (x / -x.z);
+  }
+}
+
+// One sample of the AlchemyDisk quantity (reference.h): 2 sigma f at a point uniform in radius
+// and angle on the camera-facing disk of radius r through the primary hit.
+float sampleAlchemyDisk(const Settings& s, const Shading& shading, const DiskCamera& cam,
+                        const Primary& p, Rng& rng) {
+  const AlchemyParams& a = s.alchemy;
+  const glm::dvec3 c(cam.view * glm::dvec4(glm::dvec3(p.hit.position), 1.0));
+  const double z = -c.z;
+  const glm::dvec3 n = glm::normalize(glm::dmat3(cam.view) * glm::dvec3(p.hit.shadingNormal));
+  const double rho = double(rng.uniform()) * s.radius;
+  const double phi = double(rng.uniform()) * 6.28318530717958647692;
+  const glm::dvec3 x = c + rho * glm::dvec3(std::cos(phi), std::sin(phi), 0.0);
+  if (!(x.z < 0.0)) return 0.0f;  // guard: a point at or behind the eye (z > 0 already holds)
+  glm::dvec3 origin, dir;
+  cameraRay(cam, x, origin, dir);
+  SurfaceHit h;
+  if (!shading.rays().intersect(glm::vec3(origin), glm::vec3(dir), float(cam.znear),
+                                float(cam.zfar), h))
+    return 0.0f;  // sky: unoccluded
+  const glm::dvec3 v = glm::dvec3(cam.view * glm::dvec4(glm::dvec3(h.position), 1.0)) - c;
+  const double vv = glm::dot(v, v), r2 = double(s.radius) * s.radius;
+  if (!(vv < r2)) return 0.0f;
+  const double num = std::max(0.0, glm::dot(v, n) - double(a.bias) * z);
+  const double u2 = double(a.u) * a.u;
+  const double denom = std::max(u2, vv) + double(a.epsilon);
+  return denom > 0.0 ? float(2.0 * double(a.sigma) * num / denom) : 0.0f;
 }
 
 // The camera and the depth layer (the primary hits) that the AO split classifies occluders
@@ -434,7 +481,8 @@ void validate(const Settings& s) {
   if (s.width < 1 || s.height < 1 || s.width > 16384 || s.height > 16384)
     usage("image size must be 1..16384 pixels per side");
   const bool needsRadius = s.quantity == Quantity::AO || s.quantity == Quantity::Obscurance ||
-                           s.quantity == Quantity::Alchemy || s.quantity == Quantity::AOSplit;
+                           s.quantity == Quantity::Alchemy || s.quantity == Quantity::AOSplit ||
+                           s.quantity == Quantity::AlchemyDisk;
   if (needsRadius && !(s.radius > 0.0f && std::isfinite(s.radius)))
     usage("radius must be a positive finite number");
   if (s.spp < 1) usage("samples per pixel must be at least 1");
@@ -443,12 +491,27 @@ void validate(const Settings& s) {
   const AlchemyParams& a = s.alchemy;
   if (!(a.sigma >= 0.0f && std::isfinite(a.sigma)) || !(a.u >= 0.0f && std::isfinite(a.u)) ||
       !(a.epsilon >= 0.0f && std::isfinite(a.epsilon)) ||
-      !(a.contrast > 0.0f && std::isfinite(a.contrast)))
-    usage("Alchemy parameters must be finite, sigma/u/epsilon >= 0 and contrast > 0");
+      !(a.contrast > 0.0f && std::isfinite(a.contrast)) ||
+      !(a.bias >= 0.0f && std::isfinite(a.bias)))
+    usage("Alchemy parameters must be finite, sigma/u/epsilon/bias >= 0 and contrast > 0");
   // With u = 0 the falloff sigma t / (t^2 + epsilon) peaks at sigma / (2 sqrt(epsilon)):
   // epsilon = 0 makes it unbounded near t = 0 and the estimate's variance with it.
   if (s.quantity == Quantity::Alchemy && a.u == 0.0f && a.epsilon == 0.0f)
     usage("Alchemy epsilon must be > 0 when u = 0 (the falloff is unbounded at distance 0)");
+  if (s.quantity == Quantity::AlchemyDisk && !(a.epsilon > 0.0f || a.u > 0.0f))
+    usage("alchemy-disk needs epsilon > 0 or u > 0 (a tap at the pixel's own point is 0 / 0)");
+  if (s.camera) {
+    const glm::mat4& p = s.camera->proj;
+    bool ok = true;
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 4; ++j)
+        ok = ok && std::isfinite(p[i][j]) && std::isfinite(s.camera->view[i][j]);
+    if (!ok || !(s.camera->znear > 0.0f) || !(s.camera->zfar > s.camera->znear) ||
+        !std::isfinite(s.camera->zfar))
+      usage("camera override: matrices must be finite and 0 < znear < zfar");
+    if (s.quantity == Quantity::AOSplit && p[3][3] != 0.0f)
+      usage("ao-split needs a perspective camera");
+  }
 }
 
 void setPixel(ImageRGBA32F& img, size_t i, const glm::vec3& v, float a) {
@@ -465,12 +528,13 @@ ImageRGBA32F blank(uint32_t w, uint32_t h) {
 }  // namespace
 
 Quantity parseQuantity(const std::string& name) {
-  for (Quantity q :
-       {Quantity::AO, Quantity::Obscurance, Quantity::Alchemy, Quantity::Direct,
-        Quantity::DirectIndirect, Quantity::Depth, Quantity::Normal, Quantity::AOSplit})
+  for (Quantity q : {Quantity::AO, Quantity::Obscurance, Quantity::Alchemy, Quantity::Direct,
+                     Quantity::DirectIndirect, Quantity::Depth, Quantity::Normal, Quantity::AOSplit,
+                     Quantity::AlchemyDisk})
     if (name == quantityName(q)) return q;
   usage("unknown quantity '" + name +
-        "' (ao, obscurance, alchemy, direct, direct+indirect, depth, normal, ao-split)");
+        "' (ao, obscurance, alchemy, direct, direct+indirect, depth, normal, ao-split, "
+        "alchemy-disk)");
 }
 
 const char* quantityName(Quantity q) {
@@ -491,6 +555,8 @@ const char* quantityName(Quantity q) {
       return "normal";
     case Quantity::AOSplit:
       return "ao-split";
+    case Quantity::AlchemyDisk:
+      return "alchemy-disk";
   }
   return "?";
 }
@@ -537,13 +603,15 @@ Result render(const Scene& scene, const Settings& settings) {
   Shading shading(scene, rays);
   Result result;
   result.triangles = rays.triangleCount();
-  result.camera = activeCamera(scene, float(W) / float(H));
+  result.camera = settings.camera ? *settings.camera : activeCamera(scene, float(W) / float(H));
   const CameraView& cam = result.camera;
   // Primary rays in double precision from the same matrices the rasteriser uses.
   const glm::dmat4 proj(cam.proj), view(cam.view);
   const glm::dmat4 invProj = glm::inverse(proj), invView = glm::inverse(view);
   const glm::dvec3 eye(invView[3]);
   const double znear = cam.znear, zfar = cam.zfar;
+  // An orthographic projection's w row is (0, 0, 0, 1): parallel rays along the view axis.
+  const bool orthographic = cam.proj[3][3] != 0.0f;
 
   result.value = blank(W, H);
   result.stdError = blank(W, H);
@@ -563,11 +631,17 @@ Result render(const Scene& scene, const Settings& settings) {
       // the ray parameter is then the view-space depth, and [znear, zfar] is what is rasterised.
       glm::dvec4 nearPoint = invProj * glm::dvec4(ndc, 1.0, 1.0);
       glm::dvec3 dirView = glm::dvec3(nearPoint) / nearPoint.w;
-      dirView /= -dirView.z;
+      glm::dvec3 origin = eye;
+      if (orthographic) {  // from the view plane z = 0 through the near-plane point
+        origin = glm::dvec3(invView * glm::dvec4(dirView.x, dirView.y, 0.0, 1.0));
+        dirView = glm::dvec3(0.0, 0.0, -1.0);
+      } else {
+        dirView /= -dirView.z;
+      }
       const glm::vec3 dirWorld(glm::dmat3(invView) * dirView);
       skyRadiance[i] = shading.environment(safeNormalize(dirWorld, glm::vec3(0, 0, -1)));
       Primary& p = primary[i];
-      p.geometry = rays.intersect(glm::vec3(eye), dirWorld, float(znear), float(zfar), p.hit);
+      p.geometry = rays.intersect(glm::vec3(origin), dirWorld, float(znear), float(zfar), p.hit);
       if (!p.geometry) continue;
       const glm::dvec4 viewPos = view * glm::dvec4(glm::dvec3(p.hit.position), 1.0);
       const glm::dvec4 clip = proj * viewPos;
@@ -621,7 +695,15 @@ Result render(const Scene& scene, const Settings& settings) {
   // channels: the quantity's rgb (AO_full, AO_visible, f_off, f_hid for the AO split).
   constexpr int C = 4;
   std::vector<double> mean(N * C, 0.0), m2(N * C, 0.0);
-  const bool alchemy = settings.quantity == Quantity::Alchemy;
+  const bool alchemy =
+      settings.quantity == Quantity::Alchemy || settings.quantity == Quantity::AlchemyDisk;
+  const bool alchemyDisk = settings.quantity == Quantity::AlchemyDisk;
+  DiskCamera diskCamera;
+  diskCamera.view = view;
+  diskCamera.invView = invView;
+  diskCamera.orthographic = orthographic;
+  diskCamera.znear = znear;
+  diskCamera.zfar = zfar;
   const AlchemyParams& ap = settings.alchemy;
   uint32_t done = 0;
   auto standardError = [&](size_t i, int c) {
@@ -680,6 +762,9 @@ Result render(const Scene& scene, const Settings& settings) {
             v = split.value;
             visibleBehind[i] += split.visibleBehind;
             hiddenInFront[i] += split.hiddenInFront;
+          } else if (alchemyDisk) {
+            v = glm::vec4(sampleAlchemyDisk(settings, shading, diskCamera, p, rng));
+            if (!std::isfinite(v.x)) v = glm::vec4(0.0f);  // guard: never let a NaN in
           } else {
             v = glm::vec4(sampleQuantity(settings, shading, p, rng), 0.0f);
             if (!finite(glm::vec3(v))) v = glm::vec4(0.0f);  // guard: never let a NaN in

@@ -183,6 +183,10 @@ std::string describe(const EstimatedQuantity& q) {
     case K::Alchemy:
       return "alchemy(r=" + num(q.radius) + ", sigma=" + num(q.sigma) + ", u=" + num(q.u) +
              ", epsilon=" + num(q.epsilon) + ", contrast=" + num(q.contrast) + ")";
+    case K::AlchemyDisk:
+      return "alchemy-disk(r=" + num(q.radius) + ", sigma=" + num(q.sigma) + ", u=" + num(q.u) +
+             ", epsilon=" + num(q.epsilon) + ", contrast=" + num(q.contrast) +
+             ", bias=" + num(q.bias) + ")";
     case K::DirectLight:
       return "direct light";
     case K::DirectIndirect:

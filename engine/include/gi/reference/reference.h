@@ -85,10 +85,36 @@
 // directions uniform on the hemisphere, so its expectation weights the hemisphere differently
 // (and sees only the depth layer); (2) it applies max(0, .)^k per pixel to a finite-sample
 // sum, and E[max(0, 1 - X)^k] != max(0, 1 - E[X])^k.
+//
+// What the Alchemy estimator's sum really converges to (AlchemyDisk, "alchemy-disk"; see
+// effects/alchemy/README.md). Eq. 10's taps are uniform in radius and angle on the screen-space
+// disk that the world radius r projects to at the pixel's depth, read back from the depth
+// buffer, with no Jacobian. Its expectation is the screen-disk integral
+//   I_disk = (sigma / (pi r)) int_0^r int_0^2pi max(0, v.n - beta z) H(r - |v|)
+//                                               / (max(u^2, v.v) + epsilon) dphi drho
+// and this quantity estimates exactly that: for the primary hit C (view-space position c,
+// view depth z = -c.z, G-buffer normal n) a sample draws rho uniform in [0, r) and phi uniform
+// in [0, 2 pi), forms the point X = c + rho (cos phi, sin phi, 0) in the camera-facing plane
+// through C (view space: x right, y up), traces the camera ray through X (perspective: from the
+// eye; orthographic: along the view axis) between znear and zfar to its first hit P (the depth
+// layer: what the depth buffer holds at X's pixel), and scores 2 sigma max(0, v.n - beta z)
+// H(r^2 - v.v) / (max(u^2, v.v) + epsilon) with v = P - C in view space (0 when the ray misses:
+// sky). The pixel reports A = max(0, 1 - mean)^k like Alchemy. The conventions are
+// alchemy_kernel.h's (u = 0 there): view-space lengths, bias proportional to the view depth,
+// the strict v.v < r^2. Differences from the plugin that are not part of the quantity: the
+// plugin's taps are a fixed spiral snapped to texel centres (a quadrature, not i.i.d. points),
+// taps off the image count as unoccluded unless its guard band covers them (here the guard band
+// is unlimited: every tap is traced), and it clamps the disk's projected radius to the image
+// size (a camera inside the ball).
+//
+// Cameras: Settings::camera, when set, replaces gi::activeCamera (tests use it for exact views).
+// Its projection may be orthographic (proj[3][3] == 1, e.g. gi::orthoReverseZ): primary rays
+// then run along the view axis; AOSplit needs a perspective camera (it measures along eye rays).
 #pragma once
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 
 #include "gi/image_io.h"
@@ -97,9 +123,20 @@
 
 namespace gi::reference {
 
-enum class Quantity { AO, Obscurance, Alchemy, Direct, DirectIndirect, Depth, Normal, AOSplit };
+enum class Quantity {
+  AO,
+  Obscurance,
+  Alchemy,
+  Direct,
+  DirectIndirect,
+  Depth,
+  Normal,
+  AOSplit,
+  AlchemyDisk
+};
 
-// Command-line names: ao, obscurance, alchemy, direct, direct+indirect, depth, normal, ao-split;
+// Command-line names: ao, obscurance, alchemy, direct, direct+indirect, depth, normal, ao-split,
+// alchemy-disk;
 // memberships: sqrt, linear, smoothstep, step, exp. Throw gi::Error(Usage) for unknown names.
 Quantity parseQuantity(const std::string& name);
 const char* quantityName(Quantity q);
@@ -115,20 +152,21 @@ struct Progress {
 struct Settings {
   uint32_t width = 320, height = 240;
   Quantity quantity = Quantity::AO;
-  float radius = 0.5f;  // AO / AO split radius r, obscurance R, Alchemy r (world units)
+  float radius = 0.5f;  // AO / AO split radius r, obscurance R, Alchemy (disk) r (world units)
   Membership membership = Membership::Sqrt;
   AlchemyParams alchemy;
   uint32_t spp = 64;         // maximum samples per pixel
   double noiseTarget = 0.0;  // > 0: stop once the mean standard error is at most this
   uint32_t minSpp = 16;      // samples before the noise target is first checked
   uint64_t seed = 1;
-  unsigned threads = 0;                           // 0: std::thread::hardware_concurrency()
+  std::optional<CameraView> camera;  // replaces activeCamera(scene, width / height) when set
+  unsigned threads = 0;              // 0: std::thread::hardware_concurrency()
   std::function<void(const Progress&)> progress;  // called after each progressive pass
 };
 
 struct Result {
   // The quantity (rgb; scalar quantities repeated in rgb), alpha 1 on geometry, 0 on sky. Sky
-  // pixels hold 1 for AO/obscurance/Alchemy (fully open), the environment radiance for the
+  // pixels hold 1 for the AO-like quantities (fully open), the environment radiance for the
   // lighting quantities, and 0 for depth/normal.
   ImageRGBA32F value;
   ImageRGBA32F stdError;  // per-pixel standard error of `value` (rgb), alpha as in value

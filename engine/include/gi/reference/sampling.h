@@ -116,6 +116,7 @@ struct AlchemyParams {
   float u = 0.0f;         // falloff knee; 0: the eq. 10 form
   float epsilon = 1e-4f;  // the paper's epsilon (squared length)
   float contrast = 1.0f;  // the paper's k
+  float bias = 0.0f;      // beta: numerator max(0, v.n - beta z); alchemy-disk only
 };
 
 inline float alchemyFalloff(const AlchemyParams& p, float t) {
