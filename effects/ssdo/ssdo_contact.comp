@@ -38,23 +38,23 @@ const float kPlaneEpsilon = 1e-5;
 const float kMinClipW = 1e-20;
 
 // The bias length b of `light` at view-space `pos` (world units along the light), as
-// shadowFactor computes it; 0 where the light has no shadow view covering `pos`.
+// shadowFactor computes it; 0 behind a perspective view. The view is read at the light's
+// (uniform) index only: a point light's six faces share near, far and texel footprint, and the
+// major-axis face's view depth is the largest |component| of pos - light (a per-pixel face
+// index would make llvmpipe load the view lane by lane).
 float biasLength(Light light, vec3 pos, float ndl) {
-  int first = int(light.shadow.x);
-  ShadowView sv;
-  if ((GI_SHADOW_TYPES & 2) != 0 && int(light.directionType.w) == 1) {  // point: major-axis face
-    vec3 d = mat3(frame.invView) * (pos - light.positionRange.xyz);
-    vec3 a = abs(d);
-    int axis = a.x >= a.y && a.x >= a.z ? 0 : (a.y >= a.z ? 1 : 2);
-    sv = shadowViews[min(first + 2 * axis + (d[axis] < 0.0 ? 1 : 0), GI_MAX_SHADOW_VIEWS - 1)];
-  } else {
-    sv = shadowViews[min(max(first, 0), GI_MAX_SHADOW_VIEWS - 1)];
-  }
-  vec4 clip = sv.viewToClip * vec4(pos, 1.0);
-  if (clip.w <= 0.0) return 0.0;
-  float ndcZ = clip.z / clip.w;
+  ShadowView sv = shadowViews[clamp(int(light.shadow.x), 0, GI_MAX_SHADOW_VIEWS - 1)];
   bool perspective = sv.params.x > 0.5;
-  float receiver = perspective ? clip.w : sv.params.y + (1.0 - ndcZ) * (sv.params.z - sv.params.y);
+  float receiver;
+  if ((GI_SHADOW_TYPES & 2) != 0 && int(light.directionType.w) == 1) {
+    vec3 a = abs(mat3(frame.invView) * (pos - light.positionRange.xyz));
+    receiver = max(a.x, max(a.y, a.z));
+  } else {
+    vec4 clip = sv.viewToClip * vec4(pos, 1.0);
+    if (clip.w <= 0.0) return 0.0;
+    receiver = perspective ? clip.w
+                           : sv.params.y + (1.0 - clip.z / clip.w) * (sv.params.z - sv.params.y);
+  }
   float texel = perspective ? sv.params.w * receiver : sv.params.w;
   float tanTheta = min(sqrt(max(1.0 - ndl * ndl, 0.0)) / max(ndl, 1e-4), 10.0);
   return max(texel * (light.shadow.y + light.shadow.z * tanTheta), 0.0);
