@@ -3,6 +3,9 @@
 // declarations against what an effect's passes really do.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <fstream>
+
 #include "gi/effect.h"
 #include "gi/effect_registry.h"
 #include "gi/errors.h"
@@ -146,6 +149,91 @@ TEST_F(LightingCompositionTest, AmbientReplacesTheEnvironmentTermAndIndirectAdds
     EXPECT_NEAR(indirect.lit.pixels[i + 2] - plain.lit.pixels[i + 2], 0.5f, 4e-3f);
   }
   EXPECT_GT(geometry, plain.lit.pixels.size() / 8);
+}
+
+// contact_shadow: channel 0 scales the first *shadow-casting* light's direct term (here the
+// second light: the first casts no shadow) and nothing else. Two directional lights on a plane
+// with a box; lit(contact k) = lit(both) - (1 - k) x (lit(both) - lit(unshadowed light only)),
+// k = 128/255 (0.5 in RGBA8, exact: the clear value is a multiple of 1/255). Tolerance: the
+// half-float lit image (2^-11 relative of each term, three images).
+TEST_F(LightingCompositionTest, ContactShadowScalesOnlyTheShadowedLightsDirectTerm) {
+  auto scene = [](bool withShadowed) {
+    const std::string path =
+        ::testing::TempDir() + "/contact_" + (withShadowed ? "two" : "one") + ".json";
+    std::ofstream(path) << R"({
+      "models": [ { "primitive": "plane", "size": 20, "material": { "base_color": [0.6, 0.6, 0.6] } },
+                  { "primitive": "box", "size": [1, 1, 1], "translation": [0, 0.5, 0] } ],
+      "lights": [ { "type": "directional", "direction": [0.3, -1, 0.2], "intensity": 1.5,
+                    "casts_shadows": false })"
+                        << (withShadowed ? R"(,
+                  { "type": "directional", "direction": [-0.5, -1, -0.4], "intensity": 2.5,
+                    "color": [1, 0.8, 0.6], "casts_shadows": true })"
+                                         : "")
+                        << R"( ],
+      "camera": { "position": [0, 3, 5], "target": [0, 0, 0] } })";
+    return loadSceneJson(path);
+  };
+  const float k = 128.0f / 255.0f;
+  EffectRegistry reg;
+  reg.add([k] {
+    return std::make_unique<ConstantEffect>(
+        "contact", EffectStage::BeforeLighting, std::vector<std::string>{},
+        std::vector<ConstantEffect::Output>{
+            {resources::kContactShadow, VK_FORMAT_R8G8B8A8_UNORM, {{k, 1.0f, 1.0f, 1.0f}}}});
+  });
+  reg.add([] {
+    return std::make_unique<ConstantEffect>(
+        "contact_neutral", EffectStage::BeforeLighting, std::vector<std::string>{},
+        std::vector<ConstantEffect::Output>{
+            {resources::kContactShadow, VK_FORMAT_R8G8B8A8_UNORM, {{1.0f, 1.0f, 1.0f, 1.0f}}}});
+  });
+  const Scene two = scene(true), one = scene(false);
+  const Frame both = renderWith(ctx(), two, reg, {});
+  const Frame halved = renderWith(ctx(), two, reg, {"contact"});
+  const Frame neutral = renderWith(ctx(), two, reg, {"contact_neutral"});
+  const Frame unshadowed = renderWith(ctx(), one, reg, {});
+  const Frame unshadowedContact = renderWith(ctx(), one, reg, {"contact"});
+  // The unshadowed light alone is untouched, and channels of 1 change nothing, bit for bit.
+  EXPECT_EQ(unshadowedContact.lit.pixels, unshadowed.lit.pixels);
+  EXPECT_EQ(neutral.lit.pixels, both.lit.pixels);
+  size_t lit = 0;
+  for (size_t i = 0; i < both.lit.pixels.size(); i += 4) {
+    if (both.depth.pixels[i] <= 0.0f) continue;  // sky
+    for (size_t c = 0; c < 3; ++c) {
+      const float full = both.lit.pixels[i + c], rest = unshadowed.lit.pixels[i + c];
+      const float expected = rest + k * (full - rest);
+      ASSERT_TRUE(std::isfinite(halved.lit.pixels[i + c]));
+      ASSERT_NEAR(halved.lit.pixels[i + c], expected, 2e-3f * (full + rest) + 1e-5f)
+          << "pixel " << i / 4 << " channel " << c;
+    }
+    if (both.lit.pixels[i] - unshadowed.lit.pixels[i] > 0.05f) ++lit;
+  }
+  EXPECT_GT(lit, both.lit.pixels.size() / 4 / 4) << "the shadowed light must light the view";
+}
+
+// A declared optional lighting input may stay unpublished (an effect's setting turns it off):
+// the neutral fallback stands in, bit for bit; any other declared write must be published.
+TEST_F(LightingCompositionTest, DeclaredOptionalInputsMayStayUnpublished) {
+  const Scene scene = loadScene("default");
+  EffectRegistry reg;
+  for (const char* declared : {resources::kContactShadow, "required_out"})
+    reg.add([declared] {
+      return std::make_unique<ConstantEffect>(
+          std::string("declares_") + declared, EffectStage::BeforeLighting,
+          std::vector<std::string>{},
+          std::vector<ConstantEffect::Output>{{"own_out", kRGBA16F, {{0.0f, 0.0f, 0.0f, 0.0f}}}},
+          std::vector<std::string>{}, std::vector<std::string>{"own_out", declared});
+    });
+  const Frame plain = renderWith(ctx(), scene, reg, {});
+  const Frame optional = renderWith(ctx(), scene, reg, {"declares_contact_shadow"});
+  EXPECT_EQ(optional.lit.pixels, plain.lit.pixels);
+  try {
+    renderWith(ctx(), scene, reg, {"declares_required_out"});
+    FAIL() << "an unpublished declared write must be refused";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("published nothing under that name"), std::string::npos)
+        << e.what();
+  }
 }
 
 TEST_F(LightingCompositionTest, AfterLightingEffectsRunInDependencyOrderWhateverTheSceneOrder) {

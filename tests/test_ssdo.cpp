@@ -496,6 +496,100 @@ TEST_F(SsdoTest, AdditionalCameraSeesAnOccluderOutsideTheView) {
   EXPECT_TRUE(finite(extra.lit));
 }
 
+// Seed 000 §5, contact shadows: a 0.1 box on a 16 m plane under a directional light (no
+// environment, so lit = the direct term), 256^2 shadow map (texel ~0.07 m), default bias
+// (b ~ 3 texels at 45 degrees: more than the box's thickness along the light). The engine's
+// visibility of the light at a pixel is lit / lit without shadows. Floor pixels in the box's
+// geometric shadow within 1 cm of its base: the bias lifts the receiver past the box, the
+// engine lights them; with contact_shadows the samples toward the light enter the box: darker.
+// Open floor further than 0.15 from the box keeps its value.
+TEST_F(SsdoTest, ContactShadowsRestoreTheShadowTheBiasRemoves) {
+  auto scene = [&](bool shadows) {
+    return jsonScene(shadows ? "contact" : "contact_unshadowed", std::string(R"({
+      "models": [
+        { "primitive": "plane", "size": 16, "material": { "base_color": [0.8, 0.8, 0.8], "roughness": 1 } },
+        { "primitive": "box", "size": [0.1, 0.1, 0.1], "translation": [0, 0.05, 0],
+          "material": { "base_color": [0.8, 0.8, 0.8], "roughness": 1 } } ],
+      "lights": [ { "type": "directional", "direction": [1, -1, 0.3], "intensity": 3,
+                    "casts_shadows": )") + (shadows ? "true" : "false") +
+                                                                     R"( } ],
+      "camera": { "position": [0.4, 0.25, 0.15], "target": [0.05, 0.0, 0.02] },
+      "environment": { "type": "constant", "color": [0, 0, 0] } })");
+  };
+  auto renderAt256 = [&](const Scene& sc, const std::vector<std::string>& sets,
+                         const std::string& effect) {
+    RenderSettings rs = settingsFor(sc, effect, sets);
+    rs.shadowMapSize = 256;
+    Renderer r(ctx(), sc, rs, &registry);
+    r.renderFrame();
+    Result res;
+    res.lit = r.readTarget("lit");
+    res.depth = r.readTarget("depth");
+    res.camera = r.camera();
+    res.w = int(kW);
+    res.h = int(kH);
+    return res;
+  };
+  const Scene s = scene(true), open = scene(false);
+  const std::vector<std::string> base = {"ssdo.bounce=false"};
+  std::vector<std::string> on = base;
+  on.push_back("ssdo.contact_shadows=true");
+  const Result engine = renderAt256(s, {}, "");
+  const Result unshadowed = renderAt256(open, {}, "");
+  const Result off = renderAt256(s, base, "ssdo");
+  const Result contact = renderAt256(s, on, "ssdo");
+  ASSERT_TRUE(finite(contact.lit));
+  // The light travels toward +x (and a little +z): the shadow falls on the box's +x side.
+  const glm::vec3 l = glm::normalize(glm::vec3(-1, 1, -0.3f));  // toward the light
+  auto inBoxShadow = [&](glm::vec3 p) {  // the ray toward the light hits the box
+    const glm::vec3 lo(-0.05f, 0.0f, -0.05f), hi(0.05f, 0.1f, 0.05f);
+    float t0 = 0.0f, t1 = 1e9f;
+    for (int a = 0; a < 3; ++a) {
+      const float ta = (lo[a] - p[a]) / l[a], tb = (hi[a] - p[a]) / l[a];
+      t0 = std::max(t0, std::min(ta, tb));
+      t1 = std::min(t1, std::max(ta, tb));
+    }
+    return t0 < t1;
+  };
+  auto boxDistance = [](glm::vec3 p) {  // horizontal distance to the box's base
+    const float dx = std::max(std::abs(p.x) - 0.05f, 0.0f),
+                dz = std::max(std::abs(p.z) - 0.05f, 0.0f);
+    return std::sqrt(dx * dx + dz * dz);
+  };
+  double engineSum = 0.0, contactSum = 0.0;
+  int touching = 0, far = 0;
+  for (int y = 0; y < engine.h; ++y)
+    for (int x = 0; x < engine.w; ++x) {
+      if (engine.sky(x, y)) continue;
+      const glm::vec3 p = engine.worldAt(x, y);
+      if (std::abs(p.y) > 1e-3f) continue;  // floor only
+      const float d = boxDistance(p);
+      if (d < 2e-3f) continue;  // the box's faces at its base (depth reconstruction error)
+      const float full = unshadowed.px(unshadowed.lit, x, y).g;
+      ASSERT_GT(full, 0.0f) << x << "," << y;
+      const float vEngine = engine.px(engine.lit, x, y).g / full,
+                  vOff = off.px(off.lit, x, y).g / full,
+                  vContact = contact.px(contact.lit, x, y).g / full;
+      ASSERT_NEAR(vOff, vEngine, 1e-3f) << "contact_shadows off changes nothing: " << x << "," << y;
+      if (inBoxShadow(p) && d < 0.01f) {
+        ++touching;
+        engineSum += vEngine;
+        contactSum += vContact;
+        EXPECT_GT(vEngine, 0.9f) << "the bias must lift the contact shadow: " << x << "," << y;
+      } else if (d > 0.15f) {
+        ++far;
+        ASSERT_NEAR(vContact, vEngine, 1e-3f) << "open floor: " << x << "," << y;
+      }
+    }
+  ASSERT_GT(touching, 10);
+  ASSERT_GT(far, 100);
+  std::printf("floor touching the box (%d px): engine visibility %.3f, with contact shadows %.3f\n",
+              touching, engineSum / touching, contactSum / touching);
+  // Measured 1.000 -> 0.522: the segment (b ~ 0.2 here) leaves the 0.1 box through its top, so
+  // about half the samples are blocked.
+  EXPECT_LT(contactSum / touching, engineSum / touching - 0.4);
+}
+
 TEST_F(SsdoTest, PeelingAndCameraPassesOnlyWhenAsked) {
   const Scene scene = test::cornerScene();  // no lights: no shadow pass
   auto passes = [&](const std::vector<std::string>& sets) {
@@ -512,6 +606,9 @@ TEST_F(SsdoTest, PeelingAndCameraPassesOnlyWhenAsked) {
   EXPECT_EQ(passes({"ssdo.cameras=2"}),
             (V{"gbuffer", "ssdo_cameras", "ssdo_camera_surface", "ssdo_surface", "ssdo",
                "ssdo_blur", "lighting", "tonemap"}));
+  EXPECT_EQ(
+      passes({"ssdo.contact_shadows=true"}),
+      (V{"gbuffer", "ssdo_surface", "ssdo", "ssdo_blur", "ssdo_contact", "lighting", "tonemap"}));
   EXPECT_EQ(passes({"ssdo.layers=2", "ssdo.cameras=4"}),
             (V{"gbuffer", "ssdo_peel", "ssdo_cameras", "ssdo_camera_surface", "ssdo_surface",
                "ssdo", "ssdo_blur", "lighting", "tonemap"}));

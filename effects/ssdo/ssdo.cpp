@@ -6,6 +6,8 @@
 // Optional (seed 000 §4), only built when asked: a second depth layer peeled through the
 // engine's layered-depth draw (`layers` 2, pass ssdo_peel), and `cameras` low-resolution
 // views whose G-buffers add occluders and senders (passes ssdo_cameras, ssdo_camera_surface).
+// Optional (seed 000 §5, `contact_shadows`): the contact shadows the shadow-map bias removes,
+// published as the lighting pass's "contact_shadow" (pass ssdo_contact, ssdo_contact.comp).
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -26,6 +28,7 @@
 #include "gi/vk/resources.h"
 #include "ssdo.comp.h"          // const uint32_t ssdo_comp[]
 #include "ssdo_blur_x.comp.h"   // const uint32_t ssdo_blur_x_comp[]
+#include "ssdo_contact.comp.h"  // const uint32_t ssdo_contact_comp[]
 #include "ssdo_resolve.comp.h"  // const uint32_t ssdo_resolve_comp[]
 #include "ssdo_samples.h"
 #include "ssdo_surface.comp.h"  // const uint32_t ssdo_surface_comp[]
@@ -39,6 +42,7 @@ using gi::SettingType;
 constexpr VkFormat kPackedFormat = VK_FORMAT_R32G32B32A32_UINT;
 constexpr VkFormat kOutFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 constexpr uint32_t kGroupX = 32, kGroupY = 16;  // local_size of every SSDO shader
+constexpr int kMaxContactSamples = 16;
 
 // Bit masks of the light types present and of those with shadow maps (1 directional, 2 point,
 // 4 spot), as the lighting pass's specialization constants.
@@ -64,7 +68,7 @@ class SsdoEffect : public gi::Effect {
     i.stage = gi::EffectStage::BeforeLighting;
     i.reads = {res::kDepth,    res::kNormal, res::kAlbedo,      res::kMaterial,
                res::kEmission, res::kLights, res::kShadowViews, res::kShadowMaps};
-    i.writes = {res::kAmbient, res::kIndirect};
+    i.writes = {res::kAmbient, res::kIndirect, res::kContactShadow};
     i.debugView = res::kAmbient;
     i.estimates = gi::GroundTruth::IndirectLight;
     return i;
@@ -111,6 +115,15 @@ class SsdoEffect : public gi::Effect {
          "distance of the additional cameras from the viewer, in radii of the scene's bounding "
          "sphere",
          false},
+        {"contact_shadows", SettingType::Bool, 0, 0, 1,
+         "screen-space contact shadows for the first four shadow-casting lights: restores the "
+         "shadow the shadow-map bias removes next to contacts (pass ssdo_contact, publishes "
+         "\"contact_shadow\")",
+         true},
+        gi::SettingDesc::samples("contact_samples", 4, 1, kMaxContactSamples,
+                                 "samples per pixel and light on the bias segment toward the "
+                                 "light (a specialization constant: the loop unrolls)",
+                                 true),
     };
   }
 
@@ -125,6 +138,10 @@ class SsdoEffect : public gi::Effect {
     samples_ = uint32_t(std::clamp(settings.integer("samples"), 1, gi::ssdo::kMaxSamples));
     layers_ = uint32_t(std::clamp(settings.integer("layers"), 1, gi::ssdo::kMaxLayers));
     cameras_ = uint32_t(std::clamp(settings.integer("cameras"), 0, gi::ssdo::kMaxCameras));
+    contact_ = settings.flag("contact_shadows");
+    contactSamples_ =
+        uint32_t(std::clamp(settings.integer("contact_samples"), 1, kMaxContactSamples));
+    contactMasks_.reset();  // the sample count may have changed: rebuilt on first use
     buildSurface(ctx, lightMasks(ctx.lights()));
     buildSsdo(ctx, environmentKind(ctx.frame()));
     while (views_.size() < cameras_) views_.push_back(ctx.createView());
@@ -183,7 +200,8 @@ class SsdoEffect : public gi::Effect {
       gi::TextureHandle depth, normal, albedo, material, emission, shadowMaps;
       gi::BufferHandle lights, shadowViews;
       gi::TextureHandle surface, raw, half, ambient, indirect;
-      gi::TextureHandle layer1;  // the peeled depth layer (layers 2)
+      gi::TextureHandle layer1;   // the peeled depth layer (layers 2)
+      gi::TextureHandle contact;  // contact_shadow (contact_shadows)
       // Per additional camera: its depth, G-buffer colours and surface texels.
       std::vector<gi::TextureHandle> camDepth, camSurface;
       std::vector<std::vector<gi::TextureHandle>> camG;
@@ -392,6 +410,34 @@ class SsdoEffect : public gi::Effect {
         });
     bb.put(res::kAmbient, io->ambient);
     bb.put(res::kIndirect, io->indirect);
+
+    if (contact_) {
+      graph.addPass(
+          "ssdo_contact",
+          [&](gi::PassBuilder& b) {
+            io->surface = b.read(io->surface);
+            io->lights = b.read(bb.buffer(res::kLights));
+            io->shadowViews = b.read(bb.buffer(res::kShadowViews));
+            io->shadowMaps = b.read(bb.texture(res::kShadowMaps));
+            io->contact =
+                b.write(b.create(res::kContactShadow, gi::TextureDesc{VK_FORMAT_R8G8B8A8_UNORM}),
+                        gi::TextureUsage::StorageWrite);
+          },
+          [this, io, frame, nearest, ubo, c = &ctx](gi::PassContext& pc) {
+            const auto masks = lightMasks(c->lights());
+            if (masks != contactMasks_) buildContact(*c, masks);
+            gi::vk::DescriptorWriter w;
+            w.buffer(0, ubo, frame)
+                .buffer(1, ubo, uniforms_.handle())
+                .sampled(2, pc.view(io->surface), nearest)
+                .buffer(3, ubo, pc.buffer(io->lights))
+                .buffer(4, ubo, pc.buffer(io->shadowViews))
+                .sampled(5, pc.view(io->shadowMaps), nearest)
+                .storageImage(6, pc.view(io->contact));
+            pc.dispatch(contactPipeline_, w, pc.extent(io->contact), kGroupX, kGroupY);
+          });
+      bb.put(res::kContactShadow, io->contact);
+    }
   }
 
  private:
@@ -408,6 +454,18 @@ class SsdoEffect : public gi::Effect {
         {{0, ubo}, {1, ubo}, {2, tex}, {3, img}, {4, tex}, {5, tex}, {6, tex}, {7, tex}}, 0,
         {samples_, bounce_ ? 1u : 0u, kind, layers_, cameras_});
     environmentKind_ = kind;
+  }
+
+  // The contact-shadow pipeline, specialized to the sample count and the light types present.
+  void buildContact(gi::EffectContext& ctx, std::array<uint32_t, 2> masks) {
+    const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
+               tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+               img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+    contactPipeline_ = gi::vk::Pipeline::compute(
+        ctx.vulkan(), {std::begin(ssdo_contact_comp), std::end(ssdo_contact_comp)},
+        {{0, ubo}, {1, ubo}, {2, tex}, {3, ubo}, {4, ubo}, {5, tex}, {6, img}}, 0,
+        {contactSamples_, masks[0], masks[1]});
+    contactMasks_ = masks;
   }
 
   // The surface pipelines of the main view (with its layers) and of the additional cameras
@@ -491,12 +549,15 @@ class SsdoEffect : public gi::Effect {
     vkCmdPipelineBarrier2(cmd, &dep);
   }
 
-  gi::vk::Pipeline surface_, cameraSurface_, ssdo_, blurX_, resolve_;
+  gi::vk::Pipeline surface_, cameraSurface_, ssdo_, blurX_, resolve_, contactPipeline_;
   gi::vk::Buffer uniforms_;
   std::vector<std::shared_ptr<gi::ViewUniforms>> views_;  // the additional cameras
   bool bounce_ = true, senderShadows_ = true;
   uint32_t samples_ = 12, environmentKind_ = 0, layers_ = 1, cameras_ = 0;
   std::array<uint32_t, 2> surfaceMasks_{7, 7};
+  bool contact_ = false;
+  uint32_t contactSamples_ = 4;
+  std::optional<std::array<uint32_t, 2>> contactMasks_;  // built on first use
   std::optional<std::array<double, 5>> uploaded_;
 };
 

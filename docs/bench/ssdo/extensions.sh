@@ -1,7 +1,10 @@
 #!/usr/bin/env bash
 # Overhead of SSDO's depth peeling and additional cameras over plain SSDO (seed 000 §4), on
 # this device: docs/bench/ssdo/README.md.
-#   docs/bench/ssdo/extensions.sh [--runs N] [--frames F] [--scene S] [--sizes WxH,WxH] [BUILD]
+#   docs/bench/ssdo/extensions.sh [--runs N] [--frames F] [--scene S] [--sizes WxH,WxH]
+#                                 [--configs "SETS;SETS;..."] [BUILD]
+# --configs replaces the configurations (the first is the baseline of the "x plain" ratios; each
+# a comma-separated list of --set values), e.g. "ssdo.samples=12;ssdo.contact_shadows=true".
 # Each run is one gi-render --timings --isolate-passes process (median GPU ms per pass over F
 # frames); the configurations are interleaved run by run (run 1 of all, then run 2, ...) so that
 # load drift on a shared machine hits all alike. Prints per configuration the median [min-max]
@@ -9,13 +12,14 @@
 # runs of the ratio to plain SSDO of the same run.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/../../.."
-runs=5 frames=5 scene=default sizes=320x240,640x480
+runs=5 frames=5 scene=default sizes=320x240,640x480 config_list=
 while [[ $# -gt 0 && $1 == --* ]]; do
   case $1 in
   --runs) runs=$2 ;;
   --frames) frames=$2 ;;
   --scene) scene=$2 ;;
   --sizes) sizes=$2 ;;
+  --configs) config_list=$2 ;;
   *) echo "extensions.sh: unknown option $1" >&2; exit 2 ;;
   esac
   shift 2
@@ -25,6 +29,7 @@ render=$build/bin/gi-render
 [[ -x $render ]] || { echo "extensions.sh: no $render" >&2; exit 2; }
 configs=("ssdo.layers=1,ssdo.cameras=0" "ssdo.layers=2" "ssdo.cameras=1" "ssdo.cameras=2"
   "ssdo.cameras=4")
+[[ -z $config_list ]] || IFS=';' read -ra configs <<<"$config_list"
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 IFS=, read -ra size_list <<<"$sizes"

@@ -44,8 +44,11 @@ inline constexpr const char* kAO = "ao";  // R ambient visibility of the environ
 // replaces the engine's SH9 x albedo x AO term (directional occlusion), 0 to keep the engine's.
 inline constexpr const char* kAmbient = "ambient";
 inline constexpr const char* kIndirect = "indirect";  // RGBA16F outgoing indirect radiance, added
-inline constexpr const char* kOutput = "output";      // RGBA8 tonemapped final image
-inline constexpr const char* kFloor = "floor";        // RGBA8 cost-floor pass output
+// RGBA8 (any size, sampled bilinearly at the pixel's uv): channel i multiplies the shadow factor
+// of the i-th shadow-casting light (the first four in `lights` order), 1 = no change.
+inline constexpr const char* kContactShadow = "contact_shadow";
+inline constexpr const char* kOutput = "output";  // RGBA8 tonemapped final image
+inline constexpr const char* kFloor = "floor";    // RGBA8 cost-floor pass output
 // Buffer: the point representation (gi/surface_points.h), two vec4 per point: world
 // position + represented area, world normal + material index. Exists when an effect asked
 // for points (EffectContext::requestSurfacePoints); re-evaluated every frame from the
@@ -117,8 +120,9 @@ struct EffectInfo {
   EffectStage stage = EffectStage::BeforeLighting;
   // Blackboard resources its passes look up and publish. Checked on every graph build: a lookup
   // or publication not declared here is an error naming the effect, and so is a declared write
-  // it did not publish. Effects of one stage run in the order these imply (a reader after the
-  // writer), whatever their order in the scene.
+  // it did not publish (unless it is an optional lighting input: ao, ambient, indirect,
+  // contact_shadow, which the neutral fallback then replaces). Effects of one stage run in the
+  // order these imply (a reader after the writer), whatever their order in the scene.
   std::vector<std::string> reads;
   std::vector<std::string> writes;
   std::string debugView;  // resource shown by `gi-render --view <name>`

@@ -365,6 +365,12 @@ struct Renderer::Impl : EffectContext {
     return out;
   }
 
+  static bool isOptionalInput(const std::string& name) {
+    for (const char* n : {res::kAO, res::kAmbient, res::kIndirect, res::kContactShadow})
+      if (name == n) return true;
+    return false;
+  }
+
   // Adds one effect's (or built-in's) passes and checks them against its declaration.
   void addChecked(Effect& e, const EffectInfo& info, const SettingValues& values) {
     Blackboard& bb = graph.blackboard();
@@ -383,9 +389,11 @@ struct Renderer::Impl : EffectContext {
         throw Error(ErrorKind::Usage, "",
                     "effect '" + info.name + "' publishes '" + name +
                         "', which its EffectInfo::writes does not declare");
-    if (!bb.published().empty())  // an effect may choose to add nothing at all
+    // An effect may choose to add nothing at all, and to leave an optional lighting input
+    // unpublished (its neutral fallback stands in: e.g. SSDO's contact_shadow when off).
+    if (!bb.published().empty())
       for (const std::string& name : info.writes)
-        if (!bb.published().count(name))
+        if (!bb.published().count(name) && !isOptionalInput(name))
           throw Error(ErrorKind::Usage, "",
                       "effect '" + info.name + "' declares it writes '" + name +
                           "' but published nothing under that name");
@@ -410,6 +418,8 @@ struct Renderer::Impl : EffectContext {
     graph.declareFallback(res::kAmbient, VK_FORMAT_R16G16B16A16_SFLOAT, {{0.0f, 0.0f, 0.0f, 0.0f}});
     graph.declareFallback(res::kIndirect, VK_FORMAT_R16G16B16A16_SFLOAT,
                           {{0.0f, 0.0f, 0.0f, 0.0f}});
+    graph.declareFallback(res::kContactShadow, VK_FORMAT_R8G8B8A8_UNORM,
+                          {{1.0f, 1.0f, 1.0f, 1.0f}});
     // Engine data every pass may read: lights, shadow views, the environment.
     bb.put(res::kLights,
            graph.importBuffer(res::kLights, lightBuffer.handle(), lightBuffer.size()));

@@ -1,5 +1,6 @@
 // "lighting": composes the lit image from the G-buffer, the lights and shadow maps, the
-// environment and the optional inputs effects publish (ao, ambient, indirect; neutral when
+// environment and the optional inputs effects publish (ao, ambient, indirect, contact_shadow;
+// neutral when
 // absent: the fallbacks are declared once, in the renderer's buildGraph()).
 #include <algorithm>
 #include <array>
@@ -19,9 +20,10 @@ class LightingPass final : public Effect {
   EffectInfo info() const override {
     EffectInfo i{"lighting", "2",
                  "direct light with shadows + environment x ambient visibility + indirect"};
-    i.reads = {res::kDepth,    res::kNormal,  res::kAlbedo,      res::kMaterial,
-               res::kEmission, res::kLights,  res::kShadowViews, res::kShadowMaps,
-               res::kAO,       res::kAmbient, res::kIndirect,    res::kEnvironmentMap};
+    i.reads = {
+        res::kDepth,    res::kNormal,        res::kAlbedo,        res::kMaterial, res::kEmission,
+        res::kLights,   res::kShadowViews,   res::kShadowMaps,    res::kAO,       res::kAmbient,
+        res::kIndirect, res::kContactShadow, res::kEnvironmentMap};
     i.writes = {res::kLit};
     return i;
   }
@@ -31,9 +33,10 @@ class LightingPass final : public Effect {
   }
   void addPasses(FrameGraph& graph, EffectContext& ctx, const SettingValues&) override {
     struct Io {
-      TextureHandle gbuffer[5], shadowMaps, ao, ambient, indirect, environment, lit;
+      TextureHandle gbuffer[5], shadowMaps, ao, ambient, indirect, contact, environment, lit;
       BufferHandle lights, shadowViews;
-      bool fallback[3] = {true, true, true};  // ao, ambient, indirect: the neutral stand-in
+      // ao, ambient, indirect, contact_shadow: the neutral stand-in
+      bool fallback[4] = {true, true, true, true};
     };
     auto io = std::make_shared<Io>();
 
@@ -53,6 +56,8 @@ class LightingPass final : public Effect {
           io->fallback[0] = b.isFallback(io->ao);
           io->fallback[1] = b.isFallback(io->ambient);
           io->fallback[2] = b.isFallback(io->indirect);
+          io->contact = b.readOptional(res::kContactShadow);
+          io->fallback[3] = b.isFallback(io->contact);
           io->environment = b.read(bb.texture(res::kEnvironmentMap));
           io->lit = b.write(b.create(res::kLit, TextureDesc{VK_FORMAT_R16G16B16A16_SFLOAT}),
                             TextureUsage::StorageWrite);
@@ -66,9 +71,9 @@ class LightingPass final : public Effect {
             const VkExtent2D i = pc.extent(h);
             return i.width == e.width && i.height == e.height ? 1u : 2u;
           };
-          const vk::Pipeline& pipeline =
-              variant({inputMode(io->fallback[0], io->ao), inputMode(io->fallback[1], io->ambient),
-                       inputMode(io->fallback[2], io->indirect)});
+          const vk::Pipeline& pipeline = variant(
+              {inputMode(io->fallback[0], io->ao), inputMode(io->fallback[1], io->ambient),
+               inputMode(io->fallback[2], io->indirect), inputMode(io->fallback[3], io->contact)});
           vk::DescriptorWriter w;
           w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame);
           for (uint32_t i = 0; i < 5; ++i) w.sampled(1 + i, pc.view(io->gbuffer[i]), nearest);
@@ -79,7 +84,8 @@ class LightingPass final : public Effect {
               .sampled(10, pc.view(io->ao), linear)
               .sampled(11, pc.view(io->ambient), linear)
               .sampled(12, pc.view(io->indirect), linear)
-              .sampled(13, pc.view(io->environment), s_.scene.linearRepeat());
+              .sampled(13, pc.view(io->environment), s_.scene.linearRepeat())
+              .sampled(14, pc.view(io->contact), linear);
           pc.dispatch(pipeline, w, e, kScreenGroupX, kScreenGroupY);
         });
     bb.put(res::kLit, io->lit);
@@ -87,21 +93,26 @@ class LightingPass final : public Effect {
 
  private:
   // The lighting.comp specialization constants of one configuration (constant_id order).
-  using Variant = std::array<uint32_t, 7>;
+  using Variant = std::array<uint32_t, 8>;
 
   // The pipeline for this frame's lights, PCF radius, optional inputs (mode per input: 0
   // fallback, 1 same size, 2 other size) and environment kind, built on first use: a scene
   // needs one or two, and the disk pipeline cache keeps them between runs.
-  const vk::Pipeline& variant(const std::array<uint32_t, 3>& inputs) {
+  const vk::Pipeline& variant(const std::array<uint32_t, 4>& inputs) {
     uint32_t types = 0, shadowTypes = 0;
     for (const GpuLight& l : s_.lights.lights) {
       const uint32_t bit = 1u << std::clamp(int(l.directionType.w), 0, 2);
       types |= bit;
       if (l.shadow.x >= 0.0f) shadowTypes |= bit;
     }
-    const Variant key{
-        types,     shadowTypes,          std::min(s_.settings.pcfRadius, 3u), inputs[0], inputs[1],
-        inputs[2], s_.environment.kind()};
+    const Variant key{types,
+                      shadowTypes,
+                      std::min(s_.settings.pcfRadius, 3u),
+                      inputs[0],
+                      inputs[1],
+                      inputs[2],
+                      s_.environment.kind(),
+                      inputs[3]};
     auto found = pipelines_.find(key);
     if (found != pipelines_.end()) return found->second;
     const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
@@ -122,7 +133,8 @@ class LightingPass final : public Effect {
                                              {10, tex},
                                              {11, tex},
                                              {12, tex},
-                                             {13, tex}},
+                                             {13, tex},
+                                             {14, tex}},
                                             0, {key.begin(), key.end()}))
         .first->second;
   }
