@@ -83,10 +83,11 @@ class IsmEffect : public gi::Effect {
   std::vector<gi::SettingDesc> settings() const override {
     using gi::ism::kMaxVpls;
     return {
-        {"vpls", SettingType::Int, 256, 1, kMaxVpls,
-         "virtual point lights N_vpl per bounce, the first sampled from the primary light's RSM "
-         "(each gets one ISM)",
-         true},
+        gi::SettingDesc::samples(
+            "vpls", 256, 1, kMaxVpls,
+            "virtual point lights N_vpl per bounce, the first sampled from the primary light's RSM "
+            "(each gets one ISM)",
+            true),
         {"ism_resolution", SettingType::Int, 64, 8, gi::ism::kMaxIsmResolution,
          "side of each VPL's paraboloid shadow map in texels (rounded down to a power of two)",
          true},
