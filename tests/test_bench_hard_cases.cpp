@@ -60,14 +60,14 @@ TEST_F(HardCasesTest, EveryEffectStaysFiniteAndInRangeOnEveryHardCase) {
   sweep(o);
 }
 
-// 64 static frames on the cases most likely to expose instability (grazing taps, a closed
-// scene, an edge), every effect.
+// 64 static frames on the cases most likely to expose instability (grazing taps; a closed white
+// box, where bounces feed on bounces), every effect. gi-bench --hard-cases checks every case.
 TEST_F(HardCasesTest, StaticCameraDoesNotFlickerOver64Frames) {
   bench::HardCaseOptions o;
-  o.width = 80;
-  o.height = 60;
+  o.width = 64;
+  o.height = 48;
   o.flickerFrames = 64;
-  o.cases = {"grazing_plane", "closed_box", "depth_discontinuity"};
+  o.cases = {"grazing_plane", "closed_box"};
   sweep(o);
 }
 
