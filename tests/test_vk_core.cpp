@@ -135,5 +135,26 @@ TEST(PipelineCache, WrittenToDiskAndReloaded) {
   std::filesystem::remove(path);
 }
 
+// Every Vulkan test runs under synchronization validation (vulkan_fixture: validation on, and
+// Context enables VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT with it). Proof
+// that it is live: two transfer writes to one buffer without a barrier are reported as a hazard.
+TEST(SyncValidation, AMissingBarrierIsReported) {
+  vk::ContextOptions o;
+  o.validation = true;
+  o.pipelineCachePath =
+      (std::filesystem::temp_directory_path() / "gi-test-sync-validation-cache.bin").string();
+  vk::Context ctx(o);
+  vk::Buffer buffer(ctx, 4096, VK_BUFFER_USAGE_TRANSFER_DST_BIT, false);
+  ctx.submitAndWait([&](VkCommandBuffer c) {
+    vkCmdFillBuffer(c, buffer.handle(), 0, VK_WHOLE_SIZE, 1u);
+    vkCmdFillBuffer(c, buffer.handle(), 0, VK_WHOLE_SIZE, 2u);  // no barrier in between
+  });
+  EXPECT_GE(ctx.validationErrors(), 1u);
+  bool hazard = false;
+  for (const std::string& m : ctx.validationMessages())
+    hazard |= m.find("SYNC-HAZARD-WRITE-AFTER-WRITE") != std::string::npos;
+  EXPECT_TRUE(hazard) << "synchronization validation did not report the write-after-write";
+}
+
 }  // namespace
 }  // namespace gi

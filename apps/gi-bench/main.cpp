@@ -35,6 +35,7 @@
 #include "gi/renderer.h"
 #include "gi/scene_io.h"
 #include "gi/vk/context.h"
+#include "hard_cases.h"
 #include "metrics.h"
 #include "quantity.h"
 #include "stats.h"
@@ -51,6 +52,8 @@ const char* kUsage =
     "usage: gi-bench --out DIR [--scenes A,B] [--effects E1,E2+E3,none] [--presets P1,none]\n"
     "                [--grid EFFECT.KEY=V1,V2,...]... [options]\n"
     "       gi-bench --quick --out DIR                  (CI smoke sweep, a few seconds)\n"
+    "       gi-bench --hard-cases --out DIR [--effects A,B] [--cases C,D] [--frames K]\n"
+    "                (every effect x hard scenes: no NaN/Inf in any texture, ranges, flicker)\n"
     "       gi-bench --calibrate --budget-ms B --width W --height H [--scene S]\n"
     "                [--effects E] --out PRESET.json\n"
     "  --scenes A,B          scenes (JSON, model files or 'default'; default: default)\n"
@@ -81,6 +84,7 @@ const char* kUsage =
     "  --metric M            --calibrate: accuracy to maximise, ssim (default) or nrmse. SSIM\n"
     "                        sees noise and interleave patterns that a biased estimator's\n"
     "                        NRMSE hides (SSAO's NRMSE is ~flat from 1 to 64 samples)\n"
+    "  --cases A,B           --hard-cases: only these cases (default: all)\n"
     "  --no-progress         no progress lines on stderr\n"
     "  --validation          Vulkan validation layers (also GI_VALIDATION=1)\n"
     "  --device NAME         Vulkan device by name or index (also GI_DEVICE)\n"
@@ -99,6 +103,8 @@ struct Options {
   uint32_t width = 320, height = 240, refSpp = 256;
   uint64_t refSeed = 1;
   int frames = 5, reps = 5;
+  bool hardCases = false;
+  std::vector<std::string> cases;  // --hard-cases: a subset
   bool quick = false, calibrate = false, progress = true, validation = false, aoSplit = false;
   double budgetMs = 0.0, headroom = 0.1;
   std::string metric = "ssim";  // --calibrate: what "most accurate" means
@@ -153,6 +159,10 @@ Options parseArgs(int argc, char** argv) {
       o.headroom = a.number(0, 0.9);
     else if (a.is("--quick"))
       o.quick = true;
+    else if (a.is("--hard-cases"))
+      o.hardCases = true;
+    else if (a.is("--cases"))
+      o.cases = a.list();
     else if (a.is("--ao-split"))
       o.aoSplit = true;
     else if (a.is("--calibrate"))
@@ -179,6 +189,12 @@ Options parseArgs(int argc, char** argv) {
     if (!(o.budgetMs > 0)) usageError("--calibrate", "needs --budget-ms");
     if (fs::path(o.out).extension() != ".json")
       usageError(o.out, "--calibrate writes a preset: --out must end in .json");
+  }
+  if (!o.hardCases && !o.cases.empty()) usageError("--cases", "only applies to --hard-cases");
+  if (o.hardCases) {
+    if (o.calibrate || o.quick) usageError("--hard-cases", "excludes --calibrate and --quick");
+    if (!o.sizeGiven) o.width = 160, o.height = 120;
+    if (!o.framesGiven) o.frames = 64;
   }
   if (o.quick) {
     if (!o.sizeGiven) o.width = 64, o.height = 48;
@@ -1191,11 +1207,59 @@ int runCalibrate(const Options& o) {
   return 0;
 }
 
+// ---- Hard cases ---------------------------------------------------------------------------------
+
+int runHardCaseSweep(const Options& o) {
+  gi::EffectRegistry registry;
+  registry.scanDefaultLocations();
+  gi::bench::HardCaseOptions hc;
+  hc.width = o.width;
+  hc.height = o.height;
+  hc.flickerFrames = o.frames;
+  hc.cases = o.cases;
+  if (o.effects)
+    for (const std::string& item : *o.effects) hc.effects.push_back(item);
+  gi::vk::Context ctx = makeContext(o);
+  std::error_code ec;
+  fs::create_directories(o.out, ec);
+  std::string csv =
+      "case,effect,textures,undecoded,values,non_finite,sky_fraction,flicker,seconds,problems\n";
+  int failed = 0;
+  size_t nonFinite = 0;
+  const auto runs =
+      gi::bench::runHardCases(ctx, registry, hc, [&](const gi::bench::HardCaseRun& r) {
+        std::string problems;
+        for (const std::string& p : r.problems) problems += (problems.empty() ? "" : "; ") + p;
+        std::printf(
+            "%-20s %-12s %2d textures (%d packed) %8zu values, %zu NaN/Inf, flicker %.3g, "
+            "%.1f s%s%s\n",
+            r.scene.c_str(), r.effect.c_str(), r.textures, r.undecoded, r.values, r.nonFinite,
+            r.flicker, r.seconds, problems.empty() ? "" : "  FAIL: ", problems.c_str());
+        std::fflush(stdout);
+        std::string quoted = problems;
+        std::replace(quoted.begin(), quoted.end(), '"', '\'');
+        csv += r.scene + "," + r.effect + "," + std::to_string(r.textures) + "," +
+               std::to_string(r.undecoded) + "," + std::to_string(r.values) + "," +
+               std::to_string(r.nonFinite) + "," + formatDouble(r.skyFraction) + "," +
+               formatDouble(r.flicker) + "," + formatDouble(r.seconds) + ",\"" + quoted + "\"\n";
+        failed += !r.problems.empty();
+        nonFinite += r.nonFinite;
+      });
+  gi::bench::writeFileAtomic((fs::path(o.out) / "hard_cases.csv").string(), csv);
+  std::printf("%zu runs (%zu cases x %zu effect sets), %d failed, %zu NaN/Inf values -> %s\n",
+              runs.size(), hc.cases.empty() ? gi::bench::hardCases().size() : hc.cases.size(),
+              runs.size() / std::max<size_t>(1, hc.cases.empty() ? gi::bench::hardCases().size()
+                                                                 : hc.cases.size()),
+              failed, nonFinite, (fs::path(o.out) / "hard_cases.csv").c_str());
+  return failed ? 1 : 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   return gi::cli::runMain("gi-bench", [&] {
     const Options o = parseArgs(argc, argv);
+    if (o.hardCases) return runHardCaseSweep(o);
     return o.calibrate ? runCalibrate(o) : runSweep(o);
   });
 }

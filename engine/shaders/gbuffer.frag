@@ -20,7 +20,11 @@ layout(location = 4) out vec2 outMotion;    // current minus previous position, 
 
 void main() {
   vec4 albedo = material.baseColor;
-  if (material.params.z > 0.5) albedo *= texture(baseColorTexture, inUV);
+  // Untextured materials bind a white texel, so this multiply is exact without a branch. No
+  // branch on a uniform here: lavapipe (Mesa 22.3) inlines uniforms that feed a branch into a
+  // shader variant per draw and never frees them (0.4-0.6 MiB per draw per frame: the animated
+  // scene grew 4 MiB a frame; tools/soak, docs/robustness.md).
+  albedo *= texture(baseColorTexture, inUV);
 
   // The triangle's plane normal on the side the camera sees (the fallback when the interpolated
   // normal is degenerate). The interpolated normal is turned to that side, so a double-sided

@@ -21,7 +21,9 @@ layout(location = 2) out vec4 outFlux;      // reflected flux (W), rgb
 void main() {
   DrawView v = drawView;
   vec3 albedo = material.baseColor.rgb;
-  if (material.params.z > 0.5) albedo *= texture(baseColorTexture, inUV).rgb;
+  // Untextured materials bind a white texel: exact without a branch on a uniform, which
+  // lavapipe (Mesa 22.3) would turn into a leaked shader variant per draw (gbuffer.frag).
+  albedo *= texture(baseColorTexture, inUV).rgb;
   albedo = clamp(albedo, 0.0, 1.0);
 
   int type = int(v.lightPosType.w);

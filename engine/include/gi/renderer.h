@@ -41,6 +41,9 @@ struct RenderSettings {
   // timing of the next pass that waits for it. Costs one submission per pass.
   bool isolatePasses = false;
   uint64_t surfacePointSeed = 1;
+  // Debug: false gives every transient texture its own memory, so that readAllTextures() sees
+  // each one's last version (robustness sweeps); true lets non-overlapping lifetimes share it.
+  bool aliasTransients = true;
   std::string view =
       "output";  // the resource the frame delivers (a G-buffer channel, an effect's view)
   // Resources readTarget() will read besides `view`: kept intact to the end of the frame (the
@@ -110,6 +113,17 @@ class Renderer {
   ImageRGBA8 readOutput();                           // tonemapped 8-bit image (view "output")
   ImageRGBA32F readTarget(const std::string& name);  // any produced resource as float RGBA
   std::vector<std::string> viewNames() const;        // images that can be viewed / read
+  // Every texture the last frame's graph used (G-buffer, effects' transients, history,
+  // fallbacks, imports), mip 0 / layer 0. `image` holds float RGBA for formats readTarget
+  // reads; other formats (packed integer texels) come back with `decoded` false and no pixels.
+  // With aliasTransients (the default) a transient may hold a later alias's texels.
+  struct NamedTexture {
+    std::string name;
+    VkFormat format = VK_FORMAT_UNDEFINED;
+    bool decoded = false;
+    ImageRGBA32F image;
+  };
+  std::vector<NamedTexture> readAllTextures();
   const CameraView& camera() const;
   // A free camera (gi-demo's) in place of the scene's: `view` (rigid), `position`, `yfov`,
   // `znear`, `zfar` are kept; `proj` is rebuilt for the output's aspect (also on resize).

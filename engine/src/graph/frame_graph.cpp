@@ -506,7 +506,7 @@ void FrameGraph::allocateTransients() {
                   (slot.typeBits & t.requirements.memoryTypeBits) &&
                   slot.alignment % t.requirements.alignment == 0;
       for (auto& [first, last] : slot.lifetimes)
-        fits = fits && (r.lastUse < first || last < r.firstUse);
+        fits = fits && aliasing_ && (r.lastUse < first || last < r.firstUse);
       if (fits) chosen = int(s);
     }
     if (chosen < 0) {
@@ -558,6 +558,17 @@ FrameGraph::TextureState FrameGraph::textureState(TextureHandle h) const {
   const VkImageLayout layout = r.subs->empty() ? r.importLayout : (*r.subs)[0].state.layout;
   return {r.image, r.view, r.textureDesc.format, r.imported ? resolveExtent(h.id) : r.dims.extent,
           layout};
+}
+
+std::vector<std::pair<std::string, FrameGraph::TextureState>> FrameGraph::allocatedTextures()
+    const {
+  std::vector<std::pair<std::string, TextureState>> out;
+  for (uint32_t id = 0; id < resources_.size(); ++id) {
+    const Resource& r = *resources_[id];
+    if (!r.texture || !r.image || r.firstUse < 0) continue;
+    out.emplace_back(r.name, textureState(TextureHandle{id, r.version}));
+  }
+  return out;
 }
 
 std::vector<std::string> FrameGraph::passNames() const {

@@ -410,6 +410,7 @@ struct Renderer::Impl : EffectContext {
     const auto start = std::chrono::steady_clock::now();
     graph.reset();
     graph.setOutputExtent({settings.width, settings.height});
+    graph.setAliasing(settings.aliasTransients);
     sceneGpu->setVertices({});
     enginePasses.clear();
     Blackboard& bb = graph.blackboard();
@@ -675,7 +676,8 @@ struct Renderer::Impl : EffectContext {
     const bool graphChange = resized || next.shadowMapSize != old.shadowMapSize ||
                              next.surfacePoints != old.surfacePoints ||
                              next.surfacePointSeed != old.surfacePointSeed ||
-                             next.view != old.view || next.floorPass != old.floorPass;
+                             next.view != old.view || next.floorPass != old.floorPass ||
+                             next.aliasTransients != old.aliasTransients;
     auto apply = [&](const RenderSettings& s) {
       dropGraph();
       const RenderSettings before = settings;
@@ -807,6 +809,18 @@ void Renderer::setCameraOverride(const std::optional<CameraView>& camera) {
 ImageRGBA32F Renderer::readTarget(const std::string& name) {
   const FrameGraph::TextureState t = impl_->stateOf(name);
   return texelsToFloat(readTexels(impl_->ctx, t), t, name);
+}
+std::vector<Renderer::NamedTexture> Renderer::readAllTextures() {
+  std::vector<NamedTexture> out;
+  for (const auto& [name, state] : impl_->graph.allocatedTextures()) {
+    NamedTexture t{name, state.format, false, {}};
+    if (canDecode(state.format) && state.layout != VK_IMAGE_LAYOUT_UNDEFINED) {
+      t.image = texelsToFloat(readTexels(impl_->ctx, state), state, name);
+      t.decoded = true;
+    }
+    out.push_back(std::move(t));
+  }
+  return out;
 }
 std::vector<std::string> Renderer::viewNames() const {
   // Images only: a buffer (lights, sampling tables) can be neither shown nor read back.

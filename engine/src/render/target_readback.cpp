@@ -32,6 +32,24 @@ std::vector<uint8_t> readTexels(vk::Context& ctx, const FrameGraph::TextureState
   return {p, p + bytes};
 }
 
+bool canDecode(VkFormat format) {
+  switch (format) {
+    case VK_FORMAT_D32_SFLOAT:
+    case VK_FORMAT_R32_SFLOAT:
+    case VK_FORMAT_R32G32_SFLOAT:
+    case VK_FORMAT_R32G32B32A32_SFLOAT:
+    case VK_FORMAT_R16G16B16A16_SFLOAT:
+    case VK_FORMAT_R16G16_SFLOAT:
+    case VK_FORMAT_R16_SFLOAT:
+    case VK_FORMAT_R8_UNORM:
+    case VK_FORMAT_R8G8B8A8_SRGB:
+    case VK_FORMAT_R8G8B8A8_UNORM:
+      return true;
+    default:
+      return false;
+  }
+}
+
 ImageRGBA32F texelsToFloat(const std::vector<uint8_t>& raw, const FrameGraph::TextureState& t,
                            const std::string& name) {
   ImageRGBA32F img;
@@ -53,6 +71,10 @@ ImageRGBA32F texelsToFloat(const std::vector<uint8_t>& raw, const FrameGraph::Te
       case VK_FORMAT_D32_SFLOAT:
       case VK_FORMAT_R32_SFLOAT:
         std::memcpy(&o[0], &raw[i * 4], 4);
+        o[3] = 1.0f;
+        break;
+      case VK_FORMAT_R32G32_SFLOAT:
+        std::memcpy(o, &raw[i * 8], 8);
         o[3] = 1.0f;
         break;
       case VK_FORMAT_R32G32B32A32_SFLOAT:

@@ -187,6 +187,12 @@ class FrameGraph {
   // Frees persistent and fallback textures (and forgets the fallbacks); not while compiled.
   void releasePersistent();
 
+  // Debug: false gives every transient its own memory, so that after execute() each one still
+  // holds its last version (a sweep reads them all back: allocatedTextures()). Takes effect at
+  // the next compile(). Default true (lifetimes that do not overlap share memory).
+  void setAliasing(bool on) { aliasing_ = on; }
+  bool aliasing() const { return aliasing_; }
+
   void compile();
   // Records every kept pass into `cmd` (after compile()); timer may be null. `afterPass`,
   // when given, runs after each pass with the command buffer recorded so far and returns the
@@ -216,6 +222,10 @@ class FrameGraph {
     VkImageLayout layout;  // of mip 0, layer 0
   };
   TextureState textureState(TextureHandle h) const;
+  // Every texture a kept pass of the compiled graph used (transient, persistent, fallback or
+  // imported), in declaration order, with its name and state. With aliasing on, a transient's
+  // memory may hold a later alias's texels after execute(): read them with setAliasing(false).
+  std::vector<std::pair<std::string, TextureState>> allocatedTextures() const;
 
  private:
   friend class PassBuilder;
@@ -248,6 +258,7 @@ class FrameGraph {
   Blackboard blackboard_;
   GraphStats stats_;
   bool compiled_ = false;
+  bool aliasing_ = true;
 };
 
 }  // namespace gi
