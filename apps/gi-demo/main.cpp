@@ -23,6 +23,8 @@ const char* kUsage =
     "  --script FILE          run the steps of FILE (see apps/gi-demo/script.h), then exit\n"
     "  --frames N             exit after N frames (without --script)\n"
     "  --out-dir DIR          where the screenshot key writes (default out)\n"
+    "  --shader-dir DIR       hot reload reads an effect's shader file from DIR when it has one\n"
+    "                         of that name (default: the source tree's file)\n"
     "  --validation           enable Vulkan validation layers (also GI_VALIDATION=1)\n"
     "  --device NAME          pick the Vulkan device by name or index (also GI_DEVICE)\n"
     "keys: WASD walk, Q/E down/up, Shift run, Ctrl creep, right-drag look, P pause, N step,\n"
@@ -75,6 +77,8 @@ demo::AppOptions parseArgs(int argc, char** argv) {
       o.frames = int(number(a, value(), 1, 1e9));
     else if (a == "--out-dir")
       o.outDir = value();
+    else if (a == "--shader-dir")
+      o.shaderDir = value();
     else if (a == "--validation")
       o.context.validation = true;
     else if (a == "--device")
