@@ -3,7 +3,9 @@
 # Builds an effect plugin as a shared module `gi_effect_<name>.so` that the registry loads at
 # run time. Each shader is compiled (and validated) by glslangValidator at build time into a
 # header `<file>.h` (e.g. `ssao.comp.h`) holding `const uint32_t <file_with_underscores>[]`
-# (e.g. `ssao_comp`), so a module is one self-contained file. Shaders may
+# (e.g. `ssao_comp`), so a module is one self-contained file. The header also registers the
+# words with the engine together with the source file's absolute path
+# (gi/vk/shader_overrides.h), so a tool such as gi-demo can hot-reload the GLSL. Shaders may
 # `#include "common.glsl"` (the engine's FrameUniforms and helpers), "environment.glsl"
 # (environment importance sampling) and "lights.glsl" (lights and shadow maps).
 #
@@ -38,6 +40,17 @@ function(gi_add_effect name)
   set(generated ${CMAKE_CURRENT_BINARY_DIR}/${target}_shaders)
   file(GLOB includes ${GI_SHADER_INCLUDE_DIR}/*.glsl)  # a changed include rebuilds the shaders
   set(headers)
+  # Appends the registration to a generated header: the words with their source file, so a
+  # tool can hot-reload them (one registration per translation unit; the engine finds a
+  # shader by its words' content).
+  set(register ${CMAKE_BINARY_DIR}/gi_register_shader.cmake)
+  file(CONFIGURE OUTPUT ${register} CONTENT [=[
+file(APPEND ${HEADER} "
+#include \"gi/vk/shader_overrides.h\"
+static const gi::vk::ShaderRegistration ${VARIABLE}_registration{
+    ${VARIABLE}, sizeof(${VARIABLE}) / sizeof(${VARIABLE}[0]), \"${SOURCE}\", \"${INCLUDE_DIR}\"};
+")
+]=] @ONLY)
   foreach(shader ${EFFECT_SHADERS})
     get_filename_component(file ${shader} NAME)
     get_filename_component(source ${shader} ABSOLUTE)
@@ -47,7 +60,9 @@ function(gi_add_effect name)
       COMMAND ${CMAKE_COMMAND} -E make_directory ${generated}
       COMMAND ${GI_GLSLANG_VALIDATOR} --quiet --target-env vulkan1.3 -I${GI_SHADER_INCLUDE_DIR}
               --vn ${variable} -o ${header} ${source}
-      DEPENDS ${source} ${includes}
+      COMMAND ${CMAKE_COMMAND} -DHEADER=${header} -DVARIABLE=${variable} -DSOURCE=${source}
+              -DINCLUDE_DIR=${GI_SHADER_INCLUDE_DIR} -P ${register}
+      DEPENDS ${source} ${includes} ${register}
       COMMENT "GLSL ${name}/${file}" VERBATIM)
     list(APPEND headers ${header})
   endforeach()

@@ -2,7 +2,8 @@
 // panel and the keys make: a walked camera path gives non-empty screenshots that change as the
 // camera moves; switching an effect and a graph-changing setting changes the executed passes
 // and gives exactly gi-render's headless image of that configuration; repeated resizes leave
-// no validation message and the device memory where it started.
+// no validation message and the device memory where it started; a hot-reloaded shader that
+// breaks, changes and comes back gives the expected images without a crash or a leak.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -330,6 +331,73 @@ TEST(Demo, AccuracyCheckComparesTheFrameWithTheReference) {
   EXPECT_EQ(spp, 16u) << r.output;
   EXPECT_GT(nrmse, 0.0) << r.output;
   EXPECT_LT(nrmse, 0.5) << r.output;
+}
+
+// Hot reload: a copy of ssao.comp in --shader-dir is broken (the compiler's message is reported,
+// the last good pipeline keeps giving the same image), changed to a constant AO of 0.5 (every
+// pixel of the AO view is 128), then restored (the first image again, bit for bit); no
+// validation message, and the device memory comes back to its start value.
+TEST(Demo, HotReloadOfAnEffectShader) {
+  REQUIRE_DEMO();
+  const std::string dir = test::makeTempDir("demo_reload");
+  const std::string shaders = dir + "/shaders";
+  fs::create_directories(shaders);
+  const std::string original = std::string(GI_SOURCE_DIR) + "/effects/ssao/ssao.comp";
+  fs::copy_file(original, shaders + "/ssao.comp");
+  std::string text;
+  {
+    std::ifstream in(original);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    text = ss.str();
+  }
+  std::ofstream(dir + "/broken.comp") << text << "\nthis is not glsl\n";
+  const std::string bounds = "  if (p.x >= size.x || p.y >= size.y) return;\n";
+  const size_t at = text.find(bounds);
+  ASSERT_NE(at, std::string::npos) << "ssao.comp changed: update this test";
+  std::string constant = text;
+  constant.insert(at + bounds.size(),
+                  "  imageStore(outAO, p, vec4(0.5, 0.0, 0.0, 0.0));\n  return;\n");
+  std::ofstream(dir + "/constant.comp") << constant;
+
+  const std::string target = " " + shaders + "/ssao.comp\n";
+  const std::string script = writeScript(
+      dir, "pause on\nframes 2\nprint memory\nscreenshot " + dir + "/a.png\nreload\n" +  //
+               "copy " + dir + "/broken.comp" + target + "reload\nframes 2\nscreenshot " + dir +
+               "/b.png\n" +  //
+               "copy " + dir + "/constant.comp" + target + "reload\nframes 2\nscreenshot " + dir +
+               "/c.png\n" +  //
+               "copy " + original + target + "reload\nframes 2\nscreenshot " + dir +
+               "/d.png\nprint memory\n");
+  auto r = runDemo(" --scene default --effects ssao --set ssao.blur_radius=0 --view ao" + kSize +
+                   " --shader-dir " + shaders + " --script " + script);
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_EQ(r.output.find("validation"), std::string::npos) << r.output;
+  // One line per reload, in order.
+  std::vector<std::string> reloads;
+  std::istringstream lines(r.output);
+  for (std::string line; std::getline(lines, line);)
+    if (line.rfind("reload:", 0) == 0) reloads.push_back(line);
+  ASSERT_EQ(reloads.size(), 4u) << r.output;
+  EXPECT_EQ(reloads[0], "reload: no change");
+  EXPECT_EQ(reloads[1].rfind("reload: error: ", 0), 0u) << reloads[1];
+  EXPECT_NE(reloads[1].find(shaders + "/ssao.comp"), std::string::npos) << reloads[1];
+  EXPECT_NE(reloads[1].find("ERROR"), std::string::npos) << reloads[1];
+  EXPECT_EQ(reloads[2], "reload: 1 shader(s) rebuilt");
+  EXPECT_EQ(reloads[3], "reload: 1 shader(s) rebuilt");
+
+  const ImageRGBA8 a = readPng(dir + "/a.png"), b = readPng(dir + "/b.png"),
+                   c = readPng(dir + "/c.png"), d = readPng(dir + "/d.png");
+  EXPECT_GT(distinctPixels(a), 10u) << "the AO view should not be flat";
+  EXPECT_EQ(a.pixels, b.pixels) << "a compile error must keep the last good pipeline";
+  ASSERT_EQ(c.pixels.size(), size_t(160 * 120 * 4));
+  for (size_t i = 0; i < c.pixels.size(); i += 4)
+    ASSERT_EQ(c.pixels[i], 128) << "pixel " << i / 4 << ": the reloaded shader writes 0.5";
+  EXPECT_EQ(a.pixels, d.pixels) << "the restored shader must give the first image again";
+  const auto memory = listsAfter(r.output, "device memory");
+  ASSERT_EQ(memory.size(), 2u) << r.output;
+  EXPECT_EQ(memory[0], memory[1]) << "device memory must come back to its start value:\n"
+                                  << r.output;
 }
 
 TEST(Demo, BadScriptFailsWithOneLineBeforeAnyWindow) {

@@ -54,6 +54,8 @@ App::App(const AppOptions& o) : options_(o) {
   for (const std::string& w : scene_.warnings)
     std::fprintf(stderr, "gi-demo: warning: %s\n", w.c_str());
   registry_.scanDefaultLocations();
+  // The loaded modules registered their shaders: their texts now are the baseline.
+  watcher_ = std::make_unique<ShaderWatcher>(o.shaderDir);
   if (!o.script.empty()) script_ = loadScript(o.script);
 
   window_ =
@@ -77,10 +79,11 @@ App::App(const AppOptions& o) : options_(o) {
   state_.time = o.time;
   state_.paused = o.paused;
   glfwGetCursorPos(window_->handle(), &lastX_, &lastY_);
-  last_ = std::chrono::steady_clock::now();
+  last_ = lastWatch_ = std::chrono::steady_clock::now();
 }
 
 App::~App() {
+  gi::vk::clearShaderOverrides();
   presenter_.reset();  // the Vulkan backend before ImGui's context
   imgui_.reset();
   preview_.reset();
@@ -151,6 +154,11 @@ void App::frame() {
   const double wallDt = std::min(std::chrono::duration<double>(start - last_).count(), 0.1);
   last_ = start;
   const double dt = script_.empty() ? wallDt : kScriptStep;
+  // Hot reload: the window checks the shaders twice a second (a script only on `reload`).
+  if (script_.empty() && start - lastWatch_ > std::chrono::milliseconds(500)) {
+    lastWatch_ = start;
+    reloadShaders(false);
+  }
   gi::Renderer& renderer = controller_->renderer();
 
   // The renderer follows the window's size.
@@ -295,6 +303,32 @@ void App::startAccuracy(const std::string& effect, uint32_t spp) {
   }
 }
 
+void App::reloadShaders(bool report) {
+  const ShaderWatcher::Result r = watcher_->poll();
+  std::string line;
+  if (!r.error.empty()) {
+    // The last good pipelines keep running; the panel shows the compiler's message.
+    state_.message = "shader reload failed (the previous shaders keep running):\n" + r.error;
+    line = "reload: error: " + r.error;
+  } else if (r.rebuilt.empty()) {
+    line = "reload: no change";
+  } else if (controller_->reloadEffects()) {
+    state_.message = "reloaded " + std::to_string(r.rebuilt.size()) + " shader(s)";
+    line = "reload: " + std::to_string(r.rebuilt.size()) + " shader(s) rebuilt";
+  } else {
+    // Compiled but refused by the pipeline: back to the built-in shaders.
+    const std::string why = controller_->lastError();
+    gi::vk::clearShaderOverrides();
+    controller_->reloadEffects();
+    state_.message = "shader reload failed, back to the built-in shaders:\n" + why;
+    line = "reload: error: " + why;
+  }
+  if (!report && r.error.empty() && r.rebuilt.empty()) return;
+  std::replace(line.begin(), line.end(), '\n', ' ');  // one line
+  std::printf("%s\n", line.c_str());
+  std::fflush(stdout);
+}
+
 void App::printTimings() {
   std::printf(
       "timings: %zu frames at %ux%u, frame %.2f ms (wall, median), GPU passes %.3f ms, UI GPU "
@@ -386,6 +420,11 @@ void App::execute(const ScriptStep& s) {
                           (accuracy_.error().empty() ? state_.message : accuracy_.error()));
     std::printf("accuracy: %s nrmse %.6f pixels %zu spp %u seconds %.2f quantity %s\n",
                 r->effect.c_str(), r->nrmse, r->pixels, r->spp, r->seconds, r->quantity.c_str());
+  } else if (s.verb == "reload") {
+    reloadShaders(true);
+  } else if (s.verb == "copy") {
+    std::filesystem::copy_file(s.args[0], s.args[1],
+                               std::filesystem::copy_options::overwrite_existing);
   } else if (s.verb == "screenshot") {
     screenshot(s.args[0]);
   } else if (s.args[0] == "passes") {

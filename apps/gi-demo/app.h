@@ -16,6 +16,7 @@
 #include "panel.h"
 #include "presenter.h"
 #include "script.h"
+#include "shader_watcher.h"
 #include "window.h"
 
 namespace demo {
@@ -28,6 +29,7 @@ struct AppOptions {
   double time = 0.0;
   bool paused = false;
   std::optional<float> floor;  // default: the lowest point of the scene
+  std::string shaderDir;       // hot reload reads a shader file of this name from here if present
 };
 
 class App {
@@ -48,6 +50,7 @@ class App {
   void resizeWindow(int width, int height);
   void printTimings();
   void startAccuracy(const std::string& effect, uint32_t spp);
+  void reloadShaders(bool report);
 
   AppOptions options_;
   gi::Scene scene_;
@@ -59,6 +62,8 @@ class App {
   std::unique_ptr<Presenter> presenter_;
   std::unique_ptr<FreeCamera> camera_;
   AccuracyCheck accuracy_;
+  std::unique_ptr<ShaderWatcher> watcher_;
+  std::chrono::steady_clock::time_point lastWatch_;
   gi::vk::Image preview_;  // the viewed resource when it is not the output
   FrameStats stats_;
   DemoState state_;

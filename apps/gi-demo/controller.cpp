@@ -109,6 +109,17 @@ bool Controller::setEnabled(const std::string& effect, bool on) {
   });
 }
 
+bool Controller::reloadEffects() {
+  return attempt([&] {
+    // Without its effects the renderer cannot show an effect's output: the view waits outside.
+    const bool away = view_ != gi::resources::kOutput;
+    if (away) renderer_->setView(gi::resources::kOutput);
+    renderer_->setEffects({});
+    renderer_->setEffects(configs());
+    if (away) renderer_->setView(view_);
+  });
+}
+
 const gi::SettingValues& Controller::settings(const std::string& owner) const {
   auto it = values_.find(owner);
   if (it == values_.end())

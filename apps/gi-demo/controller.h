@@ -52,6 +52,9 @@ class Controller {
   const std::string& view() const { return view_; }
   bool setView(const std::string& view);  // a resource, or an effect's name
   bool resize(uint32_t width, uint32_t height);
+  // Re-creates the effects that are on, as switching them off and on does: their pipelines are
+  // built again (from hot-reloaded shaders, gi/vk/shader_overrides.h).
+  bool reloadEffects();
 
   // The image the window shows: the output, or a preview of the viewed resource (RGBA8).
   gi::ImageRGBA8 image();

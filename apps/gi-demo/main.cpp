@@ -23,6 +23,8 @@ const char* kUsage =
     "  --script FILE          run the steps of FILE (see apps/gi-demo/script.h), then exit\n"
     "  --frames N             exit after N frames (without --script)\n"
     "  --out-dir DIR          where the screenshot key writes (default out)\n"
+    "  --shader-dir DIR       hot reload reads an effect's shader file from DIR when it has one\n"
+    "                         of that name (default: the source tree's file)\n"
     "  --validation           enable Vulkan validation layers (also GI_VALIDATION=1)\n"
     "  --device NAME          pick the Vulkan device by name or index (also GI_DEVICE)\n"
     "keys: WASD walk, Q/E down/up, Shift run, Ctrl creep, right-drag look, P pause, N step,\n"
@@ -61,6 +63,8 @@ demo::AppOptions parseArgs(int argc, char** argv) {
       o.frames = int(a.integer(1, 1000000000));
     else if (a.is("--out-dir"))
       o.outDir = a.value();
+    else if (a.is("--shader-dir"))
+      o.shaderDir = a.value();
     else if (a.is("--validation"))
       o.context.validation = true;
     else if (a.is("--device"))

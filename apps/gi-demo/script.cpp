@@ -16,9 +16,9 @@ namespace {
 
 // Verb -> argument count (-1: one or more).
 const std::map<std::string, int> kVerbs = {
-    {"frames", 1}, {"key", 2},      {"look", 2}, {"camera", 5},     {"effect", 2},
-    {"set", 1},    {"preset", 1},   {"view", 1}, {"resize", 2},     {"pause", 1},
-    {"step", 0},   {"accuracy", 2}, {"time", 1}, {"screenshot", 1}, {"print", 1}};
+    {"frames", 1}, {"key", 2},        {"look", 2},   {"camera", 5}, {"effect", 2}, {"set", 1},
+    {"preset", 1}, {"view", 1},       {"resize", 2}, {"pause", 1},  {"step", 0},   {"accuracy", 2},
+    {"time", 1},   {"screenshot", 1}, {"print", 1},  {"reload", 0}, {"copy", 2}};
 
 [[noreturn]] void fail(const std::string& path, int line, const std::string& what) {
   throw gi::Error(gi::ErrorKind::Parse, path, "line " + std::to_string(line) + ": " + what);

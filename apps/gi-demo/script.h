@@ -16,6 +16,10 @@
 //                            samples per pixel; waits) and print its NRMSE
 //   screenshot PATH          write the rendered image (without the panel) as PNG
 //   print passes|views|timings|memory|camera   print to stdout (views: what `view` takes)
+//   copy FROM TO             copy a file (e.g. an edited shader into --shader-dir)
+//   reload                   check the effects' GLSL now (hot reload; the window checks every
+//                            0.5 s) and print one line: "reload: N shader(s) rebuilt", or
+//                            "reload: no change", or "reload: error: <compiler message>"
 #pragma once
 
 #include <string>

@@ -3,11 +3,14 @@
 #include <utility>
 
 #include "gi/vk/common.h"
+#include "gi/vk/shader_overrides.h"
 
 namespace gi::vk {
 
 namespace {
-VkShaderModule createModule(VkDevice device, const std::vector<uint32_t>& code) {
+// Builds from a hot-reloaded override when `spirv` is a registered effect shader that has one.
+VkShaderModule createModule(VkDevice device, const std::vector<uint32_t>& spirv) {
+  const std::vector<uint32_t> code = resolveShader(spirv);
   VkShaderModuleCreateInfo info{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
   info.codeSize = code.size() * 4;
   info.pCode = code.data();
