@@ -193,6 +193,10 @@ TEST_F(FrameGraphTest, AliasesMemoryAndProducesCorrectPixels) {
   g.compile();
   EXPECT_EQ(g.stats().transientTextures, 3u);
   EXPECT_LT(g.stats().transientBytesAllocated, g.stats().transientBytesRequested) << g.describe();
+  // t3 took over t1's memory after t1's last read: t1 cannot be read after the frame.
+  EXPECT_FALSE(g.intactAtEnd(t1)) << g.describe();
+  EXPECT_TRUE(g.intactAtEnd(t3));
+  EXPECT_TRUE(g.intactAtEnd(out));  // imported
 
   vk::DescriptorArena arena(ctx());
   vk::GpuTimer timer(ctx());
@@ -218,6 +222,37 @@ TEST_F(FrameGraphTest, AliasesMemoryAndProducesCorrectPixels) {
 // may take its memory. t3's first write must then wait for t1's writes and make them available
 // (a write-after-write on aliased memory): synchronization validation, on in these tests, checks
 // the barrier carries the earlier occupant's write access, not only its stages.
+// A texture marked as an output keeps its memory to the end of the frame, even when a later
+// transient could otherwise have reused it.
+TEST_F(FrameGraphTest, OutputsAreNotAliasedByLaterPasses) {
+  const VkExtent2D size{32, 16};
+  FrameGraph g(ctx(), size);
+  TextureHandle t1, t2, t3;
+  g.addPass(
+      "clear_t1",
+      [&](PassBuilder& pb) { t1 = pb.write(pb.create("t1", rgba8()), TextureUsage::TransferDst); },
+      [&](PassContext& pc) { clearTo(pc, t1, 0.25f); });
+  g.addPass(
+      "t1_to_t2",
+      [&](PassBuilder& pb) {
+        pb.read(t1, TextureUsage::TransferSrc);
+        t2 = pb.write(pb.create("t2", rgba8()), TextureUsage::TransferDst);
+      },
+      [&](PassContext& pc) { copyImage(pc, t1, t2); });
+  g.addPass(
+      "t2_to_t3",
+      [&](PassBuilder& pb) {
+        pb.read(t2, TextureUsage::TransferSrc);
+        t3 = pb.write(pb.create("t3", rgba8()), TextureUsage::TransferDst);
+      },
+      [&](PassContext& pc) { copyImage(pc, t2, t3); });
+  g.markOutput(t3);
+  g.markOutput(t1);  // read after the frame too
+  g.compile();
+  EXPECT_TRUE(g.intactAtEnd(t1)) << g.describe();
+  EXPECT_TRUE(g.intactAtEnd(t3)) << g.describe();
+}
+
 TEST_F(FrameGraphTest, AliasedFirstWriteWaitsForTheEarlierOccupantsWrites) {
   const VkExtent2D size{32, 16};
   FrameGraph g(ctx(), size);

@@ -1245,7 +1245,7 @@ int runHardCaseSweep(const Options& o) {
         failed += !r.problems.empty();
         nonFinite += r.nonFinite;
       });
-  gi::bench::writeFileAtomic((fs::path(o.out) / "hard_cases.csv").string(), csv);
+  gi::cli::writeFileAtomic((fs::path(o.out) / "hard_cases.csv").string(), csv);
   std::printf("%zu runs (%zu cases x %zu effect sets), %d failed, %zu NaN/Inf values -> %s\n",
               runs.size(), hc.cases.empty() ? gi::bench::hardCases().size() : hc.cases.size(),
               runs.size() / std::max<size_t>(1, hc.cases.empty() ? gi::bench::hardCases().size()

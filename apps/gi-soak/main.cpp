@@ -49,45 +49,31 @@ struct Options {
   bool validation = false;
 };
 
-[[noreturn]] void usageError(const std::string& where, const std::string& message) {
-  throw gi::Error(gi::ErrorKind::Usage, where, message + " (see gi-soak --help)");
-}
-
-double number(const std::string& flag, const char* text, double lo, double hi) {
-  if (const auto v = gi::cli::numberIn(text, lo, hi)) return *v;
-  usageError(flag, gi::cli::rangeMessage(text, lo, hi));
-}
-
 Options parseArgs(int argc, char** argv) {
   Options o;
   o.validation = gi::vk::ContextOptions::fromEnvironment().validation;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto value = [&]() -> const char* {
-      if (i + 1 >= argc) usageError(a, "needs a value");
-      return argv[++i];
-    };
-    if (a == "--help" || a == "-h") {
+  for (gi::cli::Args a("gi-soak", argc, argv); a.next();) {
+    if (a.is("--help") || a.is("-h")) {
       std::fputs(kUsage, stdout);
       std::exit(0);
-    } else if (a == "--scene")
-      o.scene = value();
-    else if (a == "--frames")
-      o.frames = int(number(a, value(), 1, 1e8));
-    else if (a == "--cycles")
-      o.cycles = int(number(a, value(), 0, 1e6));
-    else if (a == "--every")
-      o.every = int(number(a, value(), 1, 1e8));
-    else if (a == "--width")
-      o.width = uint32_t(number(a, value(), 1, 16384));
-    else if (a == "--height")
-      o.height = uint32_t(number(a, value(), 1, 16384));
-    else if (a == "--rss-tolerance-kib")
-      o.rssToleranceKiB = number(a, value(), 0, 1e9);
-    else if (a == "--validation")
+    } else if (a.is("--scene"))
+      o.scene = a.value();
+    else if (a.is("--frames"))
+      o.frames = int(a.integer(1, 100000000));
+    else if (a.is("--cycles"))
+      o.cycles = int(a.integer(0, 1000000));
+    else if (a.is("--every"))
+      o.every = int(a.integer(1, 100000000));
+    else if (a.is("--width"))
+      o.width = uint32_t(a.integer(1, 16384));
+    else if (a.is("--height"))
+      o.height = uint32_t(a.integer(1, 16384));
+    else if (a.is("--rss-tolerance-kib"))
+      o.rssToleranceKiB = a.number(0, 1e9);
+    else if (a.is("--validation"))
       o.validation = true;
     else
-      usageError("", "unknown argument '" + a + "'");
+      a.unknown();
   }
   if (o.every == 0) o.every = std::max(1, o.frames / 50);
   return o;

@@ -51,7 +51,9 @@ ImageRGBA8 readPng(const std::string& path) {
   std::unique_ptr<stbi_uc, decltype(&stbi_image_free)> data(
       stbi_load(path.c_str(), &img.width, &img.height, &channels, 4), &stbi_image_free);
   if (!data)
-    throw Error(ErrorKind::Parse, path, std::string("cannot read image: ") + stbi_failure_reason());
+    throw Error(ErrorKind::Parse, path,
+                std::string("cannot read image: ") +
+                    (stbi_failure_reason() ? stbi_failure_reason() : "unknown image error"));
   img.pixels.assign(data.get(), data.get() + size_t(img.width) * img.height * 4);
   return img;
 }

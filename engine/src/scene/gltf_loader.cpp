@@ -794,7 +794,9 @@ class GltfLoader {
                                             &height, &channels, 4);
     if (!pixels)
       fail(ErrorKind::InvalidData,
-           what + ": " + label + " cannot be decoded: " + stbi_failure_reason());
+           what + ": " + label + " cannot be decoded: " +
+               // stb may fail without a reason (null: found by fuzzing)
+               (stbi_failure_reason() ? stbi_failure_reason() : "unknown image error"));
     Texture tex;
     tex.name = !image.name.empty() ? image.name : external ? image.uri : label;
     tex.width = width;
