@@ -372,6 +372,36 @@ TEST_F(IsmTest, CornellBoxBouncesIncreaseMonotonicallyAndConverge) {
 }
 
 // The frame graph runs ISM passes only when the scene asks for the effect.
+// The atlas debug view (distances, 0 = hole) is built only when it is the view, in both modes.
+TEST_F(IsmTest, AtlasViewRunsOnlyWhenViewed) {
+  const Scene s = panelScene();
+  auto has = [](const std::vector<std::string>& v, const char* p) {
+    return std::find(v.begin(), v.end(), p) != v.end();
+  };
+  EXPECT_FALSE(has(render(s, {"ism.vpls=16"}).passes, "ism_atlas_view"));
+  for (const char* mode : {"ism", "classic"}) {
+    EffectOverrides cli;
+    cli.effects = {"ism"};
+    cli.sets = {"ism.vpls=16", std::string("ism.mode=") + mode};
+    RenderSettings rs;
+    rs.width = kW;
+    rs.height = kH;
+    rs.view = "ism_atlas";
+    rs.effects = resolveEffects(s, nullptr, cli, registry);
+    Renderer r(ctx(), s, rs, &registry);
+    r.renderFrame();
+    r.renderFrame();  // classic mode places its maps from the previous frame's VPLs
+    EXPECT_TRUE(has(r.passNames(), "ism_atlas_view")) << mode;
+    const ImageRGBA32F atlas = r.readTarget("ism_atlas");
+    size_t filled = 0;
+    for (size_t i = 0; i < atlas.pixels.size(); i += 4) {
+      ASSERT_TRUE(std::isfinite(atlas.pixels[i]) && atlas.pixels[i] >= 0.0f) << mode;
+      filled += atlas.pixels[i] > 0.0f;
+    }
+    EXPECT_GT(filled, atlas.pixels.size() / 4 / 20) << mode << ": the 16 maps hold distances";
+  }
+}
+
 TEST_F(IsmTest, NoIsmPassWithoutTheEffect) {
   const Scene s = panelScene();
   for (const std::string& p : render(s, {}, 1, false).passes)

@@ -18,10 +18,12 @@
 #include "gi/lights.h"
 #include "gi/vk/pipeline.h"
 #include "gi/vk/resources.h"
+#include "ism_atlas_view.comp.h"
 #include "ism_blur_x.comp.h"
 #include "ism_blur_y.comp.h"
 #include "ism_bounce.comp.h"
 #include "ism_bounce_classic.comp.h"
+#include "ism_classic_atlas_view.comp.h"
 #include "ism_clear.comp.h"
 #include "ism_gather.comp.h"
 #include "ism_gather_classic.comp.h"
@@ -39,6 +41,8 @@ constexpr VkFormat kRawFormat = VK_FORMAT_R32G32B32A32_UINT;
 constexpr VkFormat kAtlasFormat = VK_FORMAT_R32_UINT;
 constexpr VkFormat kOutFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 constexpr uint32_t kGroupX = 32, kGroupY = 16;
+// Debug view of the shadow-map atlas (distances, R32F); its pass runs only when it is viewed.
+constexpr const char* kAtlasView = "ism_atlas";
 constexpr VkDeviceSize kVplBytes = 3 * sizeof(glm::vec4);
 
 int floorPow2(int v) {
@@ -74,7 +78,7 @@ class IsmEffect : public gi::Effect {
         "gathering, geometry-aware blur; 1 to 3 diffuse bounces";
     i.stage = gi::EffectStage::BeforeLighting;
     i.reads = {res::kDepth, res::kNormal, res::kAlbedo, res::kMaterial, res::kSurfacePoints};
-    i.writes = {res::kIndirect};
+    i.writes = {res::kIndirect, kAtlasView};
     i.debugView = res::kIndirect;
     i.estimates = gi::GroundTruth::IndirectLight;
     return i;
@@ -201,6 +205,14 @@ class IsmEffect : public gi::Effect {
               : gi::vk::Pipeline::compute(
                     vk, spv(std::begin(ism_bounce_comp), std::end(ism_bounce_comp)), bounceBindings,
                     sizeof(int32_t), bounceSpec);
+    atlasView_ = c.classic
+                     ? gi::vk::Pipeline::compute(vk,
+                                                 spv(std::begin(ism_classic_atlas_view_comp),
+                                                     std::end(ism_classic_atlas_view_comp)),
+                                                 {{0, tex}, {1, img}})
+                     : gi::vk::Pipeline::compute(
+                           vk, spv(std::begin(ism_atlas_view_comp), std::end(ism_atlas_view_comp)),
+                           {{0, tex}, {1, img}});
     const std::vector<uint32_t> gatherSpec = {uint32_t(c.perPixel), uint32_t(c.block)};
     const std::vector<gi::vk::Binding> gatherBindings = {{0, ubo}, {1, ubo}, {2, ubo}, {3, tex},
                                                          {4, tex}, {5, tex}, {6, img}};
@@ -237,7 +249,7 @@ class IsmEffect : public gi::Effect {
                  const gi::SettingValues& settings) override {
     struct Io {
       gi::TextureHandle rsmDepth, rsmPos, rsmNormal, rsmFlux, atlas, depth, normal, albedo,
-          material, raw, half, indirect;
+          material, raw, half, indirect, atlasView;
       gi::BufferHandle cdf, vpls, points, shade;
     };
     auto io = std::make_shared<Io>();
@@ -348,6 +360,9 @@ class IsmEffect : public gi::Effect {
           "ism_classic_sm",
           [&](gi::PassBuilder& b) {
             ctx.scene().declareRead(b);
+            // Its views come from the VPLs (last frame's, read on the host): keeps the VPL pass
+            // alive when only the atlas is needed (its debug view).
+            io->vpls = b.read(io->vpls, gi::BufferUsage::Uniform);
             io->atlas =
                 b.write(b.create("ism_classic_atlas",
                                  absolute(gi::kSceneDepthFormat, c.atlasWidth(), c.atlasHeight())),
@@ -357,6 +372,23 @@ class IsmEffect : public gi::Effect {
       if (c.bounces > 1) io->points = graph.blackboard().buffer(res::kSurfacePoints);
       for (int bounce = 1; bounce < c.bounces; ++bounce) addBounce(graph, ctx, io, bounce);
     }
+
+    // The atlas as a debug view (culled unless viewed).
+    graph.addPass(
+        "ism_atlas_view",
+        [&](gi::PassBuilder& b) {
+          io->atlas = b.read(io->atlas, gi::TextureUsage::Sampled, gi::Subresource::mipLevel(0));
+          io->atlasView = b.write(
+              b.create(kAtlasView, absolute(VK_FORMAT_R32_SFLOAT, c.atlasWidth(), c.atlasHeight())),
+              gi::TextureUsage::StorageWrite);
+        },
+        [this, io, nearest](gi::PassContext& pc) {
+          gi::vk::DescriptorWriter w;
+          w.sampled(0, pc.view(io->atlas, gi::Subresource::mipLevel(0)), nearest)
+              .storageImage(1, pc.view(io->atlasView));
+          pc.dispatch(atlasView_, w, pc.extent(io->atlasView), kGroupX, kGroupY);
+        });
+    bb.put(kAtlasView, io->atlasView);
 
     // 4. Interleaved gathering.
     graph.addPass(
@@ -612,7 +644,7 @@ class IsmEffect : public gi::Effect {
   }
 
   Config cfg_;
-  gi::vk::Pipeline vpl_, clear_, splat_, bounce_, gather_, blurX_, blurY_;
+  gi::vk::Pipeline vpl_, clear_, splat_, bounce_, gather_, blurX_, blurY_, atlasView_;
   VkSampler nearest_ = VK_NULL_HANDLE;
   std::array<gi::vk::Pipeline, 2> pullPush_;
   gi::vk::Buffer uniforms_, vplBuffer_;
