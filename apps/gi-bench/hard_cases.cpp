@@ -98,6 +98,24 @@ Scene corner(float scale, glm::vec3 albedo = glm::vec3(0.8f), float znear = 0.05
                   zfar * scale);
 }
 
+// The corner lit only by a spot light pointing away from every surface: its reflective shadow
+// map is black (an empty CDF for VPL sampling) and its shadow map empty.
+Scene lightFacingAway() {
+  Builder b;
+  b.quad(kFloor, 20.0f);
+  b.quad(kWall, 20.0f);
+  Light l;
+  l.type = LightType::Spot;
+  l.intensity = 50.0f;
+  l.outerConeAngle = glm::radians(20.0f);
+  b.s.lights.push_back(l);
+  // Up and away from the wall (x = 0): every ray of the 20-degree cone climbs and leaves it.
+  const glm::vec3 at(1, 1, 0), dir = glm::normalize(glm::vec3(1, 1, 0));
+  b.s.nodes[b.s.addNode("spot", glm::inverse(glm::lookAt(at, at + dir, glm::vec3(0, 0, 1))))]
+      .light = 0;
+  return b.camera(glm::vec3(2.5f, 1.6f, 0.0f), glm::vec3(0.0f));
+}
+
 // Six inward-facing quads around the origin (a closed box of half size 1), white, a point light
 // inside: no sky is visible and every direction is occluded at a finite distance.
 Scene closedBox() {
@@ -259,6 +277,8 @@ std::vector<HardCase> hardCases() {
       {"scale_1e-3", "the corner at scale 1e-3 (lengthScale 1e-3)", [] { return corner(1e-3f); }},
       {"scale_1e4", "the corner at scale 1e4 (lengthScale 1e4)", [] { return corner(1e4f); }},
       {"sky_only", "nothing but sky in the view", skyOnly},
+      {"light_facing_away", "the only light points into the sky: a black RSM, no VPL flux",
+       lightFacingAway},
       {"degenerate_skin", "zero weights, weights off 1, a joint scaled to 0", degenerateSkin},
       {"zero_area_triangles", "triangles that are points and lines", zeroAreaTriangles},
       {"zero_normals", "vertex normals of length 0", zeroNormals},
