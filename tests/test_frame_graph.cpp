@@ -156,6 +156,34 @@ vk::Image transferImage(vk::Context& ctx, VkExtent2D size) {
   return vk::Image(ctx, d);
 }
 
+// Three transients in a chain: t1 cleared to 0.25, copied to t2, copied to t3. t1 and t3
+// do not overlap in time, so t3 may take t1's memory.
+struct CopyChain {
+  TextureHandle t1, t2, t3;
+  explicit CopyChain(FrameGraph& g) {
+    g.addPass(
+        "clear_t1",
+        [&](PassBuilder& pb) {
+          t1 = pb.write(pb.create("t1", rgba8()), TextureUsage::TransferDst);
+        },
+        [this](PassContext& pc) { clearTo(pc, t1, 0.25f); });
+    g.addPass(
+        "t1_to_t2",
+        [&](PassBuilder& pb) {
+          pb.read(t1, TextureUsage::TransferSrc);
+          t2 = pb.write(pb.create("t2", rgba8()), TextureUsage::TransferDst);
+        },
+        [this](PassContext& pc) { copyImage(pc, t1, t2); });
+    g.addPass(
+        "t2_to_t3",
+        [&](PassBuilder& pb) {
+          pb.read(t2, TextureUsage::TransferSrc);
+          t3 = pb.write(pb.create("t3", rgba8()), TextureUsage::TransferDst);
+        },
+        [this](PassContext& pc) { copyImage(pc, t2, t3); });
+  }
+};
+
 TEST_F(FrameGraphTest, AliasesMemoryAndProducesCorrectPixels) {
   const VkExtent2D size{32, 16};
   FrameGraph g(ctx(), size);
@@ -163,25 +191,8 @@ TEST_F(FrameGraphTest, AliasesMemoryAndProducesCorrectPixels) {
   TextureHandle out =
       g.importTexture("output", outImage.handle(), outImage.view(), rgba8(),
                       VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
-  TextureHandle t1, t2, t3;
-  g.addPass(
-      "clear_t1",
-      [&](PassBuilder& pb) { t1 = pb.write(pb.create("t1", rgba8()), TextureUsage::TransferDst); },
-      [&](PassContext& pc) { clearTo(pc, t1, 0.25f); });
-  g.addPass(
-      "t1_to_t2",
-      [&](PassBuilder& pb) {
-        pb.read(t1, TextureUsage::TransferSrc);
-        t2 = pb.write(pb.create("t2", rgba8()), TextureUsage::TransferDst);
-      },
-      [&](PassContext& pc) { copyImage(pc, t1, t2); });
-  g.addPass(
-      "t2_to_t3",
-      [&](PassBuilder& pb) {
-        pb.read(t2, TextureUsage::TransferSrc);
-        t3 = pb.write(pb.create("t3", rgba8()), TextureUsage::TransferDst);
-      },
-      [&](PassContext& pc) { copyImage(pc, t2, t3); });
+  CopyChain chain(g);
+  TextureHandle &t1 = chain.t1, &t3 = chain.t3;
   g.addPass(
       "t3_to_output",
       [&](PassBuilder& pb) {
@@ -227,25 +238,8 @@ TEST_F(FrameGraphTest, AliasesMemoryAndProducesCorrectPixels) {
 TEST_F(FrameGraphTest, OutputsAreNotAliasedByLaterPasses) {
   const VkExtent2D size{32, 16};
   FrameGraph g(ctx(), size);
-  TextureHandle t1, t2, t3;
-  g.addPass(
-      "clear_t1",
-      [&](PassBuilder& pb) { t1 = pb.write(pb.create("t1", rgba8()), TextureUsage::TransferDst); },
-      [&](PassContext& pc) { clearTo(pc, t1, 0.25f); });
-  g.addPass(
-      "t1_to_t2",
-      [&](PassBuilder& pb) {
-        pb.read(t1, TextureUsage::TransferSrc);
-        t2 = pb.write(pb.create("t2", rgba8()), TextureUsage::TransferDst);
-      },
-      [&](PassContext& pc) { copyImage(pc, t1, t2); });
-  g.addPass(
-      "t2_to_t3",
-      [&](PassBuilder& pb) {
-        pb.read(t2, TextureUsage::TransferSrc);
-        t3 = pb.write(pb.create("t3", rgba8()), TextureUsage::TransferDst);
-      },
-      [&](PassContext& pc) { copyImage(pc, t2, t3); });
+  CopyChain chain(g);
+  TextureHandle &t1 = chain.t1, &t3 = chain.t3;
   g.markOutput(t3);
   g.markOutput(t1);  // read after the frame too
   g.compile();

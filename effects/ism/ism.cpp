@@ -438,7 +438,7 @@ class IsmEffect : public gi::Effect {
               .sampled(2, pc.view(io->raw), nearest)
               .storageImage(3, pc.view(io->half));
           pc.dispatch(blurX_, x, e, kGroupX, kGroupY);
-          imageBarrier(pc.cmd(), pc.image(io->half));
+          gi::vk::storageWriteToSampledRead(pc.cmd(), pc.image(io->half));
           gi::vk::DescriptorWriter y;
           y.buffer(0, ubo, frame)
               .buffer(1, ubo, params)
@@ -625,22 +625,6 @@ class IsmEffect : public gi::Effect {
     t.extent = pc.extent(io.atlas);
     t.clear = true;
     ctx.scene().drawDepth(pc, t, views);
-  }
-
-  // Compute write -> compute sampled read of a storage image that stays in GENERAL.
-  static void imageBarrier(VkCommandBuffer cmd, VkImage image) {
-    VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
-    b.srcStageMask = b.dstStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
-    b.srcAccessMask = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
-    b.dstAccessMask = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT;
-    b.oldLayout = b.newLayout = VK_IMAGE_LAYOUT_GENERAL;
-    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-    b.image = image;
-    b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-    VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-    dep.imageMemoryBarrierCount = 1;
-    dep.pImageMemoryBarriers = &b;
-    vkCmdPipelineBarrier2(cmd, &dep);
   }
 
   Config cfg_;

@@ -394,7 +394,7 @@ class SsdoEffect : public gi::Effect {
                 .storageImage(3, pc.view(io->half));
             pc.dispatch(blurX_, w, e, kGroupX, kGroupY);
             // The y dispatch reads what the x dispatch wrote (the image stays GENERAL).
-            imageBarrier(pc.cmd(), pc.image(io->half));
+            gi::vk::storageWriteToSampledRead(pc.cmd(), pc.image(io->half));
             in = pc.view(io->half);
             inLayout = VK_IMAGE_LAYOUT_GENERAL;
           }
@@ -531,22 +531,6 @@ class SsdoEffect : public gi::Effect {
         gi::ssdo::makeUniforms(key[0], int(key[1]), int(key[2]), key[3], key[4]);
     uniforms_.write(&u, sizeof u);
     uploaded_ = key;
-  }
-
-  // Compute write -> compute sampled read of a storage image that stays in GENERAL.
-  static void imageBarrier(VkCommandBuffer cmd, VkImage image) {
-    VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
-    b.srcStageMask = b.dstStageMask = VK_PIPELINE_STAGE_2_COMPUTE_SHADER_BIT;
-    b.srcAccessMask = VK_ACCESS_2_SHADER_STORAGE_WRITE_BIT;
-    b.dstAccessMask = VK_ACCESS_2_SHADER_SAMPLED_READ_BIT;
-    b.oldLayout = b.newLayout = VK_IMAGE_LAYOUT_GENERAL;
-    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-    b.image = image;
-    b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-    VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-    dep.imageMemoryBarrierCount = 1;
-    dep.pImageMemoryBarriers = &b;
-    vkCmdPipelineBarrier2(cmd, &dep);
   }
 
   gi::vk::Pipeline surface_, cameraSurface_, ssdo_, blurX_, resolve_, contactPipeline_;
