@@ -433,6 +433,16 @@ std::string splitSection(const std::vector<Row>& rows) {
   return o.str();
 }
 
+// "0.58-1.66": the floor pass's medians over the rows (how much the cost unit itself varied).
+std::string floorRange(const std::vector<Row>& rows) {
+  double lo = INFINITY, hi = 0.0;
+  for (const Row& r : rows) {
+    lo = std::min(lo, r.floorMs);
+    hi = std::max(hi, r.floorMs);
+  }
+  return rows.empty() ? std::string("-") : fmt(lo, 3) + "-" + fmt(hi, 3);
+}
+
 // Rows whose declared quantity is not their target: how much of the error against the target
 // is the declared quantity's own distance from it (no estimator can remove that part).
 std::string gapSection(const std::vector<Row>& rows) {
@@ -523,8 +533,12 @@ std::string markdown(const std::vector<Row>& rows, const RunInfo& info,
     << (rows.empty() ? std::string("-") : percent(rows.front().totalCi.coverage))
     << ": 95% needs at least 6 repetitions, fewer give [min, max]). *total* sums the "
        "frame's passes (the floor pass excluded), *effect* the passes that are not the engine's, "
-       "and *x floor* divides them by the floor pass (a fixed full-screen pass measured in the "
-       "same frame: a device-independent cost unit). NRMSE (RMSE / mean of the reference) and "
+       "and *x floor* divides them by the floor pass (a fixed full-screen pass, one fetch and "
+       "one store per pixel, measured in the same frame: a unit of this device's full-screen "
+       "cost, not a portable one; its own median ranged "
+    << floorRange(rows)
+    << " ms across this run's configurations for identical work). NRMSE (RMSE / mean of the "
+       "reference) and "
        "SSIM compare the effect's output with CPU ray-traced references over the pixels that "
        "show geometry in both, twice: against the *target* (the physically meaningful quantity: "
        "AO of the effect's radius for AO-like effects, direct + indirect light for GI effects) "
