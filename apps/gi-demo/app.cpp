@@ -14,6 +14,7 @@
 #include "gi/errors.h"
 #include "gi/image_io.h"
 #include "gi/scene_io.h"
+#include "median.h"
 
 namespace demo {
 
@@ -25,11 +26,7 @@ double ms(std::chrono::steady_clock::duration d) {
   return std::chrono::duration<double, std::milli>(d).count();
 }
 
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
+using gi::cli::median;
 
 }  // namespace
 

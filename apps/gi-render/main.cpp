@@ -24,6 +24,7 @@
 #include "gi/scene_io.h"
 #include "gi/vk/context.h"
 #include "gi/vk/swapchain.h"
+#include "median.h"
 #include "window.h"
 
 namespace {
@@ -238,9 +239,7 @@ int run(const Options& o) {
     std::printf("%-12s %12s\n", "pass", "median ms");
     double total = 0;
     for (const std::string& name : renderer.passNames()) {
-      std::vector<double> v = samples[name];
-      std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-      double median = v[v.size() / 2];
+      const double median = gi::cli::median(samples[name]);
       total += median;
       std::printf("%-12s %12.3f\n", name.c_str(), median);
     }
