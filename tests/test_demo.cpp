@@ -6,6 +6,8 @@
 // breaks, changes and comes back gives the expected images without a crash or a leak.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
+
 #include <array>
 #include <filesystem>
 #include <fstream>
@@ -39,9 +41,22 @@ std::string writeScript(const std::string& dir, const std::string& text) {
   return path;
 }
 
+// gi-demo's own exit status, reported from inside the virtual X session: xvfb-run replaces it
+// with its own when it fails to clean up its temporary folder (seen under parallel tests).
 test::ProcessResult runDemo(const std::string& args) {
-  return test::runCommand("xvfb-run -a -s '-screen 0 640x480x24' " + test::binPath("gi-demo") +
-                          " --validation" + args);
+  const std::string marker = "[gi-demo exit ";
+  test::ProcessResult r =
+      test::runCommand("xvfb-run -a -s '-screen 0 640x480x24' sh -c '\"$0\" \"$@\"; echo \"" +
+                       marker + "$?]\"' " + test::binPath("gi-demo") + " --validation" + args);
+  const size_t at = r.output.rfind(marker);
+  if (at == std::string::npos) return r;  // xvfb-run itself failed: keep its status
+  r.exitCode = std::atoi(r.output.c_str() + at + marker.size());
+  const size_t end = r.output.find('\n', at);
+  r.output.erase(at, end == std::string::npos ? std::string::npos : end + 1 - at);
+  const std::string cleanup = "xvfb-run: error: problem while cleaning up temporary directory\n";
+  if (const size_t c = r.output.find(cleanup); c != std::string::npos)
+    r.output.erase(c, cleanup.size());
+  return r;
 }
 
 // The words after "<key>:" on each line starting with it, one set per line.
