@@ -6,6 +6,7 @@
 
 #include "gi/engine_settings.h"
 #include "gi/errors.h"
+#include "preview.h"
 
 namespace demo {
 
@@ -16,20 +17,6 @@ std::string effectView(const gi::EffectRegistry& registry, const std::string& vi
 }
 
 }  // namespace
-
-gi::ImageRGBA8 previewOf(const gi::ImageRGBA32F& img, const std::string& view) {
-  // Normals and motion are signed; depth and AO are one channel shown as grey.
-  const bool signedData = view == gi::resources::kNormal || view == gi::resources::kMotion;
-  const bool grey = view == gi::resources::kDepth || view == gi::resources::kAO;
-  gi::ImageRGBA8 out{img.width, img.height, std::vector<uint8_t>(img.pixels.size())};
-  for (size_t i = 0; i < img.pixels.size(); ++i) {
-    float v = grey ? img.pixels[i - i % 4] : img.pixels[i];
-    if (signedData) v = v * 0.5f + 0.5f;
-    if (i % 4 == 3 || !std::isfinite(v)) v = i % 4 == 3 ? 1.0f : 0.0f;
-    out.pixels[i] = uint8_t(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f));
-  }
-  return out;
-}
 
 Controller::Controller(gi::vk::Context& ctx, const gi::Scene& scene,
                        const gi::EffectRegistry& registry, const ControllerOptions& options)
@@ -218,7 +205,7 @@ bool Controller::resize(uint32_t width, uint32_t height) {
 
 gi::ImageRGBA8 Controller::image() {
   if (view_ == gi::resources::kOutput) return renderer_->readOutput();
-  return previewOf(renderer_->readTarget(view_), view_);
+  return gi::app::previewOf(renderer_->readTarget(view_), view_);
 }
 
 }  // namespace demo

@@ -76,7 +76,4 @@ class Controller {
   std::optional<gi::Renderer> renderer_;
 };
 
-// Float resource -> 8-bit preview (as gi-render writes a --view PNG).
-gi::ImageRGBA8 previewOf(const gi::ImageRGBA32F& image, const std::string& view);
-
 }  // namespace demo

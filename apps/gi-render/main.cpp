@@ -25,6 +25,7 @@
 #include "gi/vk/context.h"
 #include "gi/vk/swapchain.h"
 #include "median.h"
+#include "preview.h"
 #include "window.h"
 
 namespace {
@@ -130,21 +131,6 @@ Options parseArgs(int argc, char** argv) {
   return o;
 }
 
-// Float target -> 8-bit preview (values clamped to [0,1]; normals/motion shifted to be visible,
-// depth and single-channel targets shown as grey).
-gi::ImageRGBA8 toPreview(const gi::ImageRGBA32F& img, const std::string& view) {
-  const bool signedData = view == gi::resources::kNormal || view == gi::resources::kMotion;
-  const bool grey = view == gi::resources::kDepth || view == gi::resources::kAO;
-  gi::ImageRGBA8 out{img.width, img.height, std::vector<uint8_t>(img.pixels.size())};
-  for (size_t i = 0; i < img.pixels.size(); ++i) {
-    float v = grey ? img.pixels[i - i % 4] : img.pixels[i];
-    if (signedData) v = v * 0.5f + 0.5f;
-    if (i % 4 == 3) v = 1.0f;
-    out.pixels[i] = uint8_t(std::clamp(v, 0.0f, 1.0f) * 255.0f + 0.5f);
-  }
-  return out;
-}
-
 void writeImage(const std::string& path, const std::string& view, gi::Renderer& renderer) {
   const bool output = view == gi::resources::kOutput;
   if (std::filesystem::path(path).extension() == ".pfm")
@@ -152,7 +138,7 @@ void writeImage(const std::string& path, const std::string& view, gi::Renderer& 
   else if (output)
     gi::writePng(path, renderer.readOutput());
   else
-    gi::writePng(path, toPreview(renderer.readTarget(view), view));
+    gi::writePng(path, gi::app::previewOf(renderer.readTarget(view), view));
 }
 
 int listEffects() {
