@@ -170,5 +170,28 @@ TEST_F(SsdoLayersTest, TheThirdAndFourthLayersFindASlabBehindAnother) {
   EXPECT_NEAR(mean[4], truthMean, 0.1 * shadow);
 }
 
+// The hard cases of test_ssdo's NoNaN test (grazing eye, extreme clip planes, looking into the
+// sky) with 3 and 4 layers, the bounce, the smallest distance clamp and an additional camera:
+// finite and non-negative everywhere.
+TEST_F(SsdoLayersTest, ThreeAndFourLayersStayFiniteInTheHardCases) {
+  struct Case {
+    glm::vec3 eye, target;
+    float znear, zfar;
+  };
+  for (const Case& k : {Case{{6, 1e-3f, 0.5f}, {0, 0, 0.5f}, 0.05f, 100.0f},
+                        Case{{2.5f, 1.6f, 0}, {0, 0, 0}, 1e-4f, 1e5f},
+                        Case{{2.5f, 0.3f, 0}, {0, 3, 0}, 1e-4f, 1e5f}}) {
+    const Scene s = test::quadScene(test::cornerQuads(), k.eye, k.target, 1.0f, k.znear, k.zfar);
+    for (const char* layers : {"ssdo.layers=3", "ssdo.layers=4"}) {
+      const test::SsdoFrame f =
+          render(s, {layers, "ssdo.bounce=true", "ssdo.distance_clamp=1e-6", "ssdo.cameras=1"});
+      EXPECT_TRUE(test::finite(f.ambient)) << layers << " near " << k.znear;
+      EXPECT_TRUE(test::finite(f.indirect)) << layers << " near " << k.znear;
+      for (size_t i = 0; i < f.ambient.pixels.size(); ++i) ASSERT_GE(f.ambient.pixels[i], 0.0f);
+      for (size_t i = 0; i < f.indirect.pixels.size(); ++i) ASSERT_GE(f.indirect.pixels[i], 0.0f);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace gi
