@@ -215,12 +215,12 @@ void main() {
     // (the same bias; no layer 3: the range guard from layer 2). Its surfaces are hidden: they
     // block, but their normal and radiance are unknown, so they send nothing (an additional
     // camera that sees the blocker below may).
+    // Fetched only for samples behind the back layer (most are in front of the front one).
     bool hidden = false;
-    if (kLayers > 2) {
+    if (kLayers > 2 && valid && !blocked && iB > 0.0 && iQ < iB) {
       vec2 l23 = unpackHalf2x16(texelFetch(gLayers23, t, 0).x);
       float diff2 = l23.x - iQ, prod2 = l23.x * iQ;
-      hidden = valid && !blocked && iB > 0.0 && iQ < iB && l23.x > 0.0 &&
-               diff2 > max(bias * prod2, kDepthResolution * l23.x) &&
+      hidden = l23.x > 0.0 && diff2 > max(bias * prod2, kDepthResolution * l23.x) &&
                (l23.y > 0.0 ? iQ > l23.y : diff2 < R * prod2);
     }
     vec3 send = vec3(0.0);
