@@ -25,9 +25,10 @@ layout(constant_id = 1) const bool kBounce = true;
 // evaluating all three per sample (llvmpipe runs every branch) would cost most of the pass.
 layout(constant_id = 2) const int kEnvironmentKind = 0;
 
-// Depth layers (1, 2): with 2 a sample is blocked only inside the solid interval between the
+// Depth layers (1..4): with 2 a sample is blocked only inside the solid interval between the
 // front layer and the peeled one (seed 000 §4, Fig. 5); where no second layer exists, the
-// one-layer test with its range guard.
+// one-layer test with its range guard. With 3 and 4 also inside the next interval [layer 2,
+// layer 3] (with 3, or where no fourth layer exists: layer 2 and the range guard).
 layout(constant_id = 3) const int kLayers = 1;
 // Additional cameras (0..4): a sample is also blocked when it is behind a surface one of them
 // sees (same test, their own images), and that surface is then its sender.
@@ -43,6 +44,8 @@ layout(set = 0, binding = 4) uniform usampler2D gCamera0;
 layout(set = 0, binding = 5) uniform usampler2D gCamera1;
 layout(set = 0, binding = 6) uniform usampler2D gCamera2;
 layout(set = 0, binding = 7) uniform usampler2D gCamera3;
+// Layers 2 and 3 (ssdo_layers.comp: two half 1 / z in .x; kLayers > 2, else bound to gSurface).
+layout(set = 0, binding = 8) uniform usampler2D gLayers23;
 
 // `c` is a constant after the camera loop unrolls: the branches fold.
 uvec4 fetchCamera(int c, ivec2 t) {
@@ -208,6 +211,18 @@ void main() {
     // layer exists; else the range guard.
     float iB = kLayers > 1 ? unpackHalf2x16(surface.w).y : 0.0;
     bool blocked = inFront && (iB > 0.0 ? iQ > iB : diff < R * prod);
+    // Three or four layers: behind the back layer, the next solid interval [layer 2, layer 3]
+    // (the same bias; no layer 3: the range guard from layer 2). Its surfaces are hidden: they
+    // block, but their normal and radiance are unknown, so they send nothing (an additional
+    // camera that sees the blocker below may).
+    // Fetched only for samples behind the back layer (most are in front of the front one).
+    bool hidden = false;
+    if (kLayers > 2 && valid && !blocked && iB > 0.0 && iQ < iB) {
+      vec2 l23 = unpackHalf2x16(texelFetch(gLayers23, t, 0).x);
+      float diff2 = l23.x - iQ, prod2 = l23.x * iQ;
+      hidden = l23.x > 0.0 && diff2 > max(bias * prod2, kDepthResolution * l23.x) &&
+               (l23.y > 0.0 ? iQ > l23.y : diff2 < R * prod2);
+    }
     vec3 send = vec3(0.0);
     if (kBounce) {
       vec3 S = ssdoViewPosition(vec2(t) + 0.5, max(iS, 1e-30), invSize, p00, p11, p20, p21);
@@ -246,6 +261,7 @@ void main() {
       }
       blocked = blocked || blockedC;
     }
+    blocked = blocked || hidden;
 
     if (kEnvironmentKind == 1) {
       direct.x += blocked ? 0.0 : 1.0;  // constant: count the open directions

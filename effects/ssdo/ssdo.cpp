@@ -3,8 +3,9 @@
 // radiance: ssdo_surface.comp), the samples (ssdo.comp), a geometry-aware separable blur whose
 // y half multiplies by the diffuse albedo (ssdo_blur_x.comp, ssdo_resolve.comp). Publishes
 // "ambient" (alpha 1: replaces the engine's environment x AO term) and "indirect" (added).
-// Optional (seed 000 §4), only built when asked: a second depth layer peeled through the
-// engine's layered-depth draw (`layers` 2, pass ssdo_peel), and `cameras` low-resolution
+// Optional (seed 000 §4), only built when asked: up to three more depth layers peeled through
+// the engine's layered-depth draw (`layers` 2..4, passes ssdo_peel, ssdo_peel2, ssdo_peel3;
+// layers 2 and 3 packed by ssdo_layers.comp), and `cameras` low-resolution
 // views whose G-buffers add occluders and senders (passes ssdo_cameras, ssdo_camera_surface).
 // Optional (seed 000 §5, `contact_shadows`): the contact shadows the shadow-map bias removes,
 // published as the lighting pass's "contact_shadow" (pass ssdo_contact, ssdo_contact.comp).
@@ -29,6 +30,7 @@
 #include "ssdo.comp.h"          // const uint32_t ssdo_comp[]
 #include "ssdo_blur_x.comp.h"   // const uint32_t ssdo_blur_x_comp[]
 #include "ssdo_contact.comp.h"  // const uint32_t ssdo_contact_comp[]
+#include "ssdo_layers.comp.h"   // const uint32_t ssdo_layers_comp[]
 #include "ssdo_resolve.comp.h"  // const uint32_t ssdo_resolve_comp[]
 #include "ssdo_samples.h"
 #include "ssdo_surface.comp.h"  // const uint32_t ssdo_surface_comp[]
@@ -41,7 +43,8 @@ using gi::SettingType;
 // Surface and raw texels pack four 32-bit words each (ssdo_common.glsl): one fetch per tap.
 constexpr VkFormat kPackedFormat = VK_FORMAT_R32G32B32A32_UINT;
 constexpr VkFormat kOutFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
-constexpr uint32_t kGroupX = 32, kGroupY = 16;  // local_size of every SSDO shader
+constexpr VkFormat kLayersFormat = VK_FORMAT_R32_UINT;  // layers 2 and 3: two half 1 / z
+constexpr uint32_t kGroupX = 32, kGroupY = 16;          // local_size of every SSDO shader
 constexpr int kMaxContactSamples = 16;
 
 // Bit masks of the light types present and of those with shadow maps (1 directional, 2 point,
@@ -102,8 +105,9 @@ class SsdoEffect : public gi::Effect {
         {"blur_radius", SettingType::Int, 2, 0, gi::ssdo::kMaxBlurRadius,
          "geometry-aware blur radius in pixels (0: none; even radii cancel the 4x4 pattern)", true},
         {"layers", SettingType::Int, 1, 1, gi::ssdo::kMaxLayers,
-         "depth layers (2: depth peeling, a sample is blocked only between the front and the "
-         "back layer: thin objects stop shadowing what is behind them)",
+         "depth layers (2..4: depth peeling, layers - 1 peel passes; a sample is blocked only "
+         "inside the solid intervals [layer 0, layer 1] and [layer 2, layer 3]: thin objects "
+         "stop shadowing what is behind them, and 3..4 see an occluder behind another one)",
          true},
         {"cameras", SettingType::Int, 0, 0, gi::ssdo::kMaxCameras,
          "additional low-resolution cameras (right, left, above, below the viewer, aimed at the "
@@ -153,6 +157,10 @@ class SsdoEffect : public gi::Effect {
     resolve_ = gi::vk::Pipeline::compute(
         vk, {std::begin(ssdo_resolve_comp), std::end(ssdo_resolve_comp)},
         {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, tex}, {5, img}, {6, img}}, 0, radius);
+    if (layers_ > 2)
+      layersPipeline_ =
+          gi::vk::Pipeline::compute(vk, {std::begin(ssdo_layers_comp), std::end(ssdo_layers_comp)},
+                                    {{0, ubo}, {1, tex}, {2, tex}, {3, img}}, 0, {layers_});
     if (!uniforms_)
       uniforms_ =
           gi::vk::Buffer(vk, sizeof(gi::ssdo::Uniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true);
@@ -200,7 +208,9 @@ class SsdoEffect : public gi::Effect {
       gi::TextureHandle depth, normal, albedo, material, emission, shadowMaps;
       gi::BufferHandle lights, shadowViews;
       gi::TextureHandle surface, raw, half, ambient, indirect;
-      gi::TextureHandle layer1;   // the peeled depth layer (layers 2)
+      // The peeled depth layers 1..layers-1 (peeled[0] is layer 1), and layers 2 and 3 packed.
+      std::vector<gi::TextureHandle> peeled;
+      gi::TextureHandle layers23;
       gi::TextureHandle contact;  // contact_shadow (contact_shadows)
       // Per additional camera: its depth, G-buffer colours and surface texels.
       std::vector<gi::TextureHandle> camDepth, camSurface;
@@ -214,22 +224,30 @@ class SsdoEffect : public gi::Effect {
     const VkDescriptorType ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
     gi::GpuScene& scene = ctx.scene();
 
-    if (layers_ > 1) {
-      // The second depth layer: the nearest surface strictly behind the G-buffer's depth.
+    // Depth layer k (1..layers-1): the nearest surface strictly behind layer k-1 (layer 0: the
+    // G-buffer's depth). One pass per layer: "ssdo_peel" (layer 1), "ssdo_peel2", "ssdo_peel3".
+    for (uint32_t k = 1; k < layers_; ++k) {
+      const std::string name = k == 1 ? "ssdo_peel" : "ssdo_peel" + std::to_string(k);
+      io->peeled.emplace_back();
       graph.addPass(
-          "ssdo_peel",
+          name,
           [&](gi::PassBuilder& b) {
             scene.declareRead(b);
-            io->depth = b.read(bb.texture(res::kDepth));
-            io->layer1 = b.write(b.create("ssdo_layer1", gi::TextureDesc{gi::kSceneDepthFormat}),
-                                 gi::TextureUsage::DepthAttachment);
+            if (k == 1)
+              io->depth = b.read(bb.texture(res::kDepth));
+            else
+              io->peeled[k - 2] = b.read(io->peeled[k - 2]);
+            io->peeled[k - 1] = b.write(
+                b.create("ssdo_layer" + std::to_string(k), gi::TextureDesc{gi::kSceneDepthFormat}),
+                gi::TextureUsage::DepthAttachment);
           },
-          [io, &scene, c = &ctx](gi::PassContext& pc) {
+          [io, &scene, k, c = &ctx](gi::PassContext& pc) {
             gi::SceneView v;
             v.view = c->frame().view;  // exactly the G-buffer's camera
             v.proj = c->frame().proj;
-            const gi::SceneTargets t{pc.view(io->layer1), {}, pc.extent(io->layer1)};
-            scene.drawDepthPeeled(pc, t, {&v, 1}, pc.view(io->depth));
+            const gi::TextureHandle out = io->peeled[k - 1];
+            const gi::SceneTargets t{pc.view(out), {}, pc.extent(out)};
+            scene.drawDepthPeeled(pc, t, {&v, 1}, pc.view(k == 1 ? io->depth : io->peeled[k - 2]));
           });
     }
 
@@ -315,9 +333,14 @@ class SsdoEffect : public gi::Effect {
           io->lights = b.read(bb.buffer(res::kLights));
           io->shadowViews = b.read(bb.buffer(res::kShadowViews));
           io->shadowMaps = b.read(bb.texture(res::kShadowMaps));
-          if (layers_ > 1) io->layer1 = b.read(io->layer1);
+          if (layers_ > 1) io->peeled[0] = b.read(io->peeled[0]);
           io->surface = b.write(b.create("ssdo_surface", gi::TextureDesc{kPackedFormat}),
                                 gi::TextureUsage::StorageWrite);
+          if (layers_ > 2) {
+            for (size_t k = 1; k < io->peeled.size(); ++k) io->peeled[k] = b.read(io->peeled[k]);
+            io->layers23 = b.write(b.create("ssdo_layers23", gi::TextureDesc{kLayersFormat}),
+                                   gi::TextureUsage::StorageWrite);
+          }
         },
         [this, io, values = &settings, frame, nearest, ubo, c = &ctx](gi::PassContext& pc) {
           upload(*values);
@@ -340,9 +363,18 @@ class SsdoEffect : public gi::Effect {
               .sampled(9, pc.view(io->shadowMaps), nearest)
               .storageImage(10, pc.view(io->surface))
               // The peeled layer (unused with one layer: the depth stands in).
-              .sampled(11, pc.view(layers_ > 1 ? io->layer1 : io->depth), nearest);
+              .sampled(11, pc.view(layers_ > 1 ? io->peeled[0] : io->depth), nearest);
           const VkExtent2D e = pc.extent(io->surface);
           pc.dispatch(surface_, w, e, kGroupX, kGroupY);
+          if (layers_ > 2) {
+            // Layers 2 and 3 into one R32UI texel (with 3 layers, layer 2 stands in for 3).
+            gi::vk::DescriptorWriter l;
+            l.buffer(0, ubo, frame)
+                .sampled(1, pc.view(io->peeled[1]), nearest)
+                .sampled(2, pc.view(io->peeled[layers_ > 3 ? 2 : 1]), nearest)
+                .storageImage(3, pc.view(io->layers23));
+            pc.dispatch(layersPipeline_, l, e, kGroupX, kGroupY);
+          }
         });
 
     graph.addPass(
@@ -350,6 +382,7 @@ class SsdoEffect : public gi::Effect {
         [&](gi::PassBuilder& b) {
           io->surface = b.read(io->surface);
           for (gi::TextureHandle& t : io->camSurface) t = b.read(t);
+          if (layers_ > 2) io->layers23 = b.read(io->layers23);
           io->raw = b.write(b.create("ssdo_raw", gi::TextureDesc{kPackedFormat}),
                             gi::TextureUsage::StorageWrite);
         },
@@ -363,6 +396,8 @@ class SsdoEffect : public gi::Effect {
           for (uint32_t k = 0; k < gi::ssdo::kMaxCameras; ++k)
             w.sampled(4 + k, pc.view(k < io->camSurface.size() ? io->camSurface[k] : io->surface),
                       nearest);
+          // Layers 2 and 3 (unused with up to 2 layers: the surface stands in).
+          w.sampled(8, pc.view(layers_ > 2 ? io->layers23 : io->surface), nearest);
           pc.dispatch(ssdo_, w, pc.extent(io->raw), kGroupX, kGroupY);
         });
 
@@ -451,8 +486,8 @@ class SsdoEffect : public gi::Effect {
                img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
     ssdo_ = gi::vk::Pipeline::compute(
         ctx.vulkan(), {std::begin(ssdo_comp), std::end(ssdo_comp)},
-        {{0, ubo}, {1, ubo}, {2, tex}, {3, img}, {4, tex}, {5, tex}, {6, tex}, {7, tex}}, 0,
-        {samples_, bounce_ ? 1u : 0u, kind, layers_, cameras_});
+        {{0, ubo}, {1, ubo}, {2, tex}, {3, img}, {4, tex}, {5, tex}, {6, tex}, {7, tex}, {8, tex}},
+        0, {samples_, bounce_ ? 1u : 0u, kind, layers_, cameras_});
     environmentKind_ = kind;
   }
 
@@ -533,7 +568,8 @@ class SsdoEffect : public gi::Effect {
     uploaded_ = key;
   }
 
-  gi::vk::Pipeline surface_, cameraSurface_, ssdo_, blurX_, resolve_, contactPipeline_;
+  gi::vk::Pipeline surface_, cameraSurface_, ssdo_, blurX_, resolve_, contactPipeline_,
+      layersPipeline_;
   gi::vk::Buffer uniforms_;
   std::vector<std::shared_ptr<gi::ViewUniforms>> views_;  // the additional cameras
   bool bounce_ = true, senderShadows_ = true;

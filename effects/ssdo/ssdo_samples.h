@@ -33,7 +33,8 @@ inline constexpr float kBias = 0.025f;
 inline constexpr float kBlurPlaneTolerance = 0.25f;
 inline constexpr float kBlurMinCos = 0.8f;
 
-inline constexpr int kMaxLayers = 2;   // depth layers: the front one and one peeled
+// Depth layers: the front one and up to three peeled; consecutive pairs are solid intervals.
+inline constexpr int kMaxLayers = 4;
 inline constexpr int kMaxCameras = 4;  // additional cameras
 
 // std140 mirror of `SsdoCamera` in ssdo_common.glsl (column-major matrices).
