@@ -72,6 +72,16 @@ const char* kUsage =
     "  --width W --height H  resolution (default 320x240)\n"
     "  --ref-spp N           reference samples per pixel (default 256)\n"
     "  --ref-seed N          reference seed (default 1)\n"
+    "  --target Q            score every configuration's lit image against light quantity Q\n"
+    "                        (direct or direct+indirect) instead of each effect's own target:\n"
+    "                        AO effects are then scored by the lighting they modulate, so\n"
+    "                        AO and GI effects share one axis (declared score: the effect's\n"
+    "                        own light quantity, or Q for AO-like ones)\n"
+    "  --exclude-emitters    leave pixels within 1 pixel of an emissive surface (G-buffer\n"
+    "                        emission > 0) out of the scores: their radiance is the emitter's\n"
+    "                        own, the same for every method, and where rasteriser and ray\n"
+    "                        tracer put an emitter's edge in different pixels that edge\n"
+    "                        (radiance many times its surroundings') can dominate the NRMSE\n"
     "  --ao-split            AO effects: split the reference's occlusion into what the depth\n"
     "                        buffer holds, off-screen and hidden occluders (gi-reference\n"
     "                        --quantity ao-split) and report where the effect cannot converge\n"
@@ -106,6 +116,8 @@ struct Options {
   bool hardCases = false;
   std::vector<std::string> cases;  // --hard-cases: a subset
   bool quick = false, calibrate = false, progress = true, validation = false, aoSplit = false;
+  std::optional<ref::Quantity> target;  // --target: one light quantity for every configuration
+  bool excludeEmitters = false;         // --exclude-emitters
   double budgetMs = 0.0, headroom = 0.1;
   std::string metric = "ssim";  // --calibrate: what "most accurate" means
   bool metricGiven = false;
@@ -163,6 +175,13 @@ Options parseArgs(int argc, char** argv) {
       o.hardCases = true;
     else if (a.is("--cases"))
       o.cases = a.list();
+    else if (a.is("--target")) {
+      const std::string q = a.value();
+      if (q != "direct" && q != "direct+indirect")
+        a.fail("expects direct or direct+indirect, got '" + q + "'");
+      o.target = ref::parseQuantity(q);
+    } else if (a.is("--exclude-emitters"))
+      o.excludeEmitters = true;
     else if (a.is("--ao-split"))
       o.aoSplit = true;
     else if (a.is("--calibrate"))
@@ -191,6 +210,8 @@ Options parseArgs(int argc, char** argv) {
       usageError(o.out, "--calibrate writes a preset: --out must end in .json");
   }
   if (!o.hardCases && !o.cases.empty()) usageError("--cases", "only applies to --hard-cases");
+  if (o.target && (o.aoSplit || o.calibrate || o.hardCases))
+    usageError("--target", "excludes --ao-split, --calibrate and --hard-cases");
   if (o.hardCases) {
     if (o.calibrate || o.quick) usageError("--hard-cases", "excludes --calibrate and --quick");
     if (!o.sizeGiven) o.width = 160, o.height = 120;
@@ -260,6 +281,17 @@ Comparison comparisonFor(const std::vector<gi::EffectConfig>& effects,
       c.effect = e.name;
     }
   }
+  return c;
+}
+
+// --target: the lit image against one light quantity, whatever the effects estimate (an AO
+// effect is then judged by the lighting it modulates). An AO-like declaration cannot be read
+// from the lit image: its declared score becomes the target's.
+Comparison litAgainst(Comparison c, ref::Quantity target) {
+  c.resource = gi::resources::kLit;
+  c.target = ReferenceSpec{};
+  c.target.quantity = target;
+  if (gi::bench::isAoLike(c.declared.quantity)) c.declared = c.target;
   return c;
 }
 
@@ -460,6 +492,7 @@ struct Measurement {
   std::vector<gi::bench::PassTime> passes;
   Interval total, effect, floor, wall;
   gi::ImageRGBA32F out, depth;
+  gi::ImageRGBA32F emission;  // --exclude-emitters only
 };
 
 // The effect's AO error against the ao-split reference, decomposed as in Row::AoSplit, over the
@@ -573,6 +606,7 @@ std::vector<Measurement> measureAll(
       settings.floorPass = floorPass;
       settings.effects = *jobs[i].effects;
       settings.keepForReadback = {jobs[i].resource, gi::resources::kDepth};  // read when scored
+      if (o.excludeEmitters) settings.keepForReadback.push_back(gi::resources::kEmission);
       renderers.push_back(std::make_unique<gi::Renderer>(ctx, *jobs[i].scene, settings, &registry));
       renderers.back()->renderFrame();  // first-use costs stay out of every repetition
     }
@@ -591,10 +625,13 @@ std::vector<Measurement> measureAll(
       m.wall = gi::bench::medianInterval(t.wall);
       m.out = renderers[i - first]->readTarget(jobs[i].resource);
       m.depth = renderers[i - first]->readTarget(gi::resources::kDepth);
+      if (o.excludeEmitters)
+        m.emission = renderers[i - first]->readTarget(gi::resources::kEmission);
       renderers[i - first].reset();
       scoreNow(i, m);
       m.out = {};
       m.depth = {};
+      m.emission = {};
     }
   }
   return out;
@@ -606,12 +643,33 @@ struct Scores {
   Row::AoSplit split;
 };
 
-Scores score(const Measurement& m, const ReferenceSpec& spec, const Reference& reference,
-             const Options& o) {
-  const size_t n = size_t(o.width) * size_t(o.height);
+// The compared pixels: geometry in the reference and in the frame, and with --exclude-emitters
+// none within one pixel (8-neighbourhood) of a pixel whose G-buffer emission is positive.
+std::vector<unsigned char> comparedMask(const Measurement& m, const Reference& reference,
+                                        const Options& o) {
+  const int w = int(o.width), h = int(o.height);
+  const size_t n = size_t(w) * size_t(h);
   std::vector<unsigned char> mask(n);
   for (size_t i = 0; i < n; ++i)
     mask[i] = reference.depth.pixels[i * 4 + 2] > 0.5f && m.depth.pixels[i * 4] > 0.0f;
+  if (!o.excludeEmitters || m.emission.pixels.size() != n * 4) return mask;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const float* e = &m.emission.pixels[(size_t(y) * size_t(w) + size_t(x)) * 4];
+      if (!(e[0] > 0.0f || e[1] > 0.0f || e[2] > 0.0f)) continue;
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int u = x + dx, v = y + dy;
+          if (u >= 0 && v >= 0 && u < w && v < h) mask[size_t(v) * size_t(w) + size_t(u)] = 0;
+        }
+    }
+  return mask;
+}
+
+Scores score(const Measurement& m, const ReferenceSpec& spec, const Reference& reference,
+             const Options& o) {
+  const size_t n = size_t(o.width) * size_t(o.height);
+  const std::vector<unsigned char> mask = comparedMask(m, reference, o);
   const int w = int(o.width), h = int(o.height);
   Scores s;
   if (gi::bench::isAoLike(spec.quantity)) {
@@ -637,10 +695,7 @@ std::optional<gi::bench::QuantityGap> gapOf(const Measurement& m, const Comparis
   if (cmp.declared == cmp.target ||
       gi::bench::isAoLike(cmp.declared.quantity) != gi::bench::isAoLike(cmp.target.quantity))
     return std::nullopt;
-  const size_t n = size_t(o.width) * size_t(o.height);
-  std::vector<unsigned char> mask(n);
-  for (size_t i = 0; i < n; ++i)  // as score(): geometry in the target and in the frame
-    mask[i] = target.depth.pixels[i * 4 + 2] > 0.5f && m.depth.pixels[i * 4] > 0.0f;
+  const std::vector<unsigned char> mask = comparedMask(m, target, o);  // as score()
   const int w = int(o.width), h = int(o.height),
             c = gi::bench::isAoLike(cmp.target.quantity) ? 0 : -1;
   return gi::bench::quantityGap(gi::bench::channel(w, h, m.out.pixels, c),
@@ -804,6 +859,7 @@ std::vector<Config> buildConfigs(const Options& o, const Setup& s,
           c.effects = gi::resolveEffects(s.scenes[si].scene, c.presetPtr, ov, s.registry);
           c.engine = gi::resolveEngineSettings(s.scenes[si].scene, c.presetPtr, ov, {});
           c.comparison = comparisonFor(c.effects, s.registry, o.aoSplit);
+          if (o.target) c.comparison = litAgainst(c.comparison, *o.target);
           // The reference renders the scene's environment as it is: a scaled one would be
           // compared with the wrong ground truth.
           if (c.engine.number("environment_intensity") != 1.0 &&

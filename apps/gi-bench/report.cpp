@@ -128,11 +128,8 @@ std::string json(const std::vector<Row>& rows, const RunInfo& info) {
   for (const Row& r : rows) {
     nlohmann::json p = nlohmann::json::object(), passes = nlohmann::json::array();
     auto ci = [](const Interval& i) {
-      return nlohmann::json{{"median", i.median},
-                            {"lo", i.lo},
-                            {"hi", i.hi},
-                            {"coverage", i.coverage},
-                            {"reps", i.samples}};
+      return nlohmann::json{{"median", i.median},     {"lo", i.lo},        {"hi", i.hi},
+                            {"coverage", i.coverage}, {"reps", i.samples}, {"values", i.values}};
     };
     for (const PassTime& pt : r.passes)
       passes.push_back({{"pass", pt.name}, {"ms", pt.ms.median}, {"interval", ci(pt.ms)}});

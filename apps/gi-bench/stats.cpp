@@ -30,6 +30,7 @@ double binomialCdfHalf(size_t n, size_t j) {
 Interval medianInterval(std::vector<double> v, double confidence) {
   Interval r;
   r.samples = v.size();
+  r.values = v;
   if (v.empty()) return r;
   std::sort(v.begin(), v.end());
   r.median = median(v);

@@ -24,6 +24,9 @@ struct Interval {
   double median = 0.0, lo = 0.0, hi = 0.0;
   double coverage = 0.0;  // the interval's exact coverage of the population median
   size_t samples = 0;
+  // The repetition values in measurement order: repetition r of interleaved configurations ran
+  // back to back, so per-repetition ratios pair them under the same load (results.json).
+  std::vector<double> values;
   double width() const { return hi - lo; }
 };
 

@@ -1,0 +1,138 @@
+// gi-bench --target: every configuration's lit image scored against one light quantity (AO
+// effects judged by the lighting they modulate), and results.json's per-repetition values,
+// which pair interleaved configurations repetition by repetition (docs/bench/ssdo/table1.sh).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "bench_support.h"
+#include "process.h"
+#include "test_support.h"
+
+namespace gi {
+namespace {
+
+namespace fs = std::filesystem;
+
+bool hasPlugin(const char* name) {
+  return fs::exists(test::binPath(std::string("plugins/gi_effect_") + name + ".so"));
+}
+
+nlohmann::json sweep(const std::string& dir, const std::string& name, const std::string& args) {
+  const std::string out = dir + "/" + name;
+  auto r = test::runCommand(test::benchCommand("--quick --reps 3 " + args + " --cache '" + dir +
+                                               "/cache' --out '" + out + "'"));
+  EXPECT_EQ(r.exitCode, 0) << args << ": " << r.output;
+  return nlohmann::json::parse(test::readAll(out + "/results.json"));
+}
+
+const nlohmann::json& row(const nlohmann::json& j, const std::string& effect) {
+  for (const auto& r : j["results"])
+    if (r["effect"] == effect) return r;
+  ADD_FAILURE() << "no row for " << effect;
+  return j["results"][0];
+}
+
+bool startsWith(const nlohmann::json& v, const std::string& prefix) {
+  return v.get<std::string>().rfind(prefix, 0) == 0;
+}
+
+TEST(BenchTarget, LitImagesOfEveryEffectAgainstOneQuantity) {
+  if (!hasPlugin("ssao") || !hasPlugin("ssdo")) GTEST_SKIP() << "ssao and ssdo plugins needed";
+  const std::string dir = test::makeTempDir("bench-target");
+  const std::string effects = "--effects none,ssao,ssdo ";
+  const nlohmann::json own = sweep(dir, "own", effects);
+  const nlohmann::json gi = sweep(dir, "gi", effects + "--target direct+indirect");
+  const nlohmann::json direct = sweep(dir, "direct", effects + "--target direct");
+
+  // Without --target each effect has its own target: SSAO's AO, the engine's direct light.
+  EXPECT_EQ(row(own, "ssao")["compared"], "ao");
+  EXPECT_TRUE(startsWith(row(own, "ssao")["reference"], "ao r=0.5"));
+  EXPECT_TRUE(startsWith(row(own, "none")["reference"], "direct spp="));
+  EXPECT_TRUE(startsWith(row(own, "ssdo")["reference"], "direct+indirect spp="));
+
+  for (const auto& r : gi["results"]) {
+    EXPECT_EQ(r["compared"], "lit") << r.dump();
+    EXPECT_TRUE(startsWith(r["reference"], "direct+indirect spp=")) << r.dump();
+  }
+  // SSAO's AO cannot be read from the lit image: its declared score is the target's.
+  EXPECT_EQ(row(gi, "ssao")["declared"], row(gi, "ssao")["reference"]);
+  EXPECT_DOUBLE_EQ(row(gi, "ssao")["declared_nrmse"].get<double>(),
+                   row(gi, "ssao")["nrmse"].get<double>());
+  // The same references and images: SSDO keeps its score, the engine alone is now scored
+  // against direct + indirect, and SSAO's lit image differs from the engine's.
+  EXPECT_DOUBLE_EQ(row(gi, "ssdo")["nrmse"].get<double>(), row(own, "ssdo")["nrmse"].get<double>());
+  EXPECT_NE(row(gi, "none")["nrmse"], row(own, "none")["nrmse"]);
+  EXPECT_NE(row(gi, "ssao")["nrmse"], row(gi, "none")["nrmse"]);
+
+  // --target direct: the engine alone is scored as without it; SSDO against direct light,
+  // while its declared quantity stays its own (a light quantity is read from the lit image).
+  EXPECT_DOUBLE_EQ(row(direct, "none")["nrmse"].get<double>(),
+                   row(own, "none")["nrmse"].get<double>());
+  EXPECT_TRUE(startsWith(row(direct, "ssdo")["reference"], "direct spp="));
+  EXPECT_TRUE(startsWith(row(direct, "ssdo")["declared"], "direct+indirect spp="));
+  EXPECT_DOUBLE_EQ(row(direct, "ssdo")["declared_nrmse"].get<double>(),
+                   row(own, "ssdo")["nrmse"].get<double>());
+  EXPECT_NE(row(direct, "ssdo")["nrmse"], row(own, "ssdo")["nrmse"]);
+}
+
+// Each interval keeps its repetitions in measurement order: their median is the reported one,
+// and a pass's values sum, repetition by repetition, to the effect time.
+TEST(BenchTarget, RepetitionValuesAreKeptInOrder) {
+  if (!hasPlugin("ssao")) GTEST_SKIP() << "the ssao plugin is not built";
+  const std::string dir = test::makeTempDir("bench-values");
+  const nlohmann::json j = sweep(dir, "out", "--effects ssao --reps 4");
+  const auto& r = j["results"][0];
+  const std::vector<double> total = r["total_interval"]["values"];
+  ASSERT_EQ(total.size(), 4u);
+  std::vector<double> sorted = total;
+  std::sort(sorted.begin(), sorted.end());
+  EXPECT_DOUBLE_EQ(r["total_ms"].get<double>(), (sorted[1] + sorted[2]) / 2);
+  std::vector<double> effect(4, 0.0);
+  for (const auto& p : r["passes"]) {
+    const std::vector<double> v = p["interval"]["values"];
+    ASSERT_EQ(v.size(), 4u) << p.dump();
+    if (p["pass"].get<std::string>().rfind("ssao", 0) == 0)
+      for (size_t k = 0; k < 4; ++k) effect[k] += v[k];
+  }
+  const std::vector<double> effectValues = r["effect_interval"]["values"];
+  for (size_t k = 0; k < 4; ++k) EXPECT_NEAR(effectValues[k], effect[k], 1e-9) << k;
+}
+
+// --exclude-emitters: the default room's lamp (an emissive quad on the ceiling) and the pixels
+// around it leave the comparison; nothing else changes.
+TEST(BenchTarget, ExcludeEmittersLeavesTheLampOut) {
+  const std::string dir = test::makeTempDir("bench-emitters");
+  const nlohmann::json all = sweep(dir, "all", "--effects none");
+  const nlohmann::json cut = sweep(dir, "cut", "--effects none --exclude-emitters");
+  const auto &a = all["results"][0], &c = cut["results"][0];
+  // The lamp is 0.5 x 0.4 on the 2 x 2 ceiling seen from 3.9 away: at 64x48 some tens of
+  // pixels, with the one-pixel ring around it fewer than a tenth of the image.
+  EXPECT_LT(c["pixels"].get<size_t>(), a["pixels"].get<size_t>());
+  EXPECT_GT(c["pixels"].get<size_t>(), a["pixels"].get<size_t>() * 9 / 10);
+  EXPECT_EQ(c["reference"], a["reference"]);
+  EXPECT_NE(c["nrmse"], a["nrmse"]);
+}
+
+TEST(BenchTarget, BadTargetFailsBeforeRendering) {
+  const std::string dir = test::makeTempDir("bench-target-bad");
+  const std::string out = dir + "/out";
+  for (const auto& [args, needle] : std::vector<std::pair<std::string, std::string>>{
+           {"--target ao", "--target: expects direct or direct+indirect, got 'ao'"},
+           {"--target direct --ao-split", "--target: excludes --ao-split"}}) {
+    auto r = test::runCommand(
+        test::benchCommand("--quick " + args + " --cache '" + dir + "/cache' --out '" + out + "'"));
+    EXPECT_NE(r.exitCode, 0) << args << ": " << r.output;
+    EXPECT_NE(r.output.find(needle), std::string::npos) << args << ": " << r.output;
+    EXPECT_FALSE(fs::exists(out)) << args;
+    EXPECT_FALSE(fs::exists(dir + "/cache")) << args;
+  }
+}
+
+}  // namespace
+}  // namespace gi
