@@ -4,7 +4,7 @@
 set -e
 OLD=${1:-/work/main/build/bin}
 REPS=${2:-3}
-NEW=build/bin
+NEW=${NEW:-build/bin}
 D=docs/bench/ism
 S="--set ism.vpls=256 --set ism.ism_resolution=256 --set ism.points_per_ism=8192"
 # A. ISM creation vs classic maps, 256 VPLs at 256^2 (seed 002), bunny (69k triangles).
