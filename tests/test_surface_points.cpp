@@ -130,6 +130,37 @@ TEST_F(SurfacePointsGpuTest, MixedRigidInstancedMirroredAndSkinned) {
   expectGpuPointsMatchCpu(ctx(), scene, 30000, {0.0, 0.8, 2.2});
 }
 
+// The points are re-evaluated only in frames after the pose changed: once for a static scene
+// however many frames run, once per new animation time for a skinned one, and not again when
+// the time repeats (the points stay those of that pose: checked against the CPU above).
+TEST_F(SurfacePointsGpuTest, ReevaluatedOnlyWhenThePoseChanges) {
+  RenderSettings rs;
+  rs.width = 32;
+  rs.height = 24;
+  rs.surfacePoints = 2000;
+  rs.view = "points";
+  Scene still;
+  still.meshes.push_back(quad(1.0f, 0));
+  still.materials.emplace_back();
+  still.nodes[still.addNode("quad", glm::mat4(1.0f))].meshes.push_back(0);
+  still.updateWorldTransforms();
+  Renderer r(ctx(), still, rs);
+  EXPECT_EQ(r.surfacePointEvaluations(), 0u);
+  for (double t : {0.0, 0.5, 1.0}) {
+    r.setTime(t);
+    r.renderFrame();
+  }
+  EXPECT_EQ(r.surfacePointEvaluations(), 1u);
+
+  const Scene skin = loadGltf(test::assimpModel("glTF2/simple_skin/simple_skin.gltf"));
+  Renderer s(ctx(), skin, rs);
+  for (double t : {0.0, 0.6, 1.4, 1.4, 1.4}) {
+    s.setTime(t);
+    s.renderFrame();
+  }
+  EXPECT_EQ(s.surfacePointEvaluations(), 3u);
+}
+
 // Points asked for on a scene without area: none exist, the view still renders (cleared)
 // without validation errors and the read-back is empty.
 TEST_F(SurfacePointsGpuTest, NoAreaGivesNoPointsAndAnEmptyView) {

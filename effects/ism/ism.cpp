@@ -21,15 +21,16 @@
 #include "ism_atlas_view.comp.h"
 #include "ism_blur_x.comp.h"
 #include "ism_blur_y.comp.h"
+#include "ism_blur_y_low.comp.h"
 #include "ism_bounce.comp.h"
 #include "ism_bounce_classic.comp.h"
 #include "ism_classic_atlas_view.comp.h"
-#include "ism_clear.comp.h"
 #include "ism_gather.comp.h"
 #include "ism_gather_classic.comp.h"
 #include "ism_params.h"
-#include "ism_pull.comp.h"
+#include "ism_pull_push.comp.h"
 #include "ism_splat.comp.h"
+#include "ism_upsample.comp.h"
 #include "ism_vpl.comp.h"
 
 namespace {
@@ -59,7 +60,7 @@ int log2i(int v) {
 // The graph-fixed configuration, derived once per prepare().
 struct Config {
   int vpls = 256, padded = 256, block = 4, perPixel = 16, res = 64, perRow = 16, rows = 16;
-  int perIsm = 1024, levels = 2, rsm = 64, splat = 1, blurExtra = 0, bounces = 1;
+  int perIsm = 1024, levels = 2, rsm = 64, splat = 1, blurExtra = 0, bounces = 1, scale = 1;
   int total() const { return vpls * bounces; }  // VPLs of all bounces (one tile each)
   bool classic = false;
   uint32_t atlasWidth() const { return uint32_t(perRow * res); }
@@ -137,6 +138,10 @@ class IsmEffect : public gi::Effect {
          true},
         {"splat_scale", SettingType::Float, 1.0, 0.0, 8.0,
          "scales the splat radius computed from the point's footprint", false},
+        {"gather_scale", SettingType::Int, 1, 1, 4,
+         "gather and blur at 1 / gather_scale of the resolution (each pixel stands for the "
+         "G-buffer pixel at its scaled position), then a geometry-aware bilinear upsample",
+         true},
         {"blur_radius", SettingType::Int, 0, 0, 8,
          "blur taps beyond the k that cancel the block pattern, each side", true},
         {"blur_tolerance", SettingType::Float, 0.05, 0.0, 1.0,
@@ -166,9 +171,12 @@ class IsmEffect : public gi::Effect {
     c.rsm = s.integer("rsm_resolution");
     c.splat = s.integer("splat_radius");
     c.blurExtra = s.integer("blur_radius");
+    c.scale = std::clamp(s.integer("gather_scale"), 1, 4);
     c.classic = s.option("mode") == "classic";
     cfg_ = c;
     nearest_ = ctx.nearestSampler();
+    // The engine keeps at least the points asked for: without the cap every subset fits.
+    const bool wrap = uint64_t(c.total()) * uint64_t(c.perIsm) > gi::ism::kMaxPoints;
     if (!c.classic)
       ctx.requestSurfacePoints(uint32_t(
           std::min<uint64_t>(uint64_t(c.total()) * uint64_t(c.perIsm), gi::ism::kMaxPoints)));
@@ -183,15 +191,14 @@ class IsmEffect : public gi::Effect {
         vk, spv(std::begin(ism_vpl_comp), std::end(ism_vpl_comp)),
         {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, tex}, {5, ssbo}, {6, ssbo}});
     if (!c.classic) {
-      clear_ = gi::vk::Pipeline::compute(
-          vk, spv(std::begin(ism_clear_comp), std::end(ism_clear_comp)), {{0, img}});
-      splat_ = gi::vk::Pipeline::compute(
-          vk, spv(std::begin(ism_splat_comp), std::end(ism_splat_comp)),
-          {{1, ubo}, {2, ubo}, {3, ssbo}, {4, img}}, sizeof(int32_t), {uint32_t(c.splat)});
-      for (uint32_t push = 0; push < 2; ++push)
-        pullPush_[push] =
-            gi::vk::Pipeline::compute(vk, spv(std::begin(ism_pull_comp), std::end(ism_pull_comp)),
-                                      {{1, ubo}, {2, img}, {3, img}}, 3 * sizeof(int32_t), {push});
+      splat_ =
+          gi::vk::Pipeline::compute(vk, spv(std::begin(ism_splat_comp), std::end(ism_splat_comp)),
+                                    {{1, ubo}, {2, ubo}, {3, ssbo}, {4, img}}, sizeof(int32_t),
+                                    {uint32_t(c.splat), uint32_t(wrap ? 1 : 0)});
+      if (c.levels > 0)
+        pullPush_ = gi::vk::Pipeline::compute(
+            vk, spv(std::begin(ism_pull_push_comp), std::end(ism_pull_push_comp)),
+            {{1, ubo}, {2, img}}, 2 * sizeof(int32_t), {uint32_t(c.levels)});
     }
     const std::vector<gi::vk::Binding> bounceBindings = {{1, ubo}, {2, ubo},  {3, ssbo}, {4, ssbo},
                                                          {5, tex}, {6, ssbo}, {7, ssbo}};
@@ -213,7 +220,8 @@ class IsmEffect : public gi::Effect {
                      : gi::vk::Pipeline::compute(
                            vk, spv(std::begin(ism_atlas_view_comp), std::end(ism_atlas_view_comp)),
                            {{0, tex}, {1, img}});
-    const std::vector<uint32_t> gatherSpec = {uint32_t(c.perPixel), uint32_t(c.block)};
+    const std::vector<uint32_t> gatherSpec = {uint32_t(c.perPixel), uint32_t(c.block),
+                                              uint32_t(c.scale)};
     const std::vector<gi::vk::Binding> gatherBindings = {{0, ubo}, {1, ubo}, {2, ubo}, {3, tex},
                                                          {4, tex}, {5, tex}, {6, img}};
     gather_ =
@@ -226,13 +234,23 @@ class IsmEffect : public gi::Effect {
                                         gatherBindings, 0, gatherSpec);
     // K taps from -K/2 cover each phase of a K-periodic pattern exactly once.
     const int lo = -c.block / 2 - c.blurExtra, hi = c.block - 1 - c.block / 2 + c.blurExtra;
-    const std::vector<uint32_t> blurSpec = {uint32_t(lo), uint32_t(hi)};
+    const std::vector<uint32_t> blurSpec = {uint32_t(lo), uint32_t(hi), uint32_t(c.scale)};
     blurX_ =
         gi::vk::Pipeline::compute(vk, spv(std::begin(ism_blur_x_comp), std::end(ism_blur_x_comp)),
                                   {{0, ubo}, {1, ubo}, {2, tex}, {3, img}}, 0, blurSpec);
-    blurY_ = gi::vk::Pipeline::compute(
-        vk, spv(std::begin(ism_blur_y_comp), std::end(ism_blur_y_comp)),
-        {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, tex}, {5, img}}, 0, blurSpec);
+    if (c.scale == 1) {
+      blurY_ = gi::vk::Pipeline::compute(
+          vk, spv(std::begin(ism_blur_y_comp), std::end(ism_blur_y_comp)),
+          {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, tex}, {5, img}}, 0, blurSpec);
+    } else {
+      blurY_ = gi::vk::Pipeline::compute(
+          vk, spv(std::begin(ism_blur_y_low_comp), std::end(ism_blur_y_low_comp)),
+          {{0, ubo}, {1, ubo}, {2, tex}, {3, img}}, 0, blurSpec);
+      upsample_ = gi::vk::Pipeline::compute(
+          vk, spv(std::begin(ism_upsample_comp), std::end(ism_upsample_comp)),
+          {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, tex}, {5, tex}, {6, tex}, {7, img}}, 0,
+          {uint32_t(c.scale)});
+    }
     if (!uniforms_)
       uniforms_ =
           gi::vk::Buffer(vk, sizeof(gi::ism::Uniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true);
@@ -249,7 +267,7 @@ class IsmEffect : public gi::Effect {
                  const gi::SettingValues& settings) override {
     struct Io {
       gi::TextureHandle rsmDepth, rsmPos, rsmNormal, rsmFlux, atlas, depth, normal, albedo,
-          material, raw, half, indirect, atlasView;
+          material, raw, half, low, indirect, atlasView;
       gi::BufferHandle cdf, vpls, points, shade;
     };
     auto io = std::make_shared<Io>();
@@ -259,6 +277,8 @@ class IsmEffect : public gi::Effect {
     const VkSampler nearest = ctx.nearestSampler();
     const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
     const VkBuffer params = uniforms_.handle();
+    // The gathering's resolution (gather_scale): the raw and blurred textures.
+    const gi::TextureDesc rawDesc{kRawFormat, gi::SizeClass::OutputRelative, 1.0f / float(c.scale)};
     auto absolute = [](VkFormat f, uint32_t w, uint32_t h, uint32_t mips = 1) {
       gi::TextureDesc d{f, gi::SizeClass::Absolute, 1.0f, w, h};
       d.mips = mips;
@@ -316,26 +336,33 @@ class IsmEffect : public gi::Effect {
     // 3. One shadow map per VPL in an atlas: imperfect (points + pull-push) or classic; and the
     // next bounces' VPLs from points lit by the previous bounce (their maps follow).
     if (!c.classic) {
+      // Cleared by a transfer (llvmpipe fills memory far faster than a compute pass stores
+      // texels); one clear for every bounce's tiles: the later splats only add points.
+      graph.addPass(
+          "ism_clear",
+          [&](gi::PassBuilder& b) {
+            io->atlas = b.write(
+                b.create("ism_atlas", absolute(kAtlasFormat, c.atlasWidth(), c.atlasHeight())),
+                gi::TextureUsage::TransferDst);
+          },
+          [io](gi::PassContext& pc) {
+            const VkClearColorValue empty{.uint32 = {gi::ism::kEmpty, 0u, 0u, 0u}};
+            const VkImageSubresourceRange range{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+            vkCmdClearColorImage(pc.cmd(), pc.image(io->atlas),
+                                 VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &empty, 1, &range);
+          });
       graph.addPass(
           "ism_splat",
           [&](gi::PassBuilder& b) {
             io->vpls = b.read(io->vpls, gi::BufferUsage::Uniform);
             io->points = b.read(bb.buffer(res::kSurfacePoints), gi::BufferUsage::StorageRead);
-            io->atlas =
-                b.write(b.create("ism_atlas", absolute(kAtlasFormat, c.atlasWidth(),
-                                                       c.atlasHeight(), uint32_t(c.levels + 1))),
-                        gi::TextureUsage::StorageWrite, gi::Subresource::mipLevel(0));
+            io->atlas = b.read(io->atlas, gi::TextureUsage::StorageRead);
+            io->atlas = b.write(io->atlas, gi::TextureUsage::StorageWrite);
           },
           [this, io, c](gi::PassContext& pc) {
             uploaded_.atlas.w = float(pc.bufferSize(io->points) / (2 * sizeof(glm::vec4)));
             uniforms_.write(&uploaded_.atlas, sizeof(glm::vec4),
                             offsetof(gi::ism::Uniforms, atlas));
-            // One clear for every bounce's tiles: the later splats only add points.
-            const gi::Subresource mip0 = gi::Subresource::mipLevel(0);
-            gi::vk::DescriptorWriter clear;
-            clear.storageImage(0, pc.view(io->atlas, mip0));
-            pc.dispatch(clear_, clear, pc.extent(io->atlas), kGroupX, kGroupY);
-            pc.barrier(io->atlas, mip0);
             splat(pc, *io, c, 0);
           });
       addPullPush(graph, io, c, 0, "ism_pull_push");
@@ -398,8 +425,7 @@ class IsmEffect : public gi::Effect {
           io->normal = b.read(bb.texture(res::kNormal));
           io->vpls = b.read(io->vpls, gi::BufferUsage::Uniform);
           io->atlas = b.read(io->atlas, gi::TextureUsage::Sampled, gi::Subresource::mipLevel(0));
-          io->raw = b.write(b.create("ism_raw", gi::TextureDesc{kRawFormat}),
-                            gi::TextureUsage::StorageWrite);
+          io->raw = b.write(b.create("ism_raw", rawDesc), gi::TextureUsage::StorageWrite);
         },
         [this, io, c, frame, nearest, params, ubo](gi::PassContext& pc) {
           gi::vk::DescriptorWriter w;
@@ -425,20 +451,44 @@ class IsmEffect : public gi::Effect {
           io->raw = b.read(io->raw);
           io->albedo = b.read(bb.texture(res::kAlbedo));
           io->material = b.read(bb.texture(res::kMaterial));
-          io->half = b.write(b.create("ism_blur_x", gi::TextureDesc{kRawFormat}),
-                             gi::TextureUsage::StorageWrite);
+          io->half = b.write(b.create("ism_blur_x", rawDesc), gi::TextureUsage::StorageWrite);
+          if (c.scale > 1) {
+            io->depth = b.read(bb.texture(res::kDepth));
+            io->normal = b.read(bb.texture(res::kNormal));
+            io->low = b.write(b.create("ism_blur_y", rawDesc), gi::TextureUsage::StorageWrite);
+          }
           io->indirect = b.write(b.create(res::kIndirect, gi::TextureDesc{kOutFormat}),
                                  gi::TextureUsage::StorageWrite);
         },
-        [this, io, frame, nearest, params, ubo](gi::PassContext& pc) {
-          const VkExtent2D e = pc.extent(io->indirect);
+        [this, io, c, frame, nearest, params, ubo](gi::PassContext& pc) {
+          const VkExtent2D e = pc.extent(io->indirect), low = pc.extent(io->half);
           gi::vk::DescriptorWriter x;
           x.buffer(0, ubo, frame)
               .buffer(1, ubo, params)
               .sampled(2, pc.view(io->raw), nearest)
               .storageImage(3, pc.view(io->half));
-          pc.dispatch(blurX_, x, e, kGroupX, kGroupY);
+          pc.dispatch(blurX_, x, low, kGroupX, kGroupY);
           gi::vk::storageWriteToSampledRead(pc.cmd(), pc.image(io->half));
+          if (c.scale > 1) {  // y at the gathering's resolution, then upsampled and reflected
+            gi::vk::DescriptorWriter y;
+            y.buffer(0, ubo, frame)
+                .buffer(1, ubo, params)
+                .sampled(2, pc.view(io->half), nearest, VK_IMAGE_LAYOUT_GENERAL)
+                .storageImage(3, pc.view(io->low));
+            pc.dispatch(blurY_, y, low, kGroupX, kGroupY);
+            gi::vk::storageWriteToSampledRead(pc.cmd(), pc.image(io->low));
+            gi::vk::DescriptorWriter u;
+            u.buffer(0, ubo, frame)
+                .buffer(1, ubo, params)
+                .sampled(2, pc.view(io->low), nearest, VK_IMAGE_LAYOUT_GENERAL)
+                .sampled(3, pc.view(io->depth), nearest)
+                .sampled(4, pc.view(io->normal), nearest)
+                .sampled(5, pc.view(io->albedo), nearest)
+                .sampled(6, pc.view(io->material), nearest)
+                .storageImage(7, pc.view(io->indirect));
+            pc.dispatch(upsample_, u, e, kGroupX, kGroupY);
+            return;
+          }
           gi::vk::DescriptorWriter y;
           y.buffer(0, ubo, frame)
               .buffer(1, ubo, params)
@@ -474,26 +524,20 @@ class IsmEffect : public gi::Effect {
     graph.addPass(
         name,
         [&](gi::PassBuilder& b) {
-          // Reads the splatted level 0, writes every level (level 0 in place).
+          // Every level of a 64 x 64 block in one workgroup (ism_pull_push.comp), in place.
           io->atlas = b.read(io->atlas, gi::TextureUsage::StorageRead);
           io->atlas = b.write(io->atlas, gi::TextureUsage::StorageWrite);
         },
         [this, io, c, bounce](gi::PassContext& pc) {
-          auto run = [&](int push, int level) {
-            const std::array<int32_t, 3> pcs = {level, bounce * c.vpls, (bounce + 1) * c.vpls};
-            vkCmdPushConstants(pc.cmd(), pullPush_[push].layout(), VK_SHADER_STAGE_ALL, 0,
-                               sizeof pcs, pcs.data());
-            gi::vk::DescriptorWriter w;
-            w.buffer(1, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms_.handle())
-                .storageImage(2, pc.view(io->atlas, gi::Subresource::mipLevel(uint32_t(level))))
-                .storageImage(3,
-                              pc.view(io->atlas, gi::Subresource::mipLevel(uint32_t(level + 1))));
-            pc.dispatch(pullPush_[push], w,
-                        pc.extent(io->atlas, uint32_t(push ? level : level + 1)), kGroupX, kGroupY);
-            pc.barrier(io->atlas, gi::Subresource::all());
-          };
-          for (int l = 0; l < c.levels; ++l) run(0, l);
-          for (int l = c.levels - 1; l >= 0; --l) run(1, l);
+          const std::array<int32_t, 2> tiles = {bounce * c.vpls, (bounce + 1) * c.vpls};
+          vkCmdPushConstants(pc.cmd(), pullPush_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof tiles,
+                             tiles.data());
+          gi::vk::DescriptorWriter w;
+          w.buffer(1, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms_.handle())
+              .storageImage(2, pc.view(io->atlas));
+          pc.descriptors().bind(pc.cmd(), pullPush_, w);
+          const VkExtent2D e = pc.extent(io->atlas);
+          vkCmdDispatch(pc.cmd(), (e.width + 63) / 64, (e.height + 63) / 64, 1);
         });
   }
 
@@ -628,9 +672,8 @@ class IsmEffect : public gi::Effect {
   }
 
   Config cfg_;
-  gi::vk::Pipeline vpl_, clear_, splat_, bounce_, gather_, blurX_, blurY_, atlasView_;
+  gi::vk::Pipeline vpl_, splat_, pullPush_, upsample_, bounce_, gather_, blurX_, blurY_, atlasView_;
   VkSampler nearest_ = VK_NULL_HANDLE;
-  std::array<gi::vk::Pipeline, 2> pullPush_;
   gi::vk::Buffer uniforms_, vplBuffer_;
   gi::ism::Uniforms uploaded_{};
 };

@@ -2,15 +2,18 @@
 // y (AXIS 1), taps LO..HI around the pixel (K taps cover every phase once; the blur_radius
 // setting widens it), averaging only neighbours within the tolerance (x view distance) of the centre's
 // tangent plane and whose normal is close. AXIS 1 then reflects: indirect = diffuse albedo / pi x irradiance.
+// SCALE > 1 (gathered at 1 / SCALE resolution): runs at that resolution, and AXIS 1 with LOW
+// defined keeps the raw layout (irradiance, distance, normal) for ism_upsample.comp instead.
 #include "common.glsl"
 #include "ism_common.glsl"
 
 layout(constant_id = 0) const int LO = -2;
 layout(constant_id = 1) const int HI = 1;
+layout(constant_id = 2) const int SCALE = 1;
 layout(local_size_x = 32, local_size_y = 16) in;
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 layout(set = 0, binding = 2) uniform usampler2D inRaw;
-#if AXIS == 0
+#if AXIS == 0 || defined(LOW)
 layout(set = 0, binding = 3, rgba32ui) uniform writeonly uimage2D outRaw;
 #else
 layout(set = 0, binding = 3) uniform sampler2D gAlbedo;
@@ -30,13 +33,13 @@ vec3 unpackValue(uvec4 t) { return vec3(unpackHalf2x16(t.x), unpackHalf2x16(t.y)
 
 // View-space position of pixel q at view distance `dist`.
 vec3 viewPoint(ivec2 q, float dist) {
-  vec2 uv = (vec2(q) + 0.5) * frame.viewport.zw;
+  vec2 uv = (vec2(min(q * SCALE, ivec2(frame.viewport.xy) - 1)) + 0.5) * frame.viewport.zw;
   return normalize(viewPositionFromDepth(frame.invProj, uv, 0.5)) * dist;
 }
 
 void main() {
   ivec2 p = ivec2(gl_GlobalInvocationID.xy);
-  ivec2 size = ivec2(frame.viewport.xy);
+  ivec2 size = textureSize(inRaw, 0);  // the viewport / SCALE, rounded
   if (p.x >= size.x || p.y >= size.y) return;
   uvec4 c = texelFetch(inRaw, p, 0);
   float z = uintBitsToFloat(c.z);
@@ -57,7 +60,7 @@ void main() {
     wsum += w;
   }
   vec3 e = z > 0.0 ? sum / max(wsum, 1.0) : vec3(0.0);
-#if AXIS == 0
+#if AXIS == 0 || defined(LOW)
   imageStore(outRaw, p, uvec4(packHalf2x16(e.rg), packHalf2x16(vec2(e.b, 0.0)), c.z, c.w));
 #else
   vec3 diffuse = texelFetch(gAlbedo, p, 0).rgb * (1.0 - texelFetch(gMaterial, p, 0).g);

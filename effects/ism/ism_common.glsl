@@ -29,12 +29,19 @@ void ismBasis(vec3 n, out vec3 s, out vec3 u) {
   u = cross(s, n);
 }
 
+// First texel of tile `tile`. Row and column in float (exact below 2^24): llvmpipe divides
+// integers lane by lane (a scalar division per lane).
+ivec2 ismTileOrigin(uint tile) {
+  float row = floor((float(tile) + 0.5) / ism.atlas.y);
+  return ivec2(vec2(float(tile) - row * ism.atlas.y, row) * ism.atlas.x);
+}
+
 // Texel of direction `dir` (unit, cosine c = dot(dir, n) > 0) in tile `tile` of the atlas.
 ivec2 ismTexel(uint tile, vec3 dir, vec3 s, vec3 u, float c) {
   vec2 p = vec2(dot(dir, s), dot(dir, u)) / max(1.0 + c, 1e-6);
-  int res = int(ism.atlas.x), perRow = int(ism.atlas.y);
+  int res = int(ism.atlas.x);
   ivec2 t = clamp(ivec2((p * 0.5 + 0.5) * float(res)), ivec2(0), ivec2(res - 1));
-  return ivec2(int(tile) % perRow, int(tile) / perRow) * res + t;
+  return ismTileOrigin(tile) + t;
 }
 
 uint ismHash(uint x) {

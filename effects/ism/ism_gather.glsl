@@ -6,11 +6,14 @@
 // with a constant + slope bias. Output texel (RGBA32UI): x, y irradiance (half rg, half b),
 // z view distance (float bits, 0: sky), w view normal (octahedral snorm 16x2).
 // ISM_CLASSIC: the maps are accurate paraboloid depth maps (D32 reverse-Z, near..far).
+// SCALE > 1: gathered at 1 / SCALE resolution, output pixel p for G-buffer pixel p x SCALE
+// (ism_upsample.comp brings it back to full resolution).
 #include "common.glsl"
 #include "ism_common.glsl"
 
 layout(constant_id = 0) const int PER_PIXEL = 16;  // ceil(N / K^2)
 layout(constant_id = 1) const int K = 4;
+layout(constant_id = 2) const int SCALE = 1;
 layout(local_size_x = 32, local_size_y = 16) in;
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 layout(set = 0, binding = 2, std140) uniform Vpls { Vpl vpls[ISM_VPL_SLOTS]; };
@@ -29,16 +32,17 @@ uint packNormal(vec3 n) {
 void main() {
   uint phase = gl_WorkGroupID.z;
   ivec2 p = ivec2(gl_GlobalInvocationID.xy) * K + ivec2(int(phase) % K, int(phase) / K);
-  ivec2 size = ivec2(frame.viewport.xy);
+  ivec2 size = imageSize(outRaw);  // the viewport / SCALE, rounded
   if (p.x >= size.x || p.y >= size.y) return;
-  float depth = texelFetch(gDepth, p, 0).r;
+  ivec2 g = min(p * SCALE, ivec2(frame.viewport.xy) - 1);  // the G-buffer pixel it stands for
+  float depth = texelFetch(gDepth, g, 0).r;
   if (isSky(depth)) {
     imageStore(outRaw, p, uvec4(0u));
     return;
   }
-  vec2 uv = (vec2(p) + 0.5) * frame.viewport.zw;
+  vec2 uv = (vec2(g) + 0.5) * frame.viewport.zw;
   vec3 viewPos = viewPositionFromDepth(frame.invProj, uv, depth);
-  vec3 viewN = safeNormalize(texelFetch(gNormal, p, 0).xyz, vec3(0.0, 0.0, 1.0));
+  vec3 viewN = safeNormalize(texelFetch(gNormal, g, 0).xyz, vec3(0.0, 0.0, 1.0));
   vec3 x = (frame.invView * vec4(viewPos, 1.0)).xyz;
   vec3 n = safeNormalize(mat3(frame.invView) * viewN, vec3(0.0, 1.0, 0.0));
   vec3 e = vec3(0.0);

@@ -17,7 +17,7 @@ inline constexpr int kMaxVpls = 1024;  // the VPL table is a uniform buffer (64 
 inline constexpr int kMaxBlock = 8;    // interleaving block k (k x k VPL subsets)
 inline constexpr int kVplSlots = kMaxVpls + kMaxBlock * kMaxBlock;  // padded to whole blocks
 inline constexpr int kMaxIsmResolution = 512;
-inline constexpr int kMaxPullPushLevels = 6;
+inline constexpr int kMaxPullPushLevels = 6;  // ism_pull_push.comp: 64 x 64 blocks
 inline constexpr int kMaxBounces = 3;
 // Surface points shaded per extra bounce as candidates for its VPLs (ism_bounce.glsl).
 inline constexpr uint32_t kShadePoints = 2048;

@@ -11,6 +11,9 @@
 #include "ism_common.glsl"
 
 layout(constant_id = 0) const int MAX_SPLAT = 1;
+// 1 when the engine's points are fewer than VPLs x points per ISM (capped): the subsets wrap.
+// Otherwise no modulo (llvmpipe divides integers lane by lane).
+layout(constant_id = 1) const int WRAP = 1;
 layout(local_size_x = 256) in;
 layout(push_constant) uniform Push { int base; };  // first VPL of this bounce
 layout(set = 0, binding = 2, std140) uniform Vpls { Vpl vpls[ISM_VPL_SLOTS]; };
@@ -23,7 +26,7 @@ void main() {
   uint perIsm = uint(ism.atlas.z), count = uint(ism.atlas.w);
   Vpl vpl = vpls[v];
   if (j >= perIsm || count == 0u || vpl.position.w < 0.5) return;
-  uint idx = (v * perIsm + j) % count;
+  uint idx = WRAP == 1 ? (v * perIsm + j) % count : v * perIsm + j;
   vec4 pa = points[2u * idx];
   vec3 w = pa.xyz - vpl.position.xyz;
   float d = length(w);
@@ -48,12 +51,12 @@ void main() {
     float texelOmega = 16.0 / (res * res) / ((1.0 + r2) * (1.0 + r2));
     float omega = pa.w / (d * d);
     int radius = clamp(int(0.5 * sqrt(omega / texelOmega) * ism.blur.z), 0, MAX_SPLAT);
-    int perRow = int(ism.atlas.y);
-    ivec2 lo = ivec2(int(tile) % perRow, int(tile) / perRow) * int(res);
+    ivec2 lo = ismTileOrigin(tile);
     ivec2 hi = lo + ivec2(int(res) - 1);
-    for (int y = -MAX_SPLAT; y <= MAX_SPLAT; ++y)
-      for (int x = -MAX_SPLAT; x <= MAX_SPLAT; ++x)
-        if (abs(x) <= radius && abs(y) <= radius)
-          imageAtomicMin(atlas, clamp(t + ivec2(x, y), lo, hi), depth);
+    // Loops bounded by the lanes' own radius: llvmpipe runs a loop only while some lane is
+    // active, so 8 points of radius 0 cost one atomic each, not (2 MAX_SPLAT + 1)^2 masked ones.
+    for (int y = -radius; y <= radius; ++y)
+      for (int x = -radius; x <= radius; ++x)
+        imageAtomicMin(atlas, clamp(t + ivec2(x, y), lo, hi), depth);
   }
 }

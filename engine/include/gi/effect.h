@@ -51,8 +51,8 @@ inline constexpr const char* kOutput = "output";  // RGBA8 tonemapped final imag
 inline constexpr const char* kFloor = "floor";    // RGBA8 cost-floor pass output
 // Buffer: the point representation (gi/surface_points.h), two vec4 per point: world
 // position + represented area, world normal + material index. Exists when an effect asked
-// for points (EffectContext::requestSurfacePoints); re-evaluated every frame from the
-// deformed vertices, so points follow animated meshes.
+// for points (EffectContext::requestSurfacePoints); re-evaluated from the deformed vertices
+// in each frame after the pose changed (not when it did not), so points follow animated meshes.
 inline constexpr const char* kSurfacePoints = "surface_points";
 inline constexpr const char* kPointsView = "points";  // RGBA16F debug view of the points
 // The environment (environment.glsl): equirect RGBA32F radiance map (Sky/Constant tabulated)

@@ -87,6 +87,9 @@ class Renderer {
   // positions/normals the "surface_points" pass wrote in the last frame that ran it.
   const SurfacePointSet& surfacePoints() const;
   std::vector<SurfacePointSample> readSurfacePoints();
+  // Frames whose "surface_points" pass re-evaluated the points: only those after the pose
+  // changed (animated instances, skinning or morph weights); a static scene's points once.
+  uint64_t surfacePointEvaluations() const;
   const std::vector<PassTiming>& lastTimings() const;
   std::vector<std::string> passNames() const;        // passes the graph executes, in order
   std::vector<std::string> culledPassNames() const;  // passes declared but culled

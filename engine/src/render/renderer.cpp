@@ -749,6 +749,9 @@ const SurfacePointSet& Renderer::surfacePoints() const {
   static const SurfacePointSet kNone;
   return impl_->surfacePoints ? impl_->surfacePoints->set() : kNone;
 }
+uint64_t Renderer::surfacePointEvaluations() const {
+  return impl_->surfacePoints ? impl_->surfacePoints->evaluations() : 0;
+}
 std::vector<SurfacePointSample> Renderer::readSurfacePoints() {
   if (!impl_->surfacePoints) return {};
   return impl_->surfacePoints->read(impl_->ctx);

@@ -339,6 +339,7 @@ void SceneGpu::setTime(double seconds) {
   for (size_t i = 0; i < instanceNodes_.size(); ++i) {
     GpuInstance& inst = instances_[i];
     const glm::mat4& world = pose_.nodes[instanceNodes_[i]].world;
+    if (inst.model != world) ++poseVersion_;
     inst.model = world;
     inst.normalMatrix = glm::mat4(cofactor3(world));
   }
@@ -375,6 +376,7 @@ void SceneGpu::updateDeformations() {
                            size_t(d.jointFirst) * sizeof(glm::mat4));
         d.lastJoints = std::move(joints);
         d.dirty = true;
+        ++poseVersion_;
       }
     }
     if (!mesh.morphTargets.empty()) {
@@ -385,6 +387,7 @@ void SceneGpu::updateDeformations() {
                           size_t(d.srcFirst) * sizeof(Vertex));
         d.lastWeights = weights;
         d.dirty = true;
+        ++poseVersion_;
       }
     }
   }

@@ -49,6 +49,9 @@ class SceneGpu final : public GpuScene {
   // Poses the scene at `seconds` (instance matrices, joints, morphed rest vertices).
   void setTime(double seconds);
   const Scene& pose() const { return pose_; }
+  // Bumped whenever the posed geometry changes (an instance matrix or a deformed mesh's joints
+  // or morph weights): work derived from it (the surface points) is redone only then.
+  const uint64_t* poseVersion() const { return &poseVersion_; }
   const Scene& source() const { return scene_; }
 
   // Skinned/morphed mesh instances: each owns a copy of its mesh's vertices in the vertex
@@ -95,6 +98,7 @@ class SceneGpu final : public GpuScene {
   std::vector<GpuInstance> instances_;
   std::vector<glm::mat4> rendered_;  // model matrices of the last rendered frame
   bool instancesDirty_ = true;
+  uint64_t poseVersion_ = 1;
   std::vector<Deformed> deformed_;
   std::vector<SurfacePointsPass::InstanceRef> instanceRefs_;
   std::vector<Material> materials_;

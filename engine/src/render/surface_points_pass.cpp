@@ -73,6 +73,9 @@ void SurfacePointsPass::addPasses(FrameGraph& graph, BufferHandle vertices, cons
         *out = b.write(points, BufferUsage::StorageWrite);
       },
       [this, in](PassContext& pc) {
+        // The buffer is imported (persistent): an unchanged pose leaves valid points in it.
+        const uint64_t version = in.poseVersion ? *in.poseVersion : 0;
+        if (evaluated_ && version != 0 && version == evaluatedVersion_) return;
         vk::DescriptorWriter w;
         w.buffer(0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, samples_.handle())
             .buffer(1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, in.instances)
@@ -87,6 +90,8 @@ void SurfacePointsPass::addPasses(FrameGraph& graph, BufferHandle vertices, cons
         vkCmdPushConstants(pc.cmd(), update_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof push, &push);
         dispatch256(pc.cmd(), count());
         evaluated_ = true;
+        evaluatedVersion_ = version;
+        ++evaluations_;
       });
   bb.put(resources::kSurfacePoints, *out);
 

@@ -1,6 +1,6 @@
 // The engine's point representation on the GPU (gi/surface_points.h): the "surface_points"
-// compute pass that re-evaluates every point from the current vertices each frame, published
-// as the well-known buffer resources::kSurfacePoints, and its debug view "points". Both
+// compute pass that re-evaluates every point from the current vertices when the pose changed,
+// published as the well-known buffer resources::kSurfacePoints, and its debug view "points". Both
 // passes are culled unless something reads them (an ISM-style effect, or the view).
 #pragma once
 
@@ -25,6 +25,9 @@ class SurfacePointsPass {
   struct Buffers {
     VkBuffer vertices, indices, instances, frameUniforms;
     VkSampler nearest;
+    // The scene's pose version (SceneGpu::poseVersion), read when the pass records: the
+    // points are re-evaluated only when it changed since the last evaluation.
+    const uint64_t* poseVersion = nullptr;
   };
 
   // Samples `count` points over `scene` at its current pose and uploads them.
@@ -41,12 +44,15 @@ class SurfacePointsPass {
   // frame ran the "surface_points" pass (it is culled when nothing reads the points).
   std::vector<SurfacePointSample> read(vk::Context& ctx) const;
   bool evaluated() const { return evaluated_; }
+  // How many frames re-evaluated the points (a static pose is evaluated once).
+  uint64_t evaluations() const { return evaluations_; }
 
  private:
   SurfacePointSet set_;
   vk::Buffer samples_, points_;
   vk::Pipeline update_, view_;
   bool evaluated_ = false;
+  uint64_t evaluations_ = 0, evaluatedVersion_ = 0;
 };
 
 }  // namespace gi

@@ -20,9 +20,9 @@ class SurfacePointsEffect final : public Effect {
   void addPasses(FrameGraph& graph, EffectContext& ctx, const SettingValues&) override {
     if (!s_.surfacePoints) return;
     SceneGpu& sc = s_.scene;
-    s_.surfacePoints->addPasses(
-        graph, sc.currentVertices(),
-        {sc.vertices(), sc.indices(), sc.instances(), ctx.frameUniforms(), s_.nearest});
+    s_.surfacePoints->addPasses(graph, sc.currentVertices(),
+                                {sc.vertices(), sc.indices(), sc.instances(), ctx.frameUniforms(),
+                                 s_.nearest, sc.poseVersion()});
   }
 
  private:

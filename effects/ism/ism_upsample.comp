@@ -1,0 +1,67 @@
+#version 460
+// Geometry-aware upsampling of the irradiance gathered and blurred at 1 / SCALE resolution
+// (gather_scale > 1): low-resolution pixel q stands for G-buffer pixel q x SCALE. Each pixel
+// takes the bilinear mix of its 4 nearest low-resolution samples, keeping only those near its
+// tangent plane with a similar normal (the blur's test); when none passes, the plain bilinear
+// mix (a thin feature no sample landed on). Then reflects like the blur's y pass:
+// indirect = diffuse albedo / pi x irradiance.
+#extension GL_GOOGLE_include_directive : require
+#include "common.glsl"
+#include "ism_common.glsl"
+
+layout(constant_id = 0) const int SCALE = 2;
+layout(local_size_x = 32, local_size_y = 16) in;
+layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
+layout(set = 0, binding = 2) uniform usampler2D lowRaw;
+layout(set = 0, binding = 3) uniform sampler2D gDepth;
+layout(set = 0, binding = 4) uniform sampler2D gNormal;
+layout(set = 0, binding = 5) uniform sampler2D gAlbedo;
+layout(set = 0, binding = 6) uniform sampler2D gMaterial;
+layout(set = 0, binding = 7, rgba16f) uniform writeonly image2D outIndirect;
+
+vec2 signNotZero(vec2 v) { return vec2(v.x >= 0.0 ? 1.0 : -1.0, v.y >= 0.0 ? 1.0 : -1.0); }
+vec3 unpackNormal(uint q) {
+  vec2 e = unpackSnorm2x16(q);
+  vec3 n = vec3(e, 1.0 - abs(e.x) - abs(e.y));
+  float t = max(-n.z, 0.0);
+  n.xy -= t * signNotZero(n.xy);
+  return safeNormalize(n, vec3(0.0, 0.0, 1.0));
+}
+
+void main() {
+  ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+  ivec2 size = ivec2(frame.viewport.xy);
+  if (p.x >= size.x || p.y >= size.y) return;
+  float depth = texelFetch(gDepth, p, 0).r;
+  vec3 viewPos = viewPositionFromDepth(frame.invProj, (vec2(p) + 0.5) * frame.viewport.zw, depth);
+  vec3 n = safeNormalize(texelFetch(gNormal, p, 0).xyz, vec3(0.0, 0.0, 1.0));
+  float z = length(viewPos);
+  ivec2 lowSize = textureSize(lowRaw, 0);
+  vec2 u = vec2(p) / float(SCALE);
+  ivec2 b = ivec2(floor(u));
+  vec2 f = u - vec2(b);
+  vec3 sum = vec3(0.0), any = vec3(0.0);
+  float wsum = 0.0, asum = 0.0;
+  for (int i = 0; i < 4; ++i) {
+    ivec2 o = ivec2(i & 1, i >> 1);
+    ivec2 q = min(b + o, lowSize - 1);
+    uvec4 t = texelFetch(lowRaw, q, 0);
+    float zt = uintBitsToFloat(t.z);
+    float bil = (o.x == 1 ? f.x : 1.0 - f.x) * (o.y == 1 ? f.y : 1.0 - f.y);
+    vec2 uvq = (vec2(min(q * SCALE, size - 1)) + 0.5) * frame.viewport.zw;
+    vec3 pt = normalize(viewPositionFromDepth(frame.invProj, uvq, 0.5)) * zt;
+    bool same = zt > 0.0 && abs(dot(n, pt - viewPos)) <= ism.blur.x * z &&
+                dot(unpackNormal(t.w), n) >= ism.blur.y;
+    vec3 e = vec3(unpackHalf2x16(t.x), unpackHalf2x16(t.y).x);
+    float w = same ? bil + 1e-6 : 0.0;  // + 1e-6: a passing sample at bilinear weight 0 counts
+    sum += w * e;
+    wsum += w;
+    float wa = zt > 0.0 ? bil : 0.0;
+    any += wa * e;
+    asum += wa;
+  }
+  vec3 e = wsum > 0.0 ? sum / wsum : any / max(asum, 1e-6);
+  vec3 diffuse = texelFetch(gAlbedo, p, 0).rgb * (1.0 - texelFetch(gMaterial, p, 0).g);
+  vec3 outv = isSky(depth) ? vec3(0.0) : min(diffuse * e / 3.14159265, vec3(65000.0));
+  imageStore(outIndirect, p, vec4(outv, 1.0));
+}
