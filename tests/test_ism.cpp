@@ -453,6 +453,38 @@ TEST_F(IsmTest, ClassicMapsUseThisFramesVpls) {
   EXPECT_GT(iou(a, c), 0.85);
 }
 
+// Classic mode with 2 bounces draws maps for the second bounce's VPLs too (their tiles,
+// 16..31 of the atlas, hold distances in over a quarter of their texels: before, only the first
+// bounce's VPLs got maps and the second bounce's light was unshadowed).
+TEST_F(IsmTest, ClassicModeDrawsEveryBouncesMaps) {
+  const Scene s = loadScene(std::string(GI_SOURCE_DIR) + "/assets/scenes/cornell_box.json");
+  EffectOverrides cli;
+  cli.effects = {"ism"};
+  cli.sets = {"ism.vpls=16", "ism.bounces=2", "ism.mode=classic", "ism.ism_resolution=32"};
+  RenderSettings rs;
+  rs.width = kW;
+  rs.height = kH;
+  rs.view = "ism_atlas";
+  rs.effects = resolveEffects(s, nullptr, cli, registry);
+  Renderer r(ctx(), s, rs, &registry);
+  r.renderFrame();
+  const ImageRGBA32F atlas = r.readTarget("ism_atlas");
+  const int res = 32, perRow = 6;  // ceil(sqrt(32)) tiles per row
+  ASSERT_EQ(atlas.width, perRow * res);
+  size_t filled[2] = {0, 0};
+  for (int i = 0; i < 32; ++i)
+    for (int y = 0; y < res; ++y)
+      for (int x = 0; x < res; ++x) {
+        const size_t t = size_t((i / perRow) * res + y) * atlas.width + (i % perRow) * res + x;
+        filled[i / 16] += atlas.pixels[t * 4] > 0.0f;
+      }
+  std::printf("filled texels: bounce 1 %zu, bounce 2 %zu of %d each\n", filled[0], filled[1],
+              16 * res * res);
+  // The disk is pi / 4 of a tile and the box is open to the camera: measured 6475 and 7606.
+  EXPECT_GT(filled[0], size_t(16 * res * res / 4));
+  EXPECT_GT(filled[1], size_t(16 * res * res / 4));
+}
+
 // Glossy receivers: one VPL (a down-facing panel) over a floor, Phong exponent 32. alpha: the
 // angle between the VPL light's mirror direction at a floor point and the direction to the
 // camera (VPL taken at the panel's centre, within 0.25 of the sampled one). A dielectric floor

@@ -374,40 +374,13 @@ class IsmEffect : public gi::Effect {
         addPullPush(graph, io, c, bounce, "ism_pull_push" + n);
       }
     } else {
-      // This frame's VPLs' paraboloid views, written on the GPU (no read-back: the maps are
-      // current, not one frame late).
-      graph.addPass(
-          "ism_classic_views",
-          [&](gi::PassBuilder& b) {
-            io->vpls = b.read(io->vpls, gi::BufferUsage::Uniform);
-            io->classicViews =
-                b.write(b.create("ism_classic_views",
-                                 gi::BufferDesc{gi::kDrawViewStride * VkDeviceSize(c.vpls)}),
-                        gi::BufferUsage::StorageWrite);
-          },
-          [this, io, c, params, ubo, ssbo](gi::PassContext& pc) {
-            const std::array<int32_t, 2> range = {0, c.vpls};
-            vkCmdPushConstants(pc.cmd(), classicViews_.layout(), VK_SHADER_STAGE_ALL, 0,
-                               sizeof range, range.data());
-            gi::vk::DescriptorWriter w;
-            w.buffer(1, ubo, params)
-                .buffer(2, ubo, pc.buffer(io->vpls))
-                .buffer(3, ssbo, pc.buffer(io->classicViews));
-            pc.dispatch(classicViews_, w, {uint32_t(c.vpls), 1}, 64, 1);
-          });
-      graph.addPass(
-          "ism_classic_sm",
-          [&](gi::PassBuilder& b) {
-            ctx.scene().declareRead(b);
-            io->classicViews = b.read(io->classicViews, gi::BufferUsage::Uniform);
-            io->atlas =
-                b.write(b.create("ism_classic_atlas",
-                                 absolute(gi::kSceneDepthFormat, c.atlasWidth(), c.atlasHeight())),
-                        gi::TextureUsage::DepthAttachment);
-          },
-          [this, io, c, cx = &ctx](gi::PassContext& pc) { drawClassic(pc, *cx, *io, c); });
+      addClassicMaps(graph, ctx, io,
+                     absolute(gi::kSceneDepthFormat, c.atlasWidth(), c.atlasHeight()), 0);
       if (c.bounces > 1) io->points = graph.blackboard().buffer(res::kSurfacePoints);
-      for (int bounce = 1; bounce < c.bounces; ++bounce) addBounce(graph, ctx, io, bounce);
+      for (int bounce = 1; bounce < c.bounces; ++bounce) {
+        addBounce(graph, ctx, io, bounce);
+        addClassicMaps(graph, ctx, io, {}, bounce);
+      }
     }
 
     // The atlas as a debug view (culled unless viewed).
@@ -536,6 +509,51 @@ class IsmEffect : public gi::Effect {
         });
   }
 
+  // Classic mode: bounce `bounce`'s VPLs' paraboloid views, written on the GPU from this
+  // frame's VPL table (no read-back: the maps are current, not one frame late), then their
+  // maps drawn from the triangles into their tiles (bounce 0 creates and clears the atlas).
+  template <class IoPtr>
+  void addClassicMaps(gi::FrameGraph& graph, gi::EffectContext& ctx, const IoPtr& io,
+                      const gi::TextureDesc& atlas, int bounce) {
+    const Config c = cfg_;
+    const std::string n = bounce == 0 ? "" : std::to_string(bounce + 1);
+    graph.addPass(
+        "ism_classic_views" + n,
+        [&](gi::PassBuilder& b) {
+          io->vpls = b.read(io->vpls, gi::BufferUsage::Uniform);
+          io->classicViews =
+              b.write(b.create("ism_classic_views" + n,
+                               gi::BufferDesc{gi::kDrawViewStride * VkDeviceSize(c.vpls)}),
+                      gi::BufferUsage::StorageWrite);
+        },
+        [this, io, c, bounce](gi::PassContext& pc) {
+          const std::array<int32_t, 2> range = {bounce * c.vpls, c.vpls};
+          vkCmdPushConstants(pc.cmd(), classicViews_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof range,
+                             range.data());
+          gi::vk::DescriptorWriter w;
+          w.buffer(1, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms_.handle())
+              .buffer(2, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, pc.buffer(io->vpls))
+              .buffer(3, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, pc.buffer(io->classicViews));
+          pc.dispatch(classicViews_, w, {uint32_t(c.vpls), 1}, 64, 1);
+        });
+    graph.addPass(
+        "ism_classic_sm" + n,
+        [&](gi::PassBuilder& b) {
+          ctx.scene().declareRead(b);
+          io->classicViews = b.read(io->classicViews, gi::BufferUsage::Uniform);
+          if (bounce == 0) {
+            io->atlas =
+                b.write(b.create("ism_classic_atlas", atlas), gi::TextureUsage::DepthAttachment);
+          } else {  // keeps the earlier bounces' tiles
+            io->atlas = b.read(io->atlas, gi::TextureUsage::DepthAttachment);
+            io->atlas = b.write(io->atlas, gi::TextureUsage::DepthAttachment);
+          }
+        },
+        [this, io, c, bounce, cx = &ctx](gi::PassContext& pc) {
+          drawClassic(pc, *cx, *io, c, bounce);
+        });
+  }
+
   // Bounce `bounce` + 1's VPLs from points lit by bounce `bounce`'s (ism_bounce.glsl).
   template <class IoPtr>
   void addBounce(gi::FrameGraph& graph, gi::EffectContext& ctx, const IoPtr& io, int bounce) {
@@ -643,18 +661,19 @@ class IsmEffect : public gi::Effect {
     }
   }
 
-  // Classic reference: this frame's VPLs (their views written by ism_classic_views) as
+  // Classic reference: bounce `bounce`'s VPLs (their views written by ism_classic_views) as
   // paraboloid depth maps drawn from the triangles, one atlas tile each.
   template <class IoT>
-  void drawClassic(gi::PassContext& pc, gi::EffectContext& ctx, const IoT& io, const Config& c) {
+  void drawClassic(gi::PassContext& pc, gi::EffectContext& ctx, const IoT& io, const Config& c,
+                   int bounce) {
     std::vector<VkRect2D> tiles;
-    for (int i = 0; i < c.vpls; ++i)
+    for (int i = bounce * c.vpls; i < (bounce + 1) * c.vpls; ++i)
       tiles.push_back({{int32_t((i % c.perRow) * c.res), int32_t((i / c.perRow) * c.res)},
                        {uint32_t(c.res), uint32_t(c.res)}});
     gi::SceneTargets t;
     t.depth = pc.view(io.atlas);
     t.extent = pc.extent(io.atlas);
-    t.clear = true;
+    t.clear = bounce == 0;
     ctx.scene().drawDepthFromBuffer(pc, t, pc.buffer(io.classicViews), tiles);
   }
 
