@@ -453,6 +453,51 @@ TEST_F(IsmTest, ClassicMapsUseThisFramesVpls) {
   EXPECT_GT(iou(a, c), 0.85);
 }
 
+// A moving light in classic mode: the frame at t = 1 after one at t = 0 equals a first frame
+// at t = 1 (the maps follow this frame's VPLs; with last frame's they were placed at t = 0's
+// VPLs, 1.5 away from this frame's, whose distances the maps' then no longer describe), and
+// differs from the frame at t = 0 (the light moves 1.5 in x).
+TEST_F(IsmTest, ClassicMapsFollowAMovingLightInTheSameFrame) {
+  const Scene s = jsonScene("moving_light", R"({
+      "models": [ { "primitive": "plane", "size": 10, "material": { "base_color": [0.8, 0.8, 0.8] } },
+                  { "primitive": "box", "size": [0.6, 1.2, 0.6], "translation": [0, 0.6, -1] },
+                  { "primitive": "plane", "size": 10, "translation": [0, 5, -2], "rotation": [90, 0, 0],
+                    "material": { "base_color": [0.8, 0.8, 0.8] } } ],
+      "lights": [ { "type": "spot", "position": [-1.5, 2, 0], "direction": [0, -1, 0],
+                    "intensity": 50, "outer_cone_deg": 25, "casts_shadows": false,
+                    "animation": { "translation": { "times": [0, 2],
+                        "values": [[-1.5, 2, 0], [1.5, 2, 0]] } } } ],
+      "camera": { "position": [0, 2, 6], "target": [0, 1.5, -2] },
+      "environment": { "type": "constant", "intensity": 0 } })");
+  auto frames = [&](const std::vector<double>& times) {
+    EffectOverrides cli;
+    cli.effects = {"ism"};
+    cli.sets = {"ism.vpls=64", "ism.mode=classic"};
+    RenderSettings rs;
+    rs.width = kW;
+    rs.height = kH;
+    rs.effects = resolveEffects(s, nullptr, cli, registry);
+    Renderer r(ctx(), s, rs, &registry);
+    for (double t : times) {
+      r.setTime(t);
+      r.renderFrame();
+    }
+    return r.readTarget("indirect");
+  };
+  const ImageRGBA32F moved = frames({0.0, 1.0}), fresh = frames({1.0}), before = frames({0.0});
+  expectFinite(moved);
+  double diff = 0, change = 0, sum = 0;
+  for (size_t i = 0; i < moved.pixels.size(); ++i) {
+    diff += std::abs(moved.pixels[i] - fresh.pixels[i]);
+    change += std::abs(fresh.pixels[i] - before.pixels[i]);
+    sum += fresh.pixels[i];
+  }
+  std::printf("moved vs fresh: %.3g, fresh vs t = 0: %.3g (of %.3g)\n", diff, change, sum);
+  EXPECT_GT(sum, 0.0);
+  EXPECT_GT(change, 0.02 * sum);  // measured 0.041 x sum
+  EXPECT_LE(diff, 1e-6 * sum);    // measured 0: the same VPLs, the same maps
+}
+
 // Classic mode with 2 bounces draws maps for the second bounce's VPLs too (their tiles,
 // 16..31 of the atlas, hold distances in over a quarter of their texels: before, only the first
 // bounce's VPLs got maps and the second bounce's light was unshadowed).
