@@ -230,7 +230,8 @@ class IsmEffect : public gi::Effect {
                      : gi::vk::Pipeline::compute(
                            vk, spv(std::begin(ism_atlas_view_comp), std::end(ism_atlas_view_comp)),
                            {{0, tex}, {1, img}});
-    const std::vector<uint32_t> gatherSpec = {uint32_t(c.perPixel), uint32_t(c.block),
+    // Constant 2 is left free (1).
+    const std::vector<uint32_t> gatherSpec = {uint32_t(c.perPixel), uint32_t(c.block), 1u,
                                               uint32_t(c.glossy), glm::floatBitsToUint(c.phong)};
     const std::vector<gi::vk::Binding> gatherBindings = {{0, ubo}, {1, ubo}, {2, ubo}, {3, tex},
                                                          {4, tex}, {5, tex}, {6, img}, {7, tex}};
@@ -244,7 +245,7 @@ class IsmEffect : public gi::Effect {
                                         gatherBindings, 0, gatherSpec);
     // K taps from -K/2 cover each phase of a K-periodic pattern exactly once.
     const int lo = -c.block / 2 - c.blurExtra, hi = c.block - 1 - c.block / 2 + c.blurExtra;
-    const std::vector<uint32_t> blurSpec = {uint32_t(lo), uint32_t(hi), uint32_t(c.glossy)};
+    const std::vector<uint32_t> blurSpec = {uint32_t(lo), uint32_t(hi), 1u, uint32_t(c.glossy)};
     blurX_ =
         gi::vk::Pipeline::compute(vk, spv(std::begin(ism_blur_x_comp), std::end(ism_blur_x_comp)),
                                   {{0, ubo}, {1, ubo}, {2, tex}, {3, img}}, 0, blurSpec);

@@ -10,7 +10,8 @@
 
 layout(constant_id = 0) const int LO = -2;
 layout(constant_id = 1) const int HI = 1;
-layout(constant_id = 2) const bool GLOSSY = false;
+// (constant_id 2 is left free)
+layout(constant_id = 3) const bool GLOSSY = false;
 layout(local_size_x = 32, local_size_y = 16) in;
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 layout(set = 0, binding = 2) uniform usampler2D inRaw;

@@ -13,8 +13,9 @@
 
 layout(constant_id = 0) const int PER_PIXEL = 16;  // ceil(N / K^2)
 layout(constant_id = 1) const int K = 4;
-layout(constant_id = 2) const bool GLOSSY = false;
-layout(constant_id = 3) const float PHONG_EXPONENT = 0.0;  // 0: from the roughness
+// (constant_id 2 is left free)
+layout(constant_id = 3) const bool GLOSSY = false;
+layout(constant_id = 4) const float PHONG_EXPONENT = 0.0;  // 0: from the roughness
 layout(local_size_x = 32, local_size_y = 16) in;
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 layout(set = 0, binding = 2, std140) uniform Vpls { Vpl vpls[ISM_VPL_SLOTS]; };
