@@ -1,7 +1,7 @@
 // Engine services on the plugin API (gi/gpu_scene.h, gi/lights.h, EffectContext): an effect
 // draws the scene from an extra view (depth only, G-buffer), from a light (reflective shadow
-// map), as a paraboloid hemisphere and as cube faces, and the results match the main G-buffer
-// and closed forms.
+// map), as a paraboloid hemisphere (also from view records in a buffer) and as cube faces, and
+// the results match the main G-buffer and closed forms.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -13,6 +13,7 @@
 #include "gi/effect_registry.h"
 #include "gi/renderer.h"
 #include "gi/scene_io.h"
+#include "gi/vk/resources.h"
 #include "process.h"
 #include "vulkan_fixture.h"
 
@@ -23,7 +24,15 @@ using test::VulkanTest;
 
 // What the probe draws and how.
 struct ProbeConfig {
-  enum class Mode { CameraDepth, CameraGBuffer, Rsm, Paraboloid, Cube, Peel } mode;
+  enum class Mode {
+    CameraDepth,
+    CameraGBuffer,
+    Rsm,
+    Paraboloid,
+    ParaboloidBuffer,
+    Cube,
+    Peel
+  } mode;
   float scale = 1.0f;  // extent of the probe's targets relative to the output
   uint32_t size = 0;   // absolute square size (Rsm, Paraboloid, Cube face) when non-zero
   std::function<SceneView(EffectContext&)> view;  // Rsm/Paraboloid/Cube: the view(s) to draw
@@ -43,6 +52,9 @@ class Probe : public Effect {
   std::vector<SettingDesc> settings() const override { return {}; }
   void prepare(EffectContext& ctx, const SettingValues&) override {
     if (!view_) view_ = ctx.createView();
+    if (c_.mode == ProbeConfig::Mode::ParaboloidBuffer && !records_)
+      records_ =
+          vk::Buffer(ctx.vulkan(), 2 * kDrawViewStride, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true);
   }
   void update(EffectContext& ctx, const SettingValues&) override {
     const VkExtent2D e = ctx.outputExtent();
@@ -62,7 +74,9 @@ class Probe : public Effect {
       d.scale = c_.scale;
       if (c_.size) {
         d.sizeClass = SizeClass::Absolute;
-        d.width = c_.mode == ProbeConfig::Mode::Cube ? 3 * c_.size : c_.size;
+        d.width = c_.mode == ProbeConfig::Mode::Cube               ? 3 * c_.size
+                  : c_.mode == ProbeConfig::Mode::ParaboloidBuffer ? 2 * c_.size
+                                                                   : c_.size;
         d.height = c_.mode == ProbeConfig::Mode::Cube ? 2 * c_.size : c_.size;
       }
       return d;
@@ -99,6 +113,28 @@ class Probe : public Effect {
             case ProbeConfig::Mode::Paraboloid: {
               const SceneView v = c_.view(ctx);
               scene.drawDepth(pc, t, {&v, 1});
+              break;
+            }
+            case ProbeConfig::Mode::ParaboloidBuffer: {
+              // Two DrawView records (scene_view.glsl) written on the host: the view, drawn
+              // into the left square, and one that clips every vertex (all points at view
+              // position (0, 0, 1), behind the hemisphere), into the right one.
+              const SceneView v = c_.view(ctx);
+              struct Record {
+                glm::mat4 view, proj;
+                glm::vec4 params, light[4], viewport;
+              };
+              std::array<Record, 2> rec{};
+              rec[0].view = v.view;
+              rec[1].view = glm::mat4(0.0f);
+              rec[1].view[3] = glm::vec4(0, 0, 1, 1);
+              for (Record& r : rec) r.params = glm::vec4(2.0f, v.znear, v.zfar, 0.0f);
+              for (uint32_t i = 0; i < 2; ++i)
+                records_.write(&rec[i], sizeof(Record), i * kDrawViewStride);
+              const std::array<VkRect2D, 2> tiles = {
+                  VkRect2D{{0, 0}, {c_.size, c_.size}},
+                  VkRect2D{{int32_t(c_.size), 0}, {c_.size, c_.size}}};
+              scene.drawDepthFromBuffer(pc, t, records_.handle(), tiles);
               break;
             }
             case ProbeConfig::Mode::Cube: {
@@ -145,6 +181,7 @@ class Probe : public Effect {
   }
   ProbeConfig c_;
   std::shared_ptr<ViewUniforms> view_;
+  vk::Buffer records_;  // ParaboloidBuffer: the view records
 };
 
 Scene sceneFromJson(const std::string& json) {
@@ -347,6 +384,35 @@ TEST_F(EngineServicesTest, ParaboloidViewStoresRadialDistance) {
   EXPECT_GT(checked, 40);
   // Outside the disk nothing is drawn.
   EXPECT_EQ(d.pixels[0], 0.0f);
+}
+
+// GpuScene::drawDepthFromBuffer: the paraboloid view of the test above, as a DrawView record in
+// a buffer, draws the same depth bit for bit as drawDepth into its viewport (the left square),
+// and a record that clips everything leaves its viewport (the right square) cleared.
+TEST_F(EngineServicesTest, ViewRecordsFromABufferDrawAsDrawDepth) {
+  const Scene scene = sceneFromJson(R"({
+    "models": [{"primitive": "sphere", "radius": 5, "segments": 64, "rings": 32},
+               {"primitive": "box", "size": [1, 1, 1], "translation": [0.5, -1, 0]}],
+    "camera": {"position": [0, 1, 3], "target": [0, 0, 0]}})");
+  auto view = [](EffectContext&) {
+    return SceneView::paraboloid({0, 2, 0}, glm::normalize(glm::vec3(0.2f, -1, 0.1f)), 0.1f, 20);
+  };
+  ProbeConfig direct{ProbeConfig::Mode::Paraboloid}, buffered{ProbeConfig::Mode::ParaboloidBuffer};
+  direct.size = buffered.size = 64;
+  direct.view = buffered.view = view;
+  EffectRegistry a, b;
+  const ImageRGBA32F expected = render(ctx(), scene, a, direct)->readTarget("probe_depth");
+  const ImageRGBA32F got = render(ctx(), scene, b, buffered)->readTarget("probe_depth");
+  ASSERT_EQ(got.width, 128);
+  int drawn = 0;
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) {
+      const float e = expected.pixels[(size_t(y) * 64 + x) * 4];
+      ASSERT_EQ(got.pixels[(size_t(y) * 128 + x) * 4], e) << x << "," << y;
+      ASSERT_EQ(got.pixels[(size_t(y) * 128 + 64 + x) * 4], 0.0f) << x << "," << y;
+      drawn += e > 0.0f;
+    }
+  EXPECT_GT(drawn, 64 * 64 / 2);  // the disk (pi / 4 of the square) sees the sphere
 }
 
 // Cube faces from a point whose six walls are at six different distances (+x 1, -x 2, +y 3,

@@ -3,7 +3,9 @@
 // (triangle) shadow map's, pull-push closes light leaks, an all-black RSM gives zero indirect
 // light without NaN, a receiver behind every VPL's hemisphere gets 0, moving the light moves
 // the VPLs (and their light), the ISM shadow follows an animated mesh, 1, 2, 3 bounces add up
-// monotonically, and a scene without the effect runs no ISM pass.
+// monotonically, and a scene without the effect runs no ISM pass. Glossy receivers: the Phong
+// lobe's normalisation and bounds (CPU), a highlight at the VPL's mirror direction (GPU).
+// Classic mode's maps are this frame's (its first frame already has the shadow).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -63,6 +65,62 @@ TEST(IsmFormulas, ReceiverBehindTheVplHemisphereGetsZero) {
 // Pull averages only depths close to the nearest child (a far point shining through is not
 // mixed in); push fills holes and replaces outliers far behind the coarse value, and keeps
 // valid texels near it or in front of it.
+// The Phong lobe (n + 2) / (2 pi) cos^n(alpha): exactly its maximum at the mirror direction,
+// reflecting at most all the light (the directional albedo, integrated over incoming directions
+// with the receiver's cosine, is 1 within 1% for a view along the normal and below 1 at grazing
+// views), finite and 0 for w = 0 and at grazing incidence.
+TEST(IsmFormulas, PhongLobeIsNormalisedAndPeaksAtTheMirrorDirection) {
+  const glm::vec3 n(0, 0, 1);
+  const float pi = 3.14159265f;
+  for (float e : {1.0f, 8.0f, 32.0f, gi::ism::kMaxPhongExponent}) {
+    const glm::vec3 v = glm::normalize(glm::vec3(0.6f, 0, 0.8f));
+    const glm::vec3 w = glm::reflect(v, n);  // light whose mirror direction is v
+    EXPECT_NEAR(gi::ism::phongLobe(w, n, v, e), (e + 2) / (2 * pi), 1e-4f * (e + 2));
+    EXPECT_LT(gi::ism::phongLobe(glm::normalize(w + glm::vec3(0.3f, 0.2f, 0)), n, v, e),
+              (e + 2) / (2 * pi));
+    EXPECT_EQ(gi::ism::phongLobe(glm::vec3(0.0f), n, v, e), 0.0f);
+    const float grazing = gi::ism::phongLobe(glm::vec3(1, 0, 0), n, glm::vec3(1, 0, 0), e);
+    EXPECT_TRUE(std::isfinite(grazing) && grazing >= 0.0f) << grazing;
+    // Directional albedo: sum over a theta x phi grid of lobe x cos(theta) x sin(theta).
+    for (float viewAngle : {0.0f, 1.3f}) {
+      const glm::vec3 view(std::sin(viewAngle), 0, std::cos(viewAngle));
+      const int nt = 400, np = 400;
+      double albedo = 0;
+      for (int i = 0; i < nt; ++i)
+        for (int j = 0; j < np; ++j) {
+          const float t = (i + 0.5f) * 0.5f * pi / nt, ph = (j + 0.5f) * 2 * pi / np;
+          const glm::vec3 in(std::sin(t) * std::cos(ph), std::sin(t) * std::sin(ph), std::cos(t));
+          albedo += gi::ism::phongLobe(-in, n, view, e) * std::cos(t) * std::sin(t) *
+                    (0.5 * pi / nt) * (2 * pi / np);
+        }
+      if (viewAngle == 0.0f)
+        EXPECT_NEAR(albedo, 1.0, 0.01) << e;
+      else
+        EXPECT_LT(albedo, 1.0) << e;
+    }
+  }
+}
+
+// Glossy radiance f0 x lobe x E stays bounded by the singularity guard: at most
+// f0 (n + 2) / (2 pi) phi / (pi d_min^2) for receivers from d = 0 out, finite everywhere.
+TEST(IsmFormulas, GlossyVplLightIsBoundedByTheSingularityGuard) {
+  const glm::vec3 nv(0, -1, 0), phi(3.0f), n(0, 1, 0);
+  const float dMin = 0.05f, e = gi::ism::kMaxPhongExponent, f0 = 1.0f;
+  const float bound = f0 * (e + 2) / (2 * 3.14159265f) * 3.0f / (3.14159265f * dMin * dMin);
+  float largest = 0.0f;
+  for (float d : {0.0f, 1e-12f, 1e-6f, 1e-3f, 0.01f, 0.05f, 0.2f, 1.0f})
+    for (float x : {0.0f, 1e-6f, 1e-3f, 0.01f}) {
+      const glm::vec3 xv(0, 1, 0), p = xv + glm::vec3(x, -d, 0);
+      const glm::vec3 v = glm::normalize(glm::reflect(p - xv, n) + glm::vec3(0, 1e-7f, 0));
+      const glm::vec3 l = f0 * gi::ism::phongLobe(p - xv, n, v, e) *
+                          gi::ism::vplIrradiance(p, n, xv, nv, phi, dMin);
+      ASSERT_TRUE(std::isfinite(l.x)) << d << " " << x;
+      EXPECT_LE(l.x, bound * 1.0001f) << d << " " << x;
+      largest = std::max(largest, l.x);
+    }
+  EXPECT_GT(largest, 0.5f * bound);  // the bound is reached (at d <= d_min, mirror direction)
+}
+
 TEST(IsmFormulas, PullPushFillsHolesWithoutDepthOutliers) {
   const float inf = std::numeric_limits<float>::infinity();
   const float children[4] = {2.0f, 2.1f, inf, 9.0f};
@@ -173,6 +231,10 @@ class IsmTest : public test::VulkanTest {
   }
   EffectRegistry registry;
 };
+
+float luminance(const glm::vec3& c) {
+  return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z;
+}
 
 const std::vector<std::string> kOneVpl = {"ism.vpls=1",
                                           "ism.block_size=1",
@@ -373,6 +435,176 @@ TEST_F(IsmTest, CornellBoxBouncesIncreaseMonotonicallyAndConverge) {
   EXPECT_LT(mean[3] - mean[2], mean[2] - mean[1]);
 }
 
+// Classic mode draws its maps from this frame's VPLs (their views written on the GPU, not read
+// back on the host): its first frame already has the box's shadow, the same as its second
+// frame's and as the ISM's (IoU > 0.85). Before, the first frame had no maps (no shadow) and a
+// moving light's maps lagged one frame.
+TEST_F(IsmTest, ClassicMapsUseThisFramesVpls) {
+  const Scene s = panelScene();
+  const Result first = render(s, with(kOneVpl, {"ism.mode=classic"}), 1);
+  const Result second = render(s, with(kOneVpl, {"ism.mode=classic"}), 2);
+  const Result imperfect = render(s, kOneVpl, 1);
+  expectFinite(first.indirect);
+  const auto a = shadowMask(first), b = shadowMask(second), c = shadowMask(imperfect);
+  int dark = 0;
+  for (bool v : a) dark += v;
+  std::printf("classic frame 1: %d dark; IoU with frame 2 %.4f, with the ISM %.3f\n", dark,
+              iou(a, b), iou(a, c));
+  EXPECT_GT(dark, 200);
+  EXPECT_EQ(iou(a, b), 1.0);
+  EXPECT_GT(iou(a, c), 0.85);
+}
+
+// A moving light in classic mode: the frame at t = 1 after one at t = 0 equals a first frame
+// at t = 1 (the maps follow this frame's VPLs; with last frame's they were placed at t = 0's
+// VPLs, 1.5 away from this frame's, whose distances the maps' then no longer describe), and
+// differs from the frame at t = 0 (the light moves 1.5 in x).
+TEST_F(IsmTest, ClassicMapsFollowAMovingLightInTheSameFrame) {
+  const Scene s = jsonScene("moving_light", R"({
+      "models": [ { "primitive": "plane", "size": 10, "material": { "base_color": [0.8, 0.8, 0.8] } },
+                  { "primitive": "box", "size": [0.6, 1.2, 0.6], "translation": [0, 0.6, -1] },
+                  { "primitive": "plane", "size": 10, "translation": [0, 5, -2], "rotation": [90, 0, 0],
+                    "material": { "base_color": [0.8, 0.8, 0.8] } } ],
+      "lights": [ { "type": "spot", "position": [-1.5, 2, 0], "direction": [0, -1, 0],
+                    "intensity": 50, "outer_cone_deg": 25, "casts_shadows": false,
+                    "animation": { "translation": { "times": [0, 2],
+                        "values": [[-1.5, 2, 0], [1.5, 2, 0]] } } } ],
+      "camera": { "position": [0, 2, 6], "target": [0, 1.5, -2] },
+      "environment": { "type": "constant", "intensity": 0 } })");
+  auto frames = [&](const std::vector<double>& times) {
+    EffectOverrides cli;
+    cli.effects = {"ism"};
+    cli.sets = {"ism.vpls=64", "ism.mode=classic"};
+    RenderSettings rs;
+    rs.width = kW;
+    rs.height = kH;
+    rs.effects = resolveEffects(s, nullptr, cli, registry);
+    Renderer r(ctx(), s, rs, &registry);
+    for (double t : times) {
+      r.setTime(t);
+      r.renderFrame();
+    }
+    return r.readTarget("indirect");
+  };
+  const ImageRGBA32F moved = frames({0.0, 1.0}), fresh = frames({1.0}), before = frames({0.0});
+  expectFinite(moved);
+  double diff = 0, change = 0, sum = 0;
+  for (size_t i = 0; i < moved.pixels.size(); ++i) {
+    diff += std::abs(moved.pixels[i] - fresh.pixels[i]);
+    change += std::abs(fresh.pixels[i] - before.pixels[i]);
+    sum += fresh.pixels[i];
+  }
+  std::printf("moved vs fresh: %.3g, fresh vs t = 0: %.3g (of %.3g)\n", diff, change, sum);
+  EXPECT_GT(sum, 0.0);
+  EXPECT_GT(change, 0.02 * sum);  // measured 0.041 x sum
+  EXPECT_LE(diff, 1e-6 * sum);    // measured 0: the same VPLs, the same maps
+}
+
+// Classic mode with 2 bounces draws maps for the second bounce's VPLs too (their tiles,
+// 16..31 of the atlas, hold distances in over a quarter of their texels: before, only the first
+// bounce's VPLs got maps and the second bounce's light was unshadowed).
+TEST_F(IsmTest, ClassicModeDrawsEveryBouncesMaps) {
+  const Scene s = loadScene(std::string(GI_SOURCE_DIR) + "/assets/scenes/cornell_box.json");
+  EffectOverrides cli;
+  cli.effects = {"ism"};
+  cli.sets = {"ism.vpls=16", "ism.bounces=2", "ism.mode=classic", "ism.ism_resolution=32"};
+  RenderSettings rs;
+  rs.width = kW;
+  rs.height = kH;
+  rs.view = "ism_atlas";
+  rs.effects = resolveEffects(s, nullptr, cli, registry);
+  Renderer r(ctx(), s, rs, &registry);
+  r.renderFrame();
+  const ImageRGBA32F atlas = r.readTarget("ism_atlas");
+  const int res = 32, perRow = 6;  // ceil(sqrt(32)) tiles per row
+  ASSERT_EQ(atlas.width, perRow * res);
+  size_t filled[2] = {0, 0};
+  for (int i = 0; i < 32; ++i)
+    for (int y = 0; y < res; ++y)
+      for (int x = 0; x < res; ++x) {
+        const size_t t = size_t((i / perRow) * res + y) * atlas.width + (i % perRow) * res + x;
+        filled[i / 16] += atlas.pixels[t * 4] > 0.0f;
+      }
+  std::printf("filled texels: bounce 1 %zu, bounce 2 %zu of %d each\n", filled[0], filled[1],
+              16 * res * res);
+  // The disk is pi / 4 of a tile and the box is open to the camera: measured 6475 and 7606.
+  EXPECT_GT(filled[0], size_t(16 * res * res / 4));
+  EXPECT_GT(filled[1], size_t(16 * res * res / 4));
+}
+
+// Glossy receivers: one VPL (a down-facing panel) over a floor, Phong exponent 32. alpha: the
+// angle between the VPL light's mirror direction at a floor point and the direction to the
+// camera (VPL taken at the panel's centre, within 0.25 of the sampled one). A dielectric floor
+// (f0 0.04 over an unchanged diffuse part) is never darker than the diffuse-only image (up to
+// the RGB9E5 rounding of the glossy path); its
+// largest gain (predicted 1 + 0.04 x 34 / (2 pi) / (0.8 / pi) = 1.85, measured 1.850) lies where
+// alpha < 12 degrees and there is none (< 2%) beyond 45 degrees. A metal floor (all glossy, f0 =
+// albedo) is brighter than the diffuse floor near the mirror direction and darker (< 0.2x) away
+// from it.
+TEST_F(IsmTest, GlossyReceiverShowsTheVplHighlightAtTheMirrorDirection) {
+  auto scene = [&](const std::string& name, const std::string& floor) {
+    return jsonScene("glossy_" + name, R"({
+      "models": [
+        { "primitive": "plane", "size": 12, "material": )" +
+                                           floor + R"( },
+        { "primitive": "plane", "size": 0.5, "translation": [-2, 2, 0], "rotation": [180, 0, 0],
+          "material": { "base_color": [1, 1, 1] } } ],
+      "lights": [ { "type": "spot", "position": [-2, 1.5, 0], "direction": [0, 1, 0],
+                    "intensity": 50, "inner_cone_deg": 5, "outer_cone_deg": 10,
+                    "casts_shadows": false } ],
+      "camera": { "position": [0, 6, 6], "target": [-1, 0, 1] },
+      "environment": { "type": "constant", "intensity": 0 } })");
+  };
+  const Scene dielectric = scene("dielectric", R"({ "base_color": [0.8, 0.8, 0.8] })");
+  const Scene metal = scene("metal", R"({ "base_color": [0.8, 0.8, 0.8], "metallic": 1 })");
+  const std::vector<std::string> glossy =
+      with(kOneVpl, {"ism.glossy=true", "ism.phong_exponent=32"});
+  const Result diffuse = render(dielectric, kOneVpl);
+  const Result shiny = render(dielectric, glossy);
+  const Result metallic = render(metal, glossy);
+  expectFinite(shiny.indirect);
+  expectFinite(metallic.indirect);
+  const glm::vec3 vpl(-2, 2, 0), eye(glm::inverse(diffuse.camera.view)[3]);
+  float bestGain = 0, bestAlpha = 180, farGain = 0, metalNear = 0, metalFar = 0;
+  int near = 0, far = 0;
+  for (int y = 0; y < int(kH); ++y)
+    for (int x = 0; x < int(kW); ++x) {
+      const float d = luminance(diffuse.px(diffuse.indirect, x, y));
+      const glm::vec3 p = diffuse.worldAt(x, y);
+      if (diffuse.sky(x, y) || p.y > 0.01f || d < 1e-4f) continue;
+      const glm::vec3 r = glm::reflect(glm::normalize(p - vpl), glm::vec3(0, 1, 0));
+      const float alpha =
+          glm::degrees(std::acos(std::clamp(glm::dot(r, glm::normalize(eye - p)), -1.0f, 1.0f)));
+      const float gain = luminance(shiny.px(shiny.indirect, x, y)) / d;
+      const float metalGain = luminance(metallic.px(metallic.indirect, x, y)) / d;
+      ASSERT_GE(gain, 0.995f) << x << "," << y;  // RGB9E5 rounds twice: 2 x 2^-9 relative
+      if (gain > bestGain) {
+        bestGain = gain;
+        bestAlpha = alpha;
+      }
+      if (alpha < 8) {
+        ++near;
+        metalNear = std::max(metalNear, metalGain);
+      }
+      if (alpha > 45) {
+        ++far;
+        farGain = std::max(farGain, gain);
+        metalFar = std::max(metalFar, metalGain);
+      }
+    }
+  std::printf(
+      "dielectric: largest gain %.3f at alpha %.1f deg, largest beyond 45 deg %.4f; metal vs "
+      "diffuse: %.3f near (%d px), %.4f far (%d px)\n",
+      bestGain, bestAlpha, farGain, metalNear, near, metalFar, far);
+  ASSERT_GT(near, 10);
+  ASSERT_GT(far, 100);
+  EXPECT_NEAR(bestGain, 1.85f, 0.05f);  // measured 1.850 at alpha 0.6 degrees
+  EXPECT_LT(bestAlpha, 12.0f);
+  EXPECT_LT(farGain, 1.02f);
+  EXPECT_GT(metalNear, 1.0f);
+  EXPECT_LT(metalFar, 0.2f);
+}
+
 // The frame graph runs ISM passes only when the scene asks for the effect.
 // The atlas debug view (distances, 0 = hole) is built only when it is the view, in both modes.
 TEST_F(IsmTest, AtlasViewRunsOnlyWhenViewed) {
@@ -391,8 +623,7 @@ TEST_F(IsmTest, AtlasViewRunsOnlyWhenViewed) {
     rs.view = "ism_atlas";
     rs.effects = resolveEffects(s, nullptr, cli, registry);
     Renderer r(ctx(), s, rs, &registry);
-    r.renderFrame();
-    r.renderFrame();  // classic mode places its maps from the previous frame's VPLs
+    r.renderFrame();  // one frame: classic mode places its maps from this frame's VPLs
     EXPECT_TRUE(has(r.passNames(), "ism_atlas_view")) << mode;
     const ImageRGBA32F atlas = r.readTarget("ism_atlas");
     size_t filled = 0;

@@ -25,6 +25,7 @@
 #include "ism_bounce.comp.h"
 #include "ism_bounce_classic.comp.h"
 #include "ism_classic_atlas_view.comp.h"
+#include "ism_classic_views.comp.h"
 #include "ism_gather.comp.h"
 #include "ism_gather_classic.comp.h"
 #include "ism_params.h"
@@ -63,6 +64,8 @@ struct Config {
   int perIsm = 1024, levels = 2, rsm = 64, splat = 1, blurExtra = 0, bounces = 1, scale = 1;
   int total() const { return vpls * bounces; }  // VPLs of all bounces (one tile each)
   bool classic = false;
+  bool glossy = false;  // Phong receivers (ism_glossy.glsl)
+  float phong = 0.0f;   // Phong exponent, 0: from the roughness
   uint32_t atlasWidth() const { return uint32_t(perRow * res); }
   uint32_t atlasHeight() const { return uint32_t(rows * res); }
 };
@@ -149,6 +152,14 @@ class IsmEffect : public gi::Effect {
          "distance",
          false},
         {"strength", SettingType::Float, 1.0, 0.0, 16.0, "scales the indirect light", false},
+        {"glossy", SettingType::Bool, 0.0, 0.0, 1.0,
+         "receivers also reflect the VPLs' light with a Phong lobe (f0 x (n + 2) / (2 pi) "
+         "cos^n, f0 as the lighting pass: 0.04, or the albedo of metals); off: diffuse only",
+         true},
+        {"phong_exponent", SettingType::Float, 0.0, 0.0, gi::ism::kMaxPhongExponent,
+         "glossy receivers' Phong exponent n (0: from each pixel's roughness, the lighting "
+         "pass's Blinn-Phong exponent / 4, within [1, 128])",
+         true},
     };
   }
 
@@ -173,6 +184,8 @@ class IsmEffect : public gi::Effect {
     c.blurExtra = s.integer("blur_radius");
     c.scale = std::clamp(s.integer("gather_scale"), 1, 4);
     c.classic = s.option("mode") == "classic";
+    c.glossy = s.flag("glossy");
+    c.phong = float(s.number("phong_exponent"));
     cfg_ = c;
     nearest_ = ctx.nearestSampler();
     // The engine keeps at least the points asked for: without the cap every subset fits.
@@ -190,6 +203,10 @@ class IsmEffect : public gi::Effect {
     vpl_ = gi::vk::Pipeline::compute(
         vk, spv(std::begin(ism_vpl_comp), std::end(ism_vpl_comp)),
         {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, tex}, {5, ssbo}, {6, ssbo}});
+    if (c.classic)
+      classicViews_ = gi::vk::Pipeline::compute(
+          vk, spv(std::begin(ism_classic_views_comp), std::end(ism_classic_views_comp)),
+          {{1, ubo}, {2, ubo}, {3, ssbo}}, 2 * sizeof(int32_t));
     if (!c.classic) {
       splat_ =
           gi::vk::Pipeline::compute(vk, spv(std::begin(ism_splat_comp), std::end(ism_splat_comp)),
@@ -221,9 +238,10 @@ class IsmEffect : public gi::Effect {
                            vk, spv(std::begin(ism_atlas_view_comp), std::end(ism_atlas_view_comp)),
                            {{0, tex}, {1, img}});
     const std::vector<uint32_t> gatherSpec = {uint32_t(c.perPixel), uint32_t(c.block),
-                                              uint32_t(c.scale)};
+                                              uint32_t(c.scale), uint32_t(c.glossy),
+                                              glm::floatBitsToUint(c.phong)};
     const std::vector<gi::vk::Binding> gatherBindings = {{0, ubo}, {1, ubo}, {2, ubo}, {3, tex},
-                                                         {4, tex}, {5, tex}, {6, img}};
+                                                         {4, tex}, {5, tex}, {6, img}, {7, tex}};
     gather_ =
         c.classic
             ? gi::vk::Pipeline::compute(
@@ -234,7 +252,8 @@ class IsmEffect : public gi::Effect {
                                         gatherBindings, 0, gatherSpec);
     // K taps from -K/2 cover each phase of a K-periodic pattern exactly once.
     const int lo = -c.block / 2 - c.blurExtra, hi = c.block - 1 - c.block / 2 + c.blurExtra;
-    const std::vector<uint32_t> blurSpec = {uint32_t(lo), uint32_t(hi), uint32_t(c.scale)};
+    const std::vector<uint32_t> blurSpec = {uint32_t(lo), uint32_t(hi), uint32_t(c.scale),
+                                            uint32_t(c.glossy)};
     blurX_ =
         gi::vk::Pipeline::compute(vk, spv(std::begin(ism_blur_x_comp), std::end(ism_blur_x_comp)),
                                   {{0, ubo}, {1, ubo}, {2, tex}, {3, img}}, 0, blurSpec);
@@ -249,12 +268,12 @@ class IsmEffect : public gi::Effect {
       upsample_ = gi::vk::Pipeline::compute(
           vk, spv(std::begin(ism_upsample_comp), std::end(ism_upsample_comp)),
           {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, tex}, {5, tex}, {6, tex}, {7, img}}, 0,
-          {uint32_t(c.scale)});
+          {uint32_t(c.scale), uint32_t(c.glossy)});
     }
     if (!uniforms_)
       uniforms_ =
           gi::vk::Buffer(vk, sizeof(gi::ism::Uniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true);
-    // Host-visible: classic mode reads last frame's VPLs back to place its views.
+    // Host-visible: zero-filled once from the host (slots no VPL pass wrote read as no light).
     if (!vplBuffer_) {
       vplBuffer_ = gi::vk::Buffer(
           vk, kVplBytes * gi::ism::kVplSlots,
@@ -268,7 +287,7 @@ class IsmEffect : public gi::Effect {
     struct Io {
       gi::TextureHandle rsmDepth, rsmPos, rsmNormal, rsmFlux, atlas, depth, normal, albedo,
           material, raw, half, low, indirect, atlasView;
-      gi::BufferHandle cdf, vpls, points, shade;
+      gi::BufferHandle cdf, vpls, points, shade, classicViews;
     };
     auto io = std::make_shared<Io>();
     gi::Blackboard& bb = graph.blackboard();
@@ -383,21 +402,13 @@ class IsmEffect : public gi::Effect {
         addPullPush(graph, io, c, bounce, "ism_pull_push" + n);
       }
     } else {
-      graph.addPass(
-          "ism_classic_sm",
-          [&](gi::PassBuilder& b) {
-            ctx.scene().declareRead(b);
-            // Its views come from the VPLs (last frame's, read on the host): keeps the VPL pass
-            // alive when only the atlas is needed (its debug view).
-            io->vpls = b.read(io->vpls, gi::BufferUsage::Uniform);
-            io->atlas =
-                b.write(b.create("ism_classic_atlas",
-                                 absolute(gi::kSceneDepthFormat, c.atlasWidth(), c.atlasHeight())),
-                        gi::TextureUsage::DepthAttachment);
-          },
-          [this, io, c, cx = &ctx](gi::PassContext& pc) { drawClassic(pc, *cx, *io, c); });
+      addClassicMaps(graph, ctx, io,
+                     absolute(gi::kSceneDepthFormat, c.atlasWidth(), c.atlasHeight()), 0);
       if (c.bounces > 1) io->points = graph.blackboard().buffer(res::kSurfacePoints);
-      for (int bounce = 1; bounce < c.bounces; ++bounce) addBounce(graph, ctx, io, bounce);
+      for (int bounce = 1; bounce < c.bounces; ++bounce) {
+        addBounce(graph, ctx, io, bounce);
+        addClassicMaps(graph, ctx, io, {}, bounce);
+      }
     }
 
     // The atlas as a debug view (culled unless viewed).
@@ -425,6 +436,7 @@ class IsmEffect : public gi::Effect {
           io->normal = b.read(bb.texture(res::kNormal));
           io->vpls = b.read(io->vpls, gi::BufferUsage::Uniform);
           io->atlas = b.read(io->atlas, gi::TextureUsage::Sampled, gi::Subresource::mipLevel(0));
+          io->material = b.read(bb.texture(res::kMaterial));  // glossy: roughness
           io->raw = b.write(b.create("ism_raw", rawDesc), gi::TextureUsage::StorageWrite);
         },
         [this, io, c, frame, nearest, params, ubo](gi::PassContext& pc) {
@@ -435,7 +447,8 @@ class IsmEffect : public gi::Effect {
               .sampled(3, pc.view(io->depth), nearest)
               .sampled(4, pc.view(io->normal), nearest)
               .sampled(5, pc.view(io->atlas, gi::Subresource::mipLevel(0)), nearest)
-              .storageImage(6, pc.view(io->raw));
+              .storageImage(6, pc.view(io->raw))
+              .sampled(7, pc.view(io->material), nearest);
           pc.descriptors().bind(pc.cmd(), gather_, w);
           const VkExtent2D e = pc.extent(io->raw);
           const uint32_t k = uint32_t(c.block);
@@ -538,6 +551,51 @@ class IsmEffect : public gi::Effect {
           pc.descriptors().bind(pc.cmd(), pullPush_, w);
           const VkExtent2D e = pc.extent(io->atlas);
           vkCmdDispatch(pc.cmd(), (e.width + 63) / 64, (e.height + 63) / 64, 1);
+        });
+  }
+
+  // Classic mode: bounce `bounce`'s VPLs' paraboloid views, written on the GPU from this
+  // frame's VPL table (no read-back: the maps are current, not one frame late), then their
+  // maps drawn from the triangles into their tiles (bounce 0 creates and clears the atlas).
+  template <class IoPtr>
+  void addClassicMaps(gi::FrameGraph& graph, gi::EffectContext& ctx, const IoPtr& io,
+                      const gi::TextureDesc& atlas, int bounce) {
+    const Config c = cfg_;
+    const std::string n = bounce == 0 ? "" : std::to_string(bounce + 1);
+    graph.addPass(
+        "ism_classic_views" + n,
+        [&](gi::PassBuilder& b) {
+          io->vpls = b.read(io->vpls, gi::BufferUsage::Uniform);
+          io->classicViews =
+              b.write(b.create("ism_classic_views" + n,
+                               gi::BufferDesc{gi::kDrawViewStride * VkDeviceSize(c.vpls)}),
+                      gi::BufferUsage::StorageWrite);
+        },
+        [this, io, c, bounce](gi::PassContext& pc) {
+          const std::array<int32_t, 2> range = {bounce * c.vpls, c.vpls};
+          vkCmdPushConstants(pc.cmd(), classicViews_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof range,
+                             range.data());
+          gi::vk::DescriptorWriter w;
+          w.buffer(1, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms_.handle())
+              .buffer(2, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, pc.buffer(io->vpls))
+              .buffer(3, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, pc.buffer(io->classicViews));
+          pc.dispatch(classicViews_, w, {uint32_t(c.vpls), 1}, 64, 1);
+        });
+    graph.addPass(
+        "ism_classic_sm" + n,
+        [&](gi::PassBuilder& b) {
+          ctx.scene().declareRead(b);
+          io->classicViews = b.read(io->classicViews, gi::BufferUsage::Uniform);
+          if (bounce == 0) {
+            io->atlas =
+                b.write(b.create("ism_classic_atlas", atlas), gi::TextureUsage::DepthAttachment);
+          } else {  // keeps the earlier bounces' tiles
+            io->atlas = b.read(io->atlas, gi::TextureUsage::DepthAttachment);
+            io->atlas = b.write(io->atlas, gi::TextureUsage::DepthAttachment);
+          }
+        },
+        [this, io, c, bounce, cx = &ctx](gi::PassContext& pc) {
+          drawClassic(pc, *cx, *io, c, bounce);
         });
   }
 
@@ -648,31 +706,25 @@ class IsmEffect : public gi::Effect {
     }
   }
 
-  // Classic reference: last frame's VPLs (read back from the host-visible table; the renderer
-  // waited for that frame) as paraboloid depth maps drawn from the triangles.
+  // Classic reference: bounce `bounce`'s VPLs (their views written by ism_classic_views) as
+  // paraboloid depth maps drawn from the triangles, one atlas tile each.
   template <class IoT>
-  void drawClassic(gi::PassContext& pc, gi::EffectContext& ctx, const IoT& io, const Config& c) {
-    const float extent = sceneExtent(ctx);
-    const auto* v = static_cast<const glm::vec4*>(vplBuffer_.mapped());
-    std::vector<gi::SceneView> views;
-    for (int i = 0; i < c.vpls; ++i) {
-      const glm::vec4 pos = v[3 * i], n = v[3 * i + 1];
-      if (pos.w < 0.5f) continue;
-      gi::SceneView view = gi::SceneView::paraboloid(glm::vec3(pos), glm::vec3(n),
-                                                     classicNear(extent), classicFar(extent));
-      view.viewport = {{int32_t((i % c.perRow) * c.res), int32_t((i / c.perRow) * c.res)},
-                       {uint32_t(c.res), uint32_t(c.res)}};
-      views.push_back(view);
-    }
+  void drawClassic(gi::PassContext& pc, gi::EffectContext& ctx, const IoT& io, const Config& c,
+                   int bounce) {
+    std::vector<VkRect2D> tiles;
+    for (int i = bounce * c.vpls; i < (bounce + 1) * c.vpls; ++i)
+      tiles.push_back({{int32_t((i % c.perRow) * c.res), int32_t((i / c.perRow) * c.res)},
+                       {uint32_t(c.res), uint32_t(c.res)}});
     gi::SceneTargets t;
     t.depth = pc.view(io.atlas);
     t.extent = pc.extent(io.atlas);
-    t.clear = true;
-    ctx.scene().drawDepth(pc, t, views);
+    t.clear = bounce == 0;
+    ctx.scene().drawDepthFromBuffer(pc, t, pc.buffer(io.classicViews), tiles);
   }
 
   Config cfg_;
-  gi::vk::Pipeline vpl_, splat_, pullPush_, upsample_, bounce_, gather_, blurX_, blurY_, atlasView_;
+  gi::vk::Pipeline vpl_, splat_, pullPush_, upsample_, bounce_, gather_, blurX_, blurY_, atlasView_,
+      classicViews_;
   VkSampler nearest_ = VK_NULL_HANDLE;
   gi::vk::Buffer uniforms_, vplBuffer_;
   gi::ism::Uniforms uploaded_{};

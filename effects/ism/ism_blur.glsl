@@ -4,12 +4,16 @@
 // tangent plane and whose normal is close. AXIS 1 then reflects: indirect = diffuse albedo / pi x irradiance.
 // SCALE > 1 (gathered at 1 / SCALE resolution): runs at that resolution, and AXIS 1 with LOW
 // defined keeps the raw layout (irradiance, distance, normal) for ism_upsample.comp instead.
+// GLOSSY: x, y are RGB9E5 irradiance and Phong-weighted irradiance (ism_glossy.glsl); AXIS 1
+// adds f0 x the latter (f0 as the lighting pass: mix(0.04, albedo, metallic)).
 #include "common.glsl"
 #include "ism_common.glsl"
+#include "ism_glossy.glsl"
 
 layout(constant_id = 0) const int LO = -2;
 layout(constant_id = 1) const int HI = 1;
 layout(constant_id = 2) const int SCALE = 1;
+layout(constant_id = 3) const bool GLOSSY = false;
 layout(local_size_x = 32, local_size_y = 16) in;
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 layout(set = 0, binding = 2) uniform usampler2D inRaw;
@@ -29,7 +33,9 @@ vec3 unpackNormal(uint q) {
   n.xy -= t * signNotZero(n.xy);
   return safeNormalize(n, vec3(0.0, 0.0, 1.0));
 }
-vec3 unpackValue(uvec4 t) { return vec3(unpackHalf2x16(t.x), unpackHalf2x16(t.y).x); }
+vec3 unpackValue(uvec4 t) {
+  return GLOSSY ? ismUnpackRgb9e5(t.x) : vec3(unpackHalf2x16(t.x), unpackHalf2x16(t.y).x);
+}
 
 // View-space position of pixel q at view distance `dist`.
 vec3 viewPoint(ivec2 q, float dist) {
@@ -45,7 +51,7 @@ void main() {
   float z = uintBitsToFloat(c.z);
   vec3 n = unpackNormal(c.w);
   vec3 centre = viewPoint(p, z);
-  vec3 sum = vec3(0.0);
+  vec3 sum = vec3(0.0), specSum = vec3(0.0);
   float wsum = 0.0;
   ivec2 axis = AXIS == 0 ? ivec2(1, 0) : ivec2(0, 1);
   for (int o = LO; o <= HI; ++o) {
@@ -57,13 +63,21 @@ void main() {
     float w = (zt > 0.0 && plane <= ism.blur.x * z && dot(unpackNormal(t.w), n) >= ism.blur.y)
                   ? 1.0 : 0.0;
     sum += w * unpackValue(t);
+    if (GLOSSY) specSum += w * ismUnpackRgb9e5(t.y);
     wsum += w;
   }
   vec3 e = z > 0.0 ? sum / max(wsum, 1.0) : vec3(0.0);
+  vec3 spec = z > 0.0 ? specSum / max(wsum, 1.0) : vec3(0.0);
 #if AXIS == 0 || defined(LOW)
-  imageStore(outRaw, p, uvec4(packHalf2x16(e.rg), packHalf2x16(vec2(e.b, 0.0)), c.z, c.w));
+  uvec2 value = GLOSSY ? uvec2(ismPackRgb9e5(e), ismPackRgb9e5(spec))
+                       : uvec2(packHalf2x16(e.rg), packHalf2x16(vec2(e.b, 0.0)));
+  imageStore(outRaw, p, uvec4(value, c.z, c.w));
 #else
-  vec3 diffuse = texelFetch(gAlbedo, p, 0).rgb * (1.0 - texelFetch(gMaterial, p, 0).g);
-  imageStore(outIndirect, p, vec4(min(diffuse * e / 3.14159265, vec3(65000.0)), 1.0));
+  vec3 albedo = texelFetch(gAlbedo, p, 0).rgb;
+  float metallic = texelFetch(gMaterial, p, 0).g;
+  vec3 diffuse = albedo * (1.0 - metallic);
+  vec3 l = diffuse * e / 3.14159265;
+  if (GLOSSY) l += mix(vec3(0.04), albedo, metallic) * spec;
+  imageStore(outIndirect, p, vec4(min(l, vec3(65000.0)), 1.0));
 #endif
 }

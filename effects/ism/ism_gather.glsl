@@ -8,12 +8,16 @@
 // ISM_CLASSIC: the maps are accurate paraboloid depth maps (D32 reverse-Z, near..far).
 // SCALE > 1: gathered at 1 / SCALE resolution, output pixel p for G-buffer pixel p x SCALE
 // (ism_upsample.comp brings it back to full resolution).
+// GLOSSY: x, y are RGB9E5 irradiance and its Phong-weighted sum (ism_glossy.glsl).
 #include "common.glsl"
 #include "ism_common.glsl"
+#include "ism_glossy.glsl"
 
 layout(constant_id = 0) const int PER_PIXEL = 16;  // ceil(N / K^2)
 layout(constant_id = 1) const int K = 4;
 layout(constant_id = 2) const int SCALE = 1;
+layout(constant_id = 3) const bool GLOSSY = false;
+layout(constant_id = 4) const float PHONG_EXPONENT = 0.0;  // 0: from the roughness
 layout(local_size_x = 32, local_size_y = 16) in;
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 layout(set = 0, binding = 2, std140) uniform Vpls { Vpl vpls[ISM_VPL_SLOTS]; };
@@ -21,6 +25,16 @@ layout(set = 0, binding = 3) uniform sampler2D gDepth;
 layout(set = 0, binding = 4) uniform sampler2D gNormal;
 #include "ism_lookup.glsl"
 layout(set = 0, binding = 6, rgba32ui) uniform writeonly uimage2D outRaw;
+layout(set = 0, binding = 7) uniform sampler2D gMaterial;  // GLOSSY: roughness
+
+// The receiver's BRDF (diffuse, + Phong when GLOSSY): adds VPL v's irradiance at x to e and,
+// when glossy, its Phong-weighted share to spec (view: unit direction to the camera).
+void reflectVpl(Vpl v, uint tile, vec3 x, vec3 n, vec3 view, float exponent, inout vec3 e,
+                inout vec3 spec) {
+  vec3 ei = vplIrradiance(v, tile, x, n);
+  e += ei;
+  if (GLOSSY) spec += ei * ismPhongLobe(x - v.position.xyz, n, view, exponent);
+}
 
 vec2 signNotZero(vec2 v) { return vec2(v.x >= 0.0 ? 1.0 : -1.0, v.y >= 0.0 ? 1.0 : -1.0); }
 uint packNormal(vec3 n) {
@@ -45,12 +59,16 @@ void main() {
   vec3 viewN = safeNormalize(texelFetch(gNormal, g, 0).xyz, vec3(0.0, 0.0, 1.0));
   vec3 x = (frame.invView * vec4(viewPos, 1.0)).xyz;
   vec3 n = safeNormalize(mat3(frame.invView) * viewN, vec3(0.0, 1.0, 0.0));
-  vec3 e = vec3(0.0);
+  vec3 e = vec3(0.0), spec = vec3(0.0);
+  vec3 view = safeNormalize(mat3(frame.invView) * -viewPos, n);
+  float exponent = GLOSSY ? ismPhongExponent(PHONG_EXPONENT, texelFetch(gMaterial, g, 0).r) : 1.0;
   for (int j = 0; j < PER_PIXEL; ++j) {
     uint i = phase + uint(j * K * K);
-    e += vplIrradiance(vpls[i], min(i, uint(ism.blur.w) - 1u), x, n);
+    reflectVpl(vpls[i], min(i, uint(ism.blur.w) - 1u), x, n, view, exponent, e, spec);
   }
   e = min(e * (ism.gather.z * ism.gather.w), vec3(65000.0));  // guard: half floats
-  imageStore(outRaw, p, uvec4(packHalf2x16(e.rg), packHalf2x16(vec2(e.b, 0.0)),
-                              floatBitsToUint(length(viewPos)), packNormal(viewN)));
+  spec = min(spec * (ism.gather.z * ism.gather.w), vec3(65000.0));
+  uvec2 value = GLOSSY ? uvec2(ismPackRgb9e5(e), ismPackRgb9e5(spec))
+                       : uvec2(packHalf2x16(e.rg), packHalf2x16(vec2(e.b, 0.0)));
+  imageStore(outRaw, p, uvec4(value, floatBitsToUint(length(viewPos)), packNormal(viewN)));
 }

@@ -28,6 +28,9 @@ inline constexpr uint32_t kEmpty = 0xffffffffu;   // an ISM texel no point reach
 // x the scene's extent (the `distance_clamp` setting overrides the fraction). Without it a
 // receiver next to a VPL gets unbounded irradiance (and 0/0 at d = 0).
 inline constexpr float kDistanceClamp = 0.02f;
+// Glossy receivers: the largest Phong exponent (VPLs resolve only broad lobes: "slightly
+// glossy").
+inline constexpr float kMaxPhongExponent = 128.0f;
 
 // std140 mirror of IsmParams (ism_common.glsl); vec4 members only.
 struct Uniforms {
@@ -70,6 +73,17 @@ inline glm::vec3 vplIrradiance(const glm::vec3& x, const glm::vec3& n, const glm
   const glm::vec3 dir = w / std::sqrt(d2);
   const float cv = std::max(glm::dot(nv, dir), 0.0f), cr = std::max(-glm::dot(n, dir), 0.0f);
   return phi * (cv * cr / (3.14159265f * std::max(d2, dMin * dMin)));
+}
+
+// Energy-normalised Phong lobe (n + 2) / (2 pi) cos^n(alpha) for light travelling along w
+// (VPL -> receiver, any length) at a receiver with normal n seen from unit direction v; alpha
+// between reflect(w, n) and v (mirror of ismPhongLobe in ism_glossy.glsl). At most
+// (n + 2) / (2 pi); 0 for w = 0. The glossy radiance is f0 x lobe x vplIrradiance(...).
+inline float phongLobe(const glm::vec3& w, const glm::vec3& n, const glm::vec3& v, float exponent) {
+  const float len = glm::length(w);
+  if (!(len > 1e-20f)) return 0.0f;
+  const float c = std::clamp(glm::dot(glm::reflect(w / len, n), v), 0.0f, 1.0f);
+  return (exponent + 2.0f) / (2.0f * 3.14159265f) * std::pow(c, exponent);
 }
 
 // Pull-push over one 2x2 block (seed 002 §3.2, after Marroquim et al. 2007). Depths are

@@ -4,12 +4,15 @@
 // takes the bilinear mix of its 4 nearest low-resolution samples, keeping only those near its
 // tangent plane with a similar normal (the blur's test); when none passes, the plain bilinear
 // mix (a thin feature no sample landed on). Then reflects like the blur's y pass:
-// indirect = diffuse albedo / pi x irradiance.
+// indirect = diffuse albedo / pi x irradiance (+ f0 x the Phong-weighted sum with GLOSSY, whose
+// texels carry both as RGB9E5 words: ism_glossy.glsl).
 #extension GL_GOOGLE_include_directive : require
 #include "common.glsl"
 #include "ism_common.glsl"
+#include "ism_glossy.glsl"
 
 layout(constant_id = 0) const int SCALE = 2;
+layout(constant_id = 1) const bool GLOSSY = false;
 layout(local_size_x = 32, local_size_y = 16) in;
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 layout(set = 0, binding = 2) uniform usampler2D lowRaw;
@@ -40,7 +43,7 @@ void main() {
   vec2 u = vec2(p) / float(SCALE);
   ivec2 b = ivec2(floor(u));
   vec2 f = u - vec2(b);
-  vec3 sum = vec3(0.0), any = vec3(0.0);
+  vec3 sum = vec3(0.0), any = vec3(0.0), specSum = vec3(0.0), specAny = vec3(0.0);
   float wsum = 0.0, asum = 0.0;
   for (int i = 0; i < 4; ++i) {
     ivec2 o = ivec2(i & 1, i >> 1);
@@ -52,16 +55,23 @@ void main() {
     vec3 pt = normalize(viewPositionFromDepth(frame.invProj, uvq, 0.5)) * zt;
     bool same = zt > 0.0 && abs(dot(n, pt - viewPos)) <= ism.blur.x * z &&
                 dot(unpackNormal(t.w), n) >= ism.blur.y;
-    vec3 e = vec3(unpackHalf2x16(t.x), unpackHalf2x16(t.y).x);
+    vec3 e = GLOSSY ? ismUnpackRgb9e5(t.x) : vec3(unpackHalf2x16(t.x), unpackHalf2x16(t.y).x);
+    vec3 s = GLOSSY ? ismUnpackRgb9e5(t.y) : vec3(0.0);
     float w = same ? bil + 1e-6 : 0.0;  // + 1e-6: a passing sample at bilinear weight 0 counts
     sum += w * e;
+    specSum += w * s;
     wsum += w;
     float wa = zt > 0.0 ? bil : 0.0;
     any += wa * e;
+    specAny += wa * s;
     asum += wa;
   }
   vec3 e = wsum > 0.0 ? sum / wsum : any / max(asum, 1e-6);
-  vec3 diffuse = texelFetch(gAlbedo, p, 0).rgb * (1.0 - texelFetch(gMaterial, p, 0).g);
-  vec3 outv = isSky(depth) ? vec3(0.0) : min(diffuse * e / 3.14159265, vec3(65000.0));
+  vec3 spec = wsum > 0.0 ? specSum / wsum : specAny / max(asum, 1e-6);
+  vec3 albedo = texelFetch(gAlbedo, p, 0).rgb;
+  float metallic = texelFetch(gMaterial, p, 0).g;
+  vec3 l = albedo * (1.0 - metallic) * e / 3.14159265;
+  if (GLOSSY) l += mix(vec3(0.04), albedo, metallic) * spec;
+  vec3 outv = isSky(depth) ? vec3(0.0) : min(l, vec3(65000.0));
   imageStore(outIndirect, p, vec4(outv, 1.0));
 }

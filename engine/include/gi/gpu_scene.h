@@ -76,6 +76,9 @@ enum class SceneOutputs {
 };
 std::vector<VkFormat> sceneColorFormats(SceneOutputs outputs);
 inline constexpr VkFormat kSceneDepthFormat = VK_FORMAT_D32_SFLOAT;
+// Bytes between the DrawView records (scene_view.glsl, std140) drawDepthFromBuffer reads: a
+// multiple of every device's minUniformBufferOffsetAlignment (at most 256).
+inline constexpr VkDeviceSize kDrawViewStride = 256;
 
 struct SceneTargets {
   VkImageView depth = VK_NULL_HANDLE;
@@ -104,6 +107,12 @@ class GpuScene {
   // into its viewport (a cube's faces, atlas tiles).
   virtual void drawDepth(PassContext& pc, const SceneTargets& targets,
                          std::span<const SceneView> views) = 0;
+  // As drawDepth, with view i's DrawView record (scene_view.glsl) read on the GPU from `views`
+  // at i x kDrawViewStride bytes and drawn into viewports[i]: views that an earlier pass of the
+  // same frame computed (the ISM effect's VPLs) without reading them back. The calling pass
+  // declares `views` a Uniform read; a record may clip everything (nothing drawn).
+  virtual void drawDepthFromBuffer(PassContext& pc, const SceneTargets& targets, VkBuffer views,
+                                   std::span<const VkRect2D> viewports) = 0;
   // The G-buffer set seen through `viewUniforms` (a FrameUniforms buffer: frameUniforms() or
   // an extra view's), exactly as the main G-buffer pass draws it.
   virtual void drawGBuffer(PassContext& pc, const SceneTargets& targets, VkBuffer viewUniforms) = 0;

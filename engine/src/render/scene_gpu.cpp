@@ -45,6 +45,7 @@ struct MaterialUniforms {
 constexpr VkDeviceSize kMaterialSlotBytes = 256;
 constexpr size_t kViewSlotsPerChunk = 256;
 static_assert(sizeof(DrawViewUniforms) <= kViewSlotBytes);
+static_assert(kDrawViewStride == kViewSlotBytes);
 
 Image makeTexture(Context& ctx, VkFormat format, uint32_t w, uint32_t h, const void* pixels,
                   size_t bytes) {
@@ -599,6 +600,29 @@ void SceneGpu::drawDepth(PassContext& pc, const SceneTargets& t, std::span<const
     setViewport(c, v, t.extent);
     DescriptorWriter w;
     w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, slot.buffer, slot.offset, slot.range);
+    pc.descriptors().bind(c, depthPipeline_, w);
+    for (const SceneDrawItem& d : draws_) {
+      pushDraw(c, depthPipeline_, d, true);
+      vkCmdDrawIndexed(c, d.indexCount, 1, d.firstIndex, d.vertexOffset, 0);
+    }
+  }
+  vkCmdEndRendering(c);
+}
+
+void SceneGpu::drawDepthFromBuffer(PassContext& pc, const SceneTargets& t, VkBuffer views,
+                                   std::span<const VkRect2D> viewports) {
+  if (views == VK_NULL_HANDLE && !viewports.empty())
+    throw Error(ErrorKind::Usage, "", "GpuScene::drawDepthFromBuffer: no view buffer");
+  VkCommandBuffer c = pc.cmd();
+  beginRendering(pc, t, 0);
+  if (!draws_.empty()) bindGeometry(c);
+  for (size_t i = 0; i < viewports.size(); ++i) {
+    SceneView placed;
+    placed.viewport = viewports[i];
+    setViewport(c, placed, t.extent);
+    DescriptorWriter w;
+    w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, views, VkDeviceSize(i) * kDrawViewStride,
+             sizeof(DrawViewUniforms));
     pc.descriptors().bind(c, depthPipeline_, w);
     for (const SceneDrawItem& d : draws_) {
       pushDraw(c, depthPipeline_, d, true);

@@ -33,6 +33,8 @@ class SceneGpu final : public GpuScene {
   void declareRead(PassBuilder& builder, BufferUsage usage) const override;
   void drawDepth(PassContext& pc, const SceneTargets& targets,
                  std::span<const SceneView> views) override;
+  void drawDepthFromBuffer(PassContext& pc, const SceneTargets& targets, VkBuffer views,
+                           std::span<const VkRect2D> viewports) override;
   void drawGBuffer(PassContext& pc, const SceneTargets& targets, VkBuffer viewUniforms) override;
   void drawRsm(PassContext& pc, const SceneTargets& targets, const SceneView& view,
                const LightInfo& light) override;
