@@ -5,8 +5,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -181,6 +183,57 @@ TEST(BenchCli, SeveralEffectsShareOneChartPerScene) {
   EXPECT_NE(svg.find("ssao"), std::string::npos);
   EXPECT_NE(svg.find("gtao"), std::string::npos);
   EXPECT_GT(fs::file_size(out + "/plots/default_all.png"), 1000u);
+}
+
+// repetitions.csv keeps every round of every configuration (median and fastest frame, and with
+// --isolate-passes the process CPU time), and tools/bench-pairs pairs two configurations round
+// by round: its matched-error ratio is the median of the per-round ratios of that file.
+TEST(BenchCli, RepetitionsArePairedRoundByRound) {
+  const bool hasGtao = fs::exists(test::binPath("plugins/gi_effect_gtao.so"));
+  if (!hasSsao() || !hasGtao) GTEST_SKIP() << "the ssao and gtao plugins are not built";
+  const std::string dir = test::makeTempDir("bench-reps");
+  const std::string out = dir + "/out";
+  auto r =
+      test::runCommand(bench("--quick --reps 3 --isolate-passes --effects ssao,gtao --cache '" +
+                             dir + "/cache' --out '" + out + "'"));
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  std::istringstream csv(readAll(out + "/repetitions.csv"));
+  std::string line;
+  std::getline(csv, line);
+  EXPECT_EQ(line.rfind("scene,effect,preset,params,batch,rep,effect_ms,floor_ms,passes_ms,"
+                       "effect_min_ms,passes_min_ms,effect_cpu_ms,passes_cpu_ms",
+                       0),
+            0u);
+  std::map<std::string, std::vector<double>> cpu;  // per configuration, by round
+  while (std::getline(csv, line)) {
+    const std::vector<std::string> f = splitCsvLine(line);
+    ASSERT_EQ(f.size(), 13u) << line;
+    EXPECT_EQ(f[4], "0") << "one interleave batch";
+    const std::string config = f[1] + " " + f[3];  // --quick sweeps ssao.samples=4,16
+    EXPECT_EQ(std::stoi(f[5]), int(cpu[config].size())) << "rounds in order";
+    const double median = std::stod(f[6]), fastest = std::stod(f[9]), cpuMs = std::stod(f[11]);
+    EXPECT_LE(fastest, median + 1e-9) << line;
+    EXPECT_TRUE(std::isfinite(cpuMs) && cpuMs > 0.0) << line;
+    cpu[config].push_back(cpuMs);
+  }
+  const std::string ssao = "ssao ssao.samples=4", gtao = "gtao ";
+  ASSERT_EQ(cpu[ssao].size(), 3u);
+  ASSERT_EQ(cpu[gtao].size(), 3u);
+  // GTAO is the more accurate one here, so it is the "fast" side that reaches SSAO's error.
+  std::vector<double> ratios;
+  for (size_t k = 0; k < 3; ++k) ratios.push_back(cpu[ssao][k] / cpu[gtao][k]);
+  std::sort(ratios.begin(), ratios.end());
+  auto pairs =
+      test::runCommand("python3 '" + std::string(GI_SOURCE_DIR) + "/tools/bench-pairs' matched '" +
+                       out + "' --slow ssao --fast gtao");
+  ASSERT_EQ(pairs.exitCode, 0) << pairs.output;
+  char expected[64];
+  std::snprintf(expected, sizeof expected, "**%.2f** [%.2f, %.2f]", ratios[1], ratios[0],
+                ratios[2]);
+  const size_t row = pairs.output.find("| ssao ssao.samples=4 |");
+  ASSERT_NE(row, std::string::npos) << pairs.output;
+  const std::string rowText = pairs.output.substr(row, pairs.output.find('\n', row) - row);
+  EXPECT_NE(rowText.find(expected), std::string::npos) << expected << "\n" << pairs.output;
 }
 
 // Several presets: the report gets the platform-profile table (a column per preset, the

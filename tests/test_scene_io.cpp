@@ -643,6 +643,20 @@ TEST(SceneIo, ExampleScenes) {
     s.worldBounds(bmin, bmax);
     EXPECT_NEAR(bmin.y, 0.0f, 1e-2f);  // the bunny stands on the plane
   }
+  {
+    // The room with the bunny inside it: the room's bounds (so from the room's camera the same
+    // pixels are geometry, docs/bench/ao/triangles), the bunny's triangles added.
+    GI_REQUIRE_SHARED_ASSET(ply, "stanford_bunny/reconstruction/bun_zipper.ply");
+    const gi::Scene room = gi::makeDefaultScene();
+    gi::Scene s = gi::loadScene((scenes / "room_bunny.json").string());
+    expectSaneScene(s);
+    EXPECT_EQ(s.triangleCount(), room.triangleCount() + plyHeaderFaces(ply));
+    glm::vec3 bmin, bmax, rmin, rmax;
+    s.worldBounds(bmin, bmax);
+    room.worldBounds(rmin, rmax);
+    EXPECT_LT(glm::distance(bmin, rmin), 1e-3f);  // the bunny rests on the floor (y = -1)
+    EXPECT_LT(glm::distance(bmax, rmax), 1e-3f);
+  }
   const std::string glb =
       gi::test::assimpModel("glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb");
   if (!fs::exists(glb)) GTEST_SKIP() << "assimp test models absent: " << glb;

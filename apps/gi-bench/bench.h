@@ -15,6 +15,9 @@ namespace gi::bench {
 struct PassTime {
   std::string name;
   Interval ms;
+  std::vector<double> reps;     // each repetition's median over frames, in measurement order
+  std::vector<double> repsMin;  // each repetition's fastest frame
+  std::vector<double> repsCpu;  // each repetition's median process CPU ms (-1: not isolated)
 };
 
 struct Row {
@@ -35,6 +38,13 @@ struct Row {
   double floorMs = 0.0;   // the engine's floor pass (a fixed full-screen cost baseline)
   double wallMs = 0.0;    // median CPU wall time of renderFrame() (submit + wait)
   Interval totalCi, effectCi, floorCi, wallCi;
+  // Each repetition's effect and floor times, in order: repetition r of every configuration
+  // ran in the same round, so ratios between configurations can be paired round by round
+  // (repetitions.csv).
+  std::vector<double> effectReps, floorReps;
+  std::vector<double> effectRepsMin;  // each repetition's fastest frame per effect pass, summed
+  std::vector<double> effectRepsCpu;  // each repetition's CPU ms of the effect passes (-1: none)
+  size_t batch = 0;  // interleave batch (at most 16 configurations): rounds are shared within it
   std::string compared;  // "ao" or "lit"
   // Two scores: against the physical target (AO for AO-like effects, direct + indirect for GI
   // effects, else direct light) and against the quantity the effect declares it estimates

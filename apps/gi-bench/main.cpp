@@ -86,6 +86,10 @@ const char* kUsage =
     "                        buffer holds, off-screen and hidden occluders (gi-reference\n"
     "                        --quantity ao-split) and report where the effect cannot converge\n"
     "  --cache DIR           reference cache (default <bin>/../bench-cache)\n"
+    "  --isolate-passes      submit each pass alone and wait (a CPU driver otherwise lets a\n"
+    "                        pass's work spill into the next pass's timestamps) and also\n"
+    "                        record each pass's process CPU time (repetitions.csv: robust\n"
+    "                        to other jobs on a shared CPU, unlike wall-clock timestamps)\n"
     "  --budget-ms B         --calibrate: frame budget (GPU ms, all passes)\n"
     "  --headroom F          --calibrate: keep the measured time under (1 - F) * budget (0.1);\n"
     "                        the upper end of the time interval must fit, and cost is assumed\n"
@@ -118,6 +122,7 @@ struct Options {
   bool quick = false, calibrate = false, progress = true, validation = false, aoSplit = false;
   std::optional<ref::Quantity> target;  // --target: one light quantity for every configuration
   bool excludeEmitters = false;         // --exclude-emitters
+  bool isolatePasses = false;
   double budgetMs = 0.0, headroom = 0.1;
   std::string metric = "ssim";  // --calibrate: what "most accurate" means
   bool metricGiven = false;
@@ -184,6 +189,8 @@ Options parseArgs(int argc, char** argv) {
       o.excludeEmitters = true;
     else if (a.is("--ao-split"))
       o.aoSplit = true;
+    else if (a.is("--isolate-passes"))
+      o.isolatePasses = true;
     else if (a.is("--calibrate"))
       o.calibrate = true;
     else if (a.is("--metric")) {
@@ -483,7 +490,11 @@ using gi::bench::median;
 struct Timing {
   std::vector<std::string> passNames;  // graph order
   std::map<std::string, std::vector<double>> passes;
+  std::map<std::string, std::vector<double>> passMins;  // per repetition: fastest frame
+  std::map<std::string, std::vector<double>> passCpu;   // per repetition: median CPU ms
   std::vector<double> total, effect, floor, wall;
+  std::vector<double> effectMin;  // per repetition: the effect passes' fastest frames, summed
+  std::vector<double> effectCpu;  // per repetition: the effect passes' median CPU ms, summed
 };
 
 // The rendered configuration: its timings over the repetitions and, after the last one, the
@@ -491,6 +502,10 @@ struct Timing {
 struct Measurement {
   std::vector<gi::bench::PassTime> passes;
   Interval total, effect, floor, wall;
+  std::vector<double> effectReps, floorReps;  // per repetition, in order
+  std::vector<double> effectRepsMin;          // per repetition: fastest frames
+  std::vector<double> effectRepsCpu;          // per repetition: CPU ms (--isolate-passes)
+  size_t batch = 0;  // interleave batch: only configurations of one batch share rounds
   gi::ImageRGBA32F out, depth;
   gi::ImageRGBA32F emission;  // --exclude-emitters only
 };
@@ -557,20 +572,33 @@ struct RenderJob {
 // `frames` timed frames; each pass's median over them.
 void measureRepetition(gi::Renderer& renderer, int frames, Timing& t) {
   renderer.renderFrame();
-  std::map<std::string, std::vector<double>> samples;
+  std::map<std::string, std::vector<double>> samples, cpu;
   std::vector<double> wall;
   for (int f = 0; f < frames; ++f) {
     const auto t0 = std::chrono::steady_clock::now();
     renderer.renderFrame();
     wall.push_back(
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-    for (const auto& pt : renderer.lastTimings()) samples[pt.name].push_back(pt.ms);
+    for (const auto& pt : renderer.lastTimings()) {
+      samples[pt.name].push_back(pt.ms);
+      if (pt.cpuMs >= 0.0) cpu[pt.name].push_back(pt.cpuMs);
+    }
   }
   t.passNames = renderer.passNames();
-  double total = 0.0, effect = 0.0, floor = 0.0;
+  double total = 0.0, effect = 0.0, floor = 0.0, effectMin = 0.0, effectCpu = 0.0;
   for (const std::string& name : t.passNames) {
     const double ms = median(samples[name]);
     t.passes[name].push_back(ms);
+    // On a shared CPU device a frame's pass is often preempted: the fastest frame is the
+    // least disturbed one (repetitions.csv keeps it beside the median).
+    const double fastest = *std::min_element(samples[name].begin(), samples[name].end());
+    t.passMins[name].push_back(fastest);
+    const double cpuMs = cpu[name].empty() ? -1.0 : median(cpu[name]);
+    t.passCpu[name].push_back(cpuMs);
+    if (name != "floor" && !renderer.isEnginePass(name)) {
+      effectMin += fastest;
+      effectCpu += cpuMs;
+    }
     if (name == "floor") {
       floor = ms;
       continue;
@@ -580,6 +608,8 @@ void measureRepetition(gi::Renderer& renderer, int frames, Timing& t) {
   }
   t.total.push_back(total);
   t.effect.push_back(effect);
+  t.effectMin.push_back(effectMin);
+  t.effectCpu.push_back(cpu.empty() ? -1.0 : effectCpu);
   t.floor.push_back(floor);
   t.wall.push_back(median(wall));
 }
@@ -604,6 +634,7 @@ std::vector<Measurement> measureAll(
       settings.width = o.width;
       settings.height = o.height;
       settings.floorPass = floorPass;
+      settings.isolatePasses = o.isolatePasses;
       settings.effects = *jobs[i].effects;
       settings.keepForReadback = {jobs[i].resource, gi::resources::kDepth};  // read when scored
       if (o.excludeEmitters) settings.keepForReadback.push_back(gi::resources::kEmission);
@@ -618,11 +649,17 @@ std::vector<Measurement> measureAll(
       const Timing& t = timings[i - first];
       Measurement& m = out[i];
       for (const std::string& name : t.passNames)
-        m.passes.push_back({name, gi::bench::medianInterval(t.passes.at(name))});
+        m.passes.push_back({name, gi::bench::medianInterval(t.passes.at(name)), t.passes.at(name),
+                            t.passMins.at(name), t.passCpu.at(name)});
       m.total = gi::bench::medianInterval(t.total);
       m.effect = gi::bench::medianInterval(t.effect);
       m.floor = gi::bench::medianInterval(t.floor);
       m.wall = gi::bench::medianInterval(t.wall);
+      m.effectReps = t.effect;
+      m.effectRepsMin = t.effectMin;
+      m.effectRepsCpu = t.effectCpu;
+      m.batch = first / kInterleaveBatch;
+      m.floorReps = t.floor;
       m.out = renderers[i - first]->readTarget(jobs[i].resource);
       m.depth = renderers[i - first]->readTarget(gi::resources::kDepth);
       if (o.excludeEmitters)
@@ -980,6 +1017,11 @@ int runSweep(const Options& o) {
     r.effectCi = m.effect;
     r.floorCi = m.floor;
     r.wallCi = m.wall;
+    r.effectReps = m.effectReps;
+    r.effectRepsMin = m.effectRepsMin;
+    r.effectRepsCpu = m.effectRepsCpu;
+    r.batch = m.batch;
+    r.floorReps = m.floorReps;
     r.totalMs = m.total.median;
     r.effectMs = m.effect.median;
     r.floorMs = m.floor.median;

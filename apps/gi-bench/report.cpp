@@ -77,6 +77,35 @@ bool anySplit(const std::vector<Row>& rows) {
   return std::any_of(rows.begin(), rows.end(), [](const Row& r) { return r.split.present; });
 }
 
+// One line per configuration and repetition: repetition r of every configuration ran in the
+// same round-robin round, so a ratio of two configurations' times can be formed round by round
+// (paired), which cancels load that drifts between rounds; only within one interleave batch
+// (`batch`: at most 16 configurations are alive, and measured round-robin, at once).
+std::string repetitionsCsv(const std::vector<Row>& rows) {
+  std::ostringstream o;
+  o << "scene,effect,preset,params,batch,rep,effect_ms,floor_ms,passes_ms,effect_min_ms,"
+       "passes_min_ms,effect_cpu_ms,passes_cpu_ms\n";
+  for (const Row& r : rows)
+    for (size_t k = 0; k < r.effectReps.size(); ++k) {
+      std::string passes, mins, cpu;
+      for (const PassTime& p : r.passes) {
+        if (k < p.reps.size())
+          passes += (passes.empty() ? "" : " ") + p.name + "=" + fmt(p.reps[k], 6);
+        if (k < p.repsMin.size())
+          mins += (mins.empty() ? "" : " ") + p.name + "=" + fmt(p.repsMin[k], 6);
+        if (k < p.repsCpu.size())
+          cpu += (cpu.empty() ? "" : " ") + p.name + "=" + fmt(p.repsCpu[k], 6);
+      }
+      o << csvField(r.scene) << ',' << csvField(r.effect) << ',' << csvField(r.preset) << ','
+        << csvField(r.params) << ',' << r.batch << ',' << k << ',' << fmt(r.effectReps[k], 6) << ','
+        << fmt(k < r.floorReps.size() ? r.floorReps[k] : 0.0, 6) << ',' << csvField(passes) << ','
+        << fmt(k < r.effectRepsMin.size() ? r.effectRepsMin[k] : 0.0, 6) << ',' << csvField(mins)
+        << ',' << fmt(k < r.effectRepsCpu.size() ? r.effectRepsCpu[k] : -1.0, 6) << ','
+        << csvField(cpu) << '\n';
+    }
+  return o.str();
+}
+
 std::string csv(const std::vector<Row>& rows) {
   std::ostringstream o;
   const bool split = anySplit(rows);
@@ -623,6 +652,7 @@ void writeResults(const std::string& dir, const std::vector<Row>& rows, const Ru
     write(file, buildPlot(title, groups[key]));
   }
   writeFileAtomic((fs::path(dir) / "results.csv").string(), csv(rows));
+  writeFileAtomic((fs::path(dir) / "repetitions.csv").string(), repetitionsCsv(rows));
   writeFileAtomic((fs::path(dir) / "results.json").string(), json(rows, info));
   writeFileAtomic((fs::path(dir) / "report.md").string(), markdown(rows, info, plots));
 }

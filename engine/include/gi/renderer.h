@@ -56,6 +56,11 @@ struct RenderSettings {
 struct PassTiming {
   std::string name;
   double ms = 0.0;
+  // With RenderSettings::isolatePasses: the process's CPU time over the pass (recording,
+  // submission, execution on every driver thread, the wait), ms. On a CPU driver (lavapipe) this
+  // is the pass's work, which other processes sharing the cores do not inflate as they inflate
+  // the wall-clock timestamps of `ms`. Negative without isolatePasses.
+  double cpuMs = -1.0;
 };
 
 class Renderer {

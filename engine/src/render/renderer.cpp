@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <map>
 #include <set>
 
@@ -516,6 +517,13 @@ struct Renderer::Impl : EffectContext {
     for (const auto& v : views) v.lock()->refresh(frameData);
   }
 
+  // CPU time of the whole process (every thread, a CPU driver's workers included), ms.
+  static double processCpuMs() {
+    timespec ts{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return double(ts.tv_sec) * 1e3 + double(ts.tv_nsec) * 1e-6;
+  }
+
   // Ends `c`, submits it and waits for it to complete.
   void submitAndWait(VkCommandBuffer c) {
     check(vkEndCommandBuffer(c), "vkEndCommandBuffer");
@@ -542,17 +550,24 @@ struct Renderer::Impl : EffectContext {
     check(vkBeginCommandBuffer(cmd, &begin), "vkBeginCommandBuffer");
     timer->beginFrame(cmd);
     FrameGraph::PassBoundary isolate;
-    if (settings.isolatePasses)
-      isolate = [this, &begin](VkCommandBuffer c) {
+    std::vector<double> cpuMarks;  // process CPU time before the first pass and after each
+    if (settings.isolatePasses) {
+      cpuMarks.push_back(processCpuMs());
+      isolate = [this, &begin, &cpuMarks](VkCommandBuffer c) {
         submitAndWait(c);
+        cpuMarks.push_back(processCpuMs());
         check(vkResetCommandBuffer(c, 0), "vkResetCommandBuffer");
         check(vkBeginCommandBuffer(c, &begin), "vkBeginCommandBuffer");
         return c;
       };
+    }
     graph.execute(cmd, descriptors, timer.get(), isolate);
     submitAndWait(cmd);
     timings.clear();
-    for (auto& [name, ms] : timer->collect()) timings.push_back({name, ms});
+    for (auto& [name, ms] : timer->collect()) timings.push_back({name, ms, -1.0});
+    // One boundary per executed pass, in the order the timer saw them.
+    if (cpuMarks.size() == timings.size() + 1)
+      for (size_t i = 0; i < timings.size(); ++i) timings[i].cpuMs = cpuMarks[i + 1] - cpuMarks[i];
     prevViewProj = cameraView.proj * cameraView.view;
     lastFrameTime = timeSeconds;
     ++framesRendered;
