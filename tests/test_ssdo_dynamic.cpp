@@ -13,42 +13,30 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "effect_fixture.h"
 #include "gi/effect_config.h"
 #include "gi/renderer.h"
 #include "gi/scene_io.h"
 #include "quad_scene.h"
 #include "ssdo_frames.h"
 #include "test_support.h"
-#include "vulkan_fixture.h"
 
 namespace gi {
 namespace {
 
 constexpr uint32_t kW = 160, kH = 120;
 
-class SsdoDynamicTest : public test::VulkanTest {
+class SsdoDynamicTest : public test::EffectTest {
  protected:
-  void SetUp() override {
-    VulkanTest::SetUp();
-    registry.scanDirectory(test::binPath("plugins"));
-    ASSERT_TRUE(registry.has("ssdo")) << "ssdo plugin missing from " << test::binPath("plugins");
-  }
-  RenderSettings settingsFor(const Scene& scene, const std::vector<std::string>& sets) {
-    EffectOverrides cli;
-    cli.effects = {"ssdo"};
-    cli.sets = sets;
-    RenderSettings rs;
-    rs.width = kW;
-    rs.height = kH;
-    rs.effects = resolveEffects(scene, nullptr, cli, registry);
-    return rs;
+  std::string effectName() const override { return "ssdo"; }
+  RenderSettings settingsFor(const Scene& scene, const std::vector<std::string>& sets) const {
+    return EffectTest::settingsFor(scene, sets, kW, kH);
   }
   static test::SsdoFrame grab(Renderer& r) {
     r.renderFrame();
     return test::SsdoFrame(r.readTarget("ambient"), r.readTarget("indirect"), r.readTarget("depth"),
                            r.camera());
   }
-  EffectRegistry registry;
 };
 
 // ---- the walking Fox ------------------------------------------------------------------------

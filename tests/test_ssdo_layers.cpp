@@ -7,35 +7,24 @@
 #include <fstream>
 #include <string>
 
+#include "effect_fixture.h"
 #include "gi/effect_config.h"
 #include "gi/renderer.h"
 #include "gi/scene_io.h"
 #include "quad_scene.h"
 #include "ssdo_frames.h"
 #include "test_support.h"
-#include "vulkan_fixture.h"
 
 namespace gi {
 namespace {
 
 constexpr uint32_t kW = 160, kH = 120;
 
-class SsdoLayersTest : public test::VulkanTest {
+class SsdoLayersTest : public test::EffectTest {
  protected:
-  void SetUp() override {
-    VulkanTest::SetUp();
-    registry.scanDirectory(test::binPath("plugins"));
-    ASSERT_TRUE(registry.has("ssdo")) << "ssdo plugin missing from " << test::binPath("plugins");
-  }
-  RenderSettings settingsFor(const Scene& scene, const std::vector<std::string>& sets) {
-    EffectOverrides cli;
-    cli.effects = {"ssdo"};
-    cli.sets = sets;
-    RenderSettings rs;
-    rs.width = kW;
-    rs.height = kH;
-    rs.effects = resolveEffects(scene, nullptr, cli, registry);
-    return rs;
+  std::string effectName() const override { return "ssdo"; }
+  RenderSettings settingsFor(const Scene& scene, const std::vector<std::string>& sets) const {
+    return EffectTest::settingsFor(scene, sets, kW, kH);
   }
   test::SsdoFrame render(const Scene& scene, const std::vector<std::string>& sets,
                          std::vector<std::string>* passes = nullptr) {
@@ -53,7 +42,6 @@ class SsdoLayersTest : public test::VulkanTest {
     }
     return loadSceneJson(path);
   }
-  EffectRegistry registry;
 };
 
 TEST_F(SsdoLayersTest, TheGraphRunsLayersMinusOnePeelPasses) {
