@@ -19,7 +19,8 @@
 
 // Bumped whenever this header, settings.h, frame_graph.h or the shader interface change in a
 // way that breaks compiled modules; the registry refuses modules built against another value.
-#define GI_EFFECT_ABI_VERSION 7u
+// 8: GpuScene::drawDepthFromBuffer (a new virtual: the vtable moved).
+#define GI_EFFECT_ABI_VERSION 8u
 
 namespace gi {
 
