@@ -15,11 +15,11 @@
 #include <vector>
 
 #include "../effects/ism/ism_params.h"
+#include "effect_fixture.h"
 #include "gi/effect_config.h"
 #include "gi/renderer.h"
 #include "gi/scene_io.h"
 #include "test_support.h"
-#include "vulkan_fixture.h"
 
 namespace gi {
 namespace {
@@ -136,13 +136,9 @@ TEST(IsmFormulas, PullPushFillsHolesWithoutDepthOutliers) {
 
 // ---- GPU ------------------------------------------------------------------------------------
 
-class IsmTest : public test::VulkanTest {
+class IsmTest : public test::EffectTest {
  protected:
-  void SetUp() override {
-    VulkanTest::SetUp();
-    registry.scanDirectory(test::binPath("plugins"));
-    ASSERT_TRUE(registry.has("ism")) << "ism plugin missing from " << test::binPath("plugins");
-  }
+  std::string effectName() const override { return "ism"; }
   struct Result {
     ImageRGBA32F indirect, depth;
     CameraView camera;
@@ -229,7 +225,6 @@ class IsmTest : public test::VulkanTest {
   static void expectFinite(const ImageRGBA32F& img) {
     for (float v : img.pixels) ASSERT_TRUE(std::isfinite(v) && v >= 0.0f) << v;
   }
-  EffectRegistry registry;
 };
 
 float luminance(const glm::vec3& c) {
@@ -472,13 +467,7 @@ TEST_F(IsmTest, ClassicMapsFollowAMovingLightInTheSameFrame) {
       "camera": { "position": [0, 2, 6], "target": [0, 1.5, -2] },
       "environment": { "type": "constant", "intensity": 0 } })");
   auto frames = [&](const std::vector<double>& times) {
-    EffectOverrides cli;
-    cli.effects = {"ism"};
-    cli.sets = {"ism.vpls=64", "ism.mode=classic"};
-    RenderSettings rs;
-    rs.width = kW;
-    rs.height = kH;
-    rs.effects = resolveEffects(s, nullptr, cli, registry);
+    RenderSettings rs = settingsFor(s, {"ism.vpls=64", "ism.mode=classic"}, kW, kH);
     Renderer r(ctx(), s, rs, &registry);
     for (double t : times) {
       r.setTime(t);
@@ -505,14 +494,9 @@ TEST_F(IsmTest, ClassicMapsFollowAMovingLightInTheSameFrame) {
 // bounce's VPLs got maps and the second bounce's light was unshadowed).
 TEST_F(IsmTest, ClassicModeDrawsEveryBouncesMaps) {
   const Scene s = loadScene(std::string(GI_SOURCE_DIR) + "/assets/scenes/cornell_box.json");
-  EffectOverrides cli;
-  cli.effects = {"ism"};
-  cli.sets = {"ism.vpls=16", "ism.bounces=2", "ism.mode=classic", "ism.ism_resolution=32"};
-  RenderSettings rs;
-  rs.width = kW;
-  rs.height = kH;
+  RenderSettings rs = settingsFor(
+      s, {"ism.vpls=16", "ism.bounces=2", "ism.mode=classic", "ism.ism_resolution=32"}, kW, kH);
   rs.view = "ism_atlas";
-  rs.effects = resolveEffects(s, nullptr, cli, registry);
   Renderer r(ctx(), s, rs, &registry);
   r.renderFrame();
   const ImageRGBA32F atlas = r.readTarget("ism_atlas");
@@ -614,14 +598,8 @@ TEST_F(IsmTest, AtlasViewRunsOnlyWhenViewed) {
   };
   EXPECT_FALSE(has(render(s, {"ism.vpls=16"}).passes, "ism_atlas_view"));
   for (const char* mode : {"ism", "classic"}) {
-    EffectOverrides cli;
-    cli.effects = {"ism"};
-    cli.sets = {"ism.vpls=16", std::string("ism.mode=") + mode};
-    RenderSettings rs;
-    rs.width = kW;
-    rs.height = kH;
+    RenderSettings rs = settingsFor(s, {"ism.vpls=16", std::string("ism.mode=") + mode}, kW, kH);
     rs.view = "ism_atlas";
-    rs.effects = resolveEffects(s, nullptr, cli, registry);
     Renderer r(ctx(), s, rs, &registry);
     r.renderFrame();  // one frame: classic mode places its maps from this frame's VPLs
     EXPECT_TRUE(has(r.passNames(), "ism_atlas_view")) << mode;
@@ -645,19 +623,14 @@ TEST_F(IsmTest, AtlasViewRunsOnlyWhenViewed) {
 TEST_F(IsmTest, PullPushMatchesTheCpuRules) {
   const Scene s = panelScene();
   auto atlas = [&](int levels, const char* threshold) {
-    EffectOverrides cli;
-    cli.effects = {"ism"};
-    cli.sets = {"ism.vpls=16",
-                "ism.ism_resolution=64",
-                "ism.points_per_ism=256",
-                "ism.pull_push_levels=" + std::to_string(levels),
-                std::string("ism.pull_threshold=") + threshold,
-                std::string("ism.push_threshold=") + threshold};
-    RenderSettings rs;
-    rs.width = kW;
-    rs.height = kH;
+    RenderSettings rs =
+        settingsFor(s,
+                    {"ism.vpls=16", "ism.ism_resolution=64", "ism.points_per_ism=256",
+                     "ism.pull_push_levels=" + std::to_string(levels),
+                     std::string("ism.pull_threshold=") + threshold,
+                     std::string("ism.push_threshold=") + threshold},
+                    kW, kH);
     rs.view = "ism_atlas";
-    rs.effects = resolveEffects(s, nullptr, cli, registry);
     Renderer r(ctx(), s, rs, &registry);
     r.renderFrame();
     return r.readTarget("ism_atlas");
