@@ -320,16 +320,9 @@ TEST_F(SsdoTest, TouchingOccludersStayFiniteAndBoundedByTheDistanceClamp) {
 }
 
 TEST_F(SsdoTest, NoNaNAtGrazingAnglesExtremeClipPlanesAndSky) {
-  using test::cornerQuads;
-  struct Case {
-    glm::vec3 eye, target;
-    float znear, zfar;
-  };
   // Grazing: the eye 1e-3 above the floor; extreme planes; looking up into the sky.
-  for (const Case& k : {Case{{6, 1e-3f, 0.5f}, {0, 0, 0.5f}, 0.05f, 100.0f},
-                        Case{{2.5f, 1.6f, 0}, {0, 0, 0}, 1e-4f, 1e5f},
-                        Case{{2.5f, 0.3f, 0}, {0, 3, 0}, 1e-4f, 1e5f}}) {
-    const Scene s = test::quadScene(cornerQuads(), k.eye, k.target, 1.0f, k.znear, k.zfar);
+  for (const test::HardCornerView& k : test::hardCornerViews()) {
+    const Scene s = k.scene();
     // The last: depth peeling and additional cameras on the same hard cases.
     for (const char* bounce : {"ssdo.bounce=true", "ssdo.bounce=false", "ssdo.layers=2"}) {
       std::vector<std::string> sets = {bounce, "ssdo.distance_clamp=1e-6"};

@@ -162,14 +162,8 @@ TEST_F(SsdoLayersTest, TheThirdAndFourthLayersFindASlabBehindAnother) {
 // sky) with 3 and 4 layers, the bounce, the smallest distance clamp and an additional camera:
 // finite and non-negative everywhere.
 TEST_F(SsdoLayersTest, ThreeAndFourLayersStayFiniteInTheHardCases) {
-  struct Case {
-    glm::vec3 eye, target;
-    float znear, zfar;
-  };
-  for (const Case& k : {Case{{6, 1e-3f, 0.5f}, {0, 0, 0.5f}, 0.05f, 100.0f},
-                        Case{{2.5f, 1.6f, 0}, {0, 0, 0}, 1e-4f, 1e5f},
-                        Case{{2.5f, 0.3f, 0}, {0, 3, 0}, 1e-4f, 1e5f}}) {
-    const Scene s = test::quadScene(test::cornerQuads(), k.eye, k.target, 1.0f, k.znear, k.zfar);
+  for (const test::HardCornerView& k : test::hardCornerViews()) {
+    const Scene s = k.scene();
     for (const char* layers : {"ssdo.layers=3", "ssdo.layers=4"}) {
       const test::SsdoFrame f =
           render(s, {layers, "ssdo.bounce=true", "ssdo.distance_clamp=1e-6", "ssdo.cameras=1"});

@@ -70,6 +70,19 @@ inline Scene cornerScene(float scale = 1.0f, float yfov = glm::radians(60.0f)) {
                    100.0f, yfov);
 }
 
+// The corner seen in the hard cases screen-space effects must survive: the eye 1e-3 above the
+// floor (grazing), near 1e-4 / far 1e5, and looking up into the sky with those planes.
+struct HardCornerView {
+  glm::vec3 eye, target;
+  float znear, zfar;
+  Scene scene() const { return quadScene(cornerQuads(), eye, target, 1.0f, znear, zfar); }
+};
+inline std::vector<HardCornerView> hardCornerViews() {
+  return {{{6, 1e-3f, 0.5f}, {0, 0, 0.5f}, 0.05f, 100.0f},
+          {{2.5f, 1.6f, 0}, {0, 0, 0}, 1e-4f, 1e5f},
+          {{2.5f, 0.3f, 0}, {0, 3, 0}, 1e-4f, 1e5f}};
+}
+
 // The depth-discontinuity case: a wall at z = 0 and, 3 units in front of it, an open book (two
 // 0.4-wide quads meeting at 90 degrees, opening toward a camera at z = 6): dark inside, up to
 // its outline, while nothing darkens the wall 3 units behind.
