@@ -1,6 +1,6 @@
-// Lighting composition: the optional inputs ao / ambient / indirect with their neutral
-// fallbacks, effects ordered by their declared reads and writes, and the check of those
-// declarations against what an effect's passes really do.
+// Lighting composition: the optional inputs ao / ambient / indirect / contact_shadow /
+// direct_light with their neutral fallbacks, effects ordered by their declared reads and
+// writes, and the check of those declarations against what an effect's passes really do.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -209,6 +209,53 @@ TEST_F(LightingCompositionTest, ContactShadowScalesOnlyTheShadowedLightsDirectTe
     if (both.lit.pixels[i] - unshadowed.lit.pixels[i] > 0.05f) ++lit;
   }
   EXPECT_GT(lit, both.lit.pixels.size() / 4 / 4) << "the shadowed light must light the view";
+}
+
+// direct_light replaces the lighting pass's sum of the lights: lit(with it) = lit(the same scene
+// without lights) + the published radiance on geometry; published beside contact_shadow (whose
+// factors apply to single lights, already summed in it) the frame is refused with the reason.
+TEST_F(LightingCompositionTest, DirectLightReplacesTheLightsAndRefusesContactShadowsBesideIt) {
+  const Scene lit = loadScene("default");
+  Scene dark = lit;
+  dark.lights.clear();
+  for (Node& n : dark.nodes) n.light = -1;
+  EffectRegistry reg;
+  reg.add([] {
+    return std::make_unique<ConstantEffect>(
+        "direct_const", EffectStage::BeforeLighting, std::vector<std::string>{},
+        std::vector<ConstantEffect::Output>{
+            {resources::kDirectLight, kRGBA16F, {{0.25f, 0.5f, 0.125f, 1.0f}}}});
+  });
+  reg.add([] {
+    return std::make_unique<ConstantEffect>(
+        "contact_const", EffectStage::BeforeLighting, std::vector<std::string>{},
+        std::vector<ConstantEffect::Output>{
+            {resources::kContactShadow, VK_FORMAT_R8G8B8A8_UNORM, {{0.5f, 1.0f, 1.0f, 1.0f}}}});
+  });
+  const Frame own = renderWith(ctx(), lit, reg, {});
+  const Frame replaced = renderWith(ctx(), lit, reg, {"direct_const"});
+  const Frame unlit = renderWith(ctx(), dark, reg, {});
+  size_t geometry = 0, changed = 0;
+  const float c[3] = {0.25f, 0.5f, 0.125f};
+  for (size_t i = 0; i < own.lit.pixels.size(); i += 4) {
+    if (own.depth.pixels[i] <= 0.0f) continue;  // sky: not composed
+    ++geometry;
+    for (size_t k = 0; k < 3; ++k)
+      ASSERT_NEAR(replaced.lit.pixels[i + k], unlit.lit.pixels[i + k] + c[k],
+                  2e-3f * (unlit.lit.pixels[i + k] + c[k]))
+          << "pixel " << i / 4 << " channel " << k;
+    if (std::abs(own.lit.pixels[i + 1] - replaced.lit.pixels[i + 1]) > 0.01f) ++changed;
+  }
+  EXPECT_GT(geometry, own.lit.pixels.size() / 8);
+  EXPECT_GT(changed, geometry / 2) << "the scene's own lights must differ from the constant";
+  try {
+    renderWith(ctx(), lit, reg, {"direct_const", "contact_const"});
+    FAIL() << "direct_light beside contact_shadow must be refused";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("direct_light must apply the contact shadows"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 // A declared optional lighting input may stay unpublished (an effect's setting turns it off):

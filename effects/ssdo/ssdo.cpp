@@ -7,8 +7,12 @@
 // the engine's layered-depth draw (`layers` 2..4, passes ssdo_peel, ssdo_peel2, ssdo_peel3;
 // layers 2 and 3 packed by ssdo_layers.comp), and `cameras` low-resolution
 // views whose G-buffers add occluders and senders (passes ssdo_cameras, ssdo_camera_surface).
-// Optional (seed 000 §5, `contact_shadows`): the contact shadows the shadow-map bias removes,
-// published as the lighting pass's "contact_shadow" (pass ssdo_contact, ssdo_contact.comp).
+// Optional (seed 000 §5, `contact_shadows`): the contact shadows the shadow-map bias removes
+// (pass ssdo_contact, ssdo_contact.comp), applied to the lights SSDO publishes with the bounce,
+// or published as the lighting pass's "contact_shadow" without it.
+// With the bounce the senders need this frame's direct light, so ssdo_surface sums the lights
+// as the lighting pass would and publishes that as "direct_light": the lighting pass uses it
+// instead of summing them a second time.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -71,7 +75,7 @@ class SsdoEffect : public gi::Effect {
     i.stage = gi::EffectStage::BeforeLighting;
     i.reads = {res::kDepth,    res::kNormal, res::kAlbedo,      res::kMaterial,
                res::kEmission, res::kLights, res::kShadowViews, res::kShadowMaps};
-    i.writes = {res::kAmbient, res::kIndirect, res::kContactShadow};
+    i.writes = {res::kAmbient, res::kIndirect, res::kContactShadow, res::kDirectLight};
     i.debugView = res::kAmbient;
     i.estimates = gi::GroundTruth::IndirectLight;
     return i;
@@ -98,10 +102,6 @@ class SsdoEffect : public gi::Effect {
         gi::SettingDesc::length("distance_clamp", 0.1, 1e-6, 1e9,
                                 "bounce guard: the sender distance d is clamped to at least "
                                 "this (1 / max(d^2, d_min^2))"),
-        {"sender_shadows", SettingType::Bool, 1, 0, 1,
-         "shadow maps in the senders' direct light (off: senders in shadow glow, but the "
-         "surface pass costs about a third: the point lights' per-pixel cube-face lookup)",
-         true},
         {"blur_radius", SettingType::Int, 2, 0, gi::ssdo::kMaxBlurRadius,
          "geometry-aware blur radius in pixels (0: none; even radii cancel the 4x4 pattern)", true},
         {"layers", SettingType::Int, 1, 1, gi::ssdo::kMaxLayers,
@@ -121,8 +121,9 @@ class SsdoEffect : public gi::Effect {
          false},
         {"contact_shadows", SettingType::Bool, 0, 0, 1,
          "screen-space contact shadows for the first four shadow-casting lights: restores the "
-         "shadow the shadow-map bias removes next to contacts (pass ssdo_contact, publishes "
-         "\"contact_shadow\")",
+         "shadow the shadow-map bias removes next to contacts (pass ssdo_contact; applied to "
+         "the published \"direct_light\" with the bounce, published as \"contact_shadow\" "
+         "without it)",
          true},
         gi::SettingDesc::samples("contact_samples", 4, 1, kMaxContactSamples,
                                  "samples per pixel and light on the bias segment toward the "
@@ -138,7 +139,6 @@ class SsdoEffect : public gi::Effect {
                tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
                img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
     bounce_ = settings.flag("bounce");
-    senderShadows_ = settings.flag("sender_shadows");
     samples_ = uint32_t(std::clamp(settings.integer("samples"), 1, gi::ssdo::kMaxSamples));
     layers_ = uint32_t(std::clamp(settings.integer("layers"), 1, gi::ssdo::kMaxLayers));
     cameras_ = uint32_t(std::clamp(settings.integer("cameras"), 0, gi::ssdo::kMaxCameras));
@@ -211,7 +211,9 @@ class SsdoEffect : public gi::Effect {
       // The peeled depth layers 1..layers-1 (peeled[0] is layer 1), and layers 2 and 3 packed.
       std::vector<gi::TextureHandle> peeled;
       gi::TextureHandle layers23;
-      gi::TextureHandle contact;  // contact_shadow (contact_shadows)
+      gi::TextureHandle contact;    // contact_shadow (contact_shadows)
+      gi::TextureHandle direct;     // direct_light (bounce)
+      gi::TextureHandle camDirect;  // the cameras' stand-in for direct_light's binding
       // Per additional camera: its depth, G-buffer colours and surface texels.
       std::vector<gi::TextureHandle> camDepth, camSurface;
       std::vector<std::vector<gi::TextureHandle>> camG;
@@ -297,11 +299,16 @@ class SsdoEffect : public gi::Effect {
             io->lights = b.read(bb.buffer(res::kLights));
             io->shadowViews = b.read(bb.buffer(res::kShadowViews));
             io->shadowMaps = b.read(bb.texture(res::kShadowMaps));
+            // The cameras publish no direct light: a 1x1 image stands in for that binding.
+            io->camDirect =
+                b.write(b.create("ssdo_camera_direct",
+                                 gi::TextureDesc{kOutFormat, gi::SizeClass::Absolute, 1.0f, 1, 1}),
+                        gi::TextureUsage::StorageWrite);
           },
           [this, io, values = &settings, nearest, ubo, n, c = &ctx](gi::PassContext& pc) {
             upload(*values);
             const auto masks = lightMasks(c->lights());
-            if (masks != surfaceMasks_) buildSurface(*c, masks);
+            if (masks != surfaceMasks_ || pcfRadius(*c) != pcf_) buildSurface(*c, masks);
             for (uint32_t k = 0; k < n; ++k) {
               const std::vector<gi::TextureHandle>& g = io->camG[k];
               gi::vk::DescriptorWriter w;
@@ -316,10 +323,44 @@ class SsdoEffect : public gi::Effect {
                   .buffer(8, ubo, pc.buffer(io->shadowViews))
                   .sampled(9, pc.view(io->shadowMaps), nearest)
                   .storageImage(10, pc.view(io->camSurface[k]))
-                  .sampled(11, pc.view(io->camDepth[k]), nearest);  // unused: one layer
+                  .sampled(11, pc.view(io->camDepth[k]), nearest)   // unused: one layer
+                  .storageImage(12, pc.view(io->camDirect))         // unused
+                  .sampled(13, pc.view(io->camDepth[k]), nearest);  // unused: no contact
               pc.dispatch(cameraSurface_, w, pc.extent(io->camSurface[k]), kGroupX, kGroupY);
             }
           });
+    }
+
+    // Contact shadows first: with the bounce ssdo_surface applies them to the direct light it
+    // publishes; without it the lighting pass applies them ("contact_shadow").
+    if (contact_) {
+      graph.addPass(
+          "ssdo_contact",
+          [&](gi::PassBuilder& b) {
+            io->depth = b.read(bb.texture(res::kDepth));
+            io->normal = b.read(bb.texture(res::kNormal));
+            io->lights = b.read(bb.buffer(res::kLights));
+            io->shadowViews = b.read(bb.buffer(res::kShadowViews));
+            io->shadowMaps = b.read(bb.texture(res::kShadowMaps));
+            io->contact =
+                b.write(b.create(res::kContactShadow, gi::TextureDesc{VK_FORMAT_R8G8B8A8_UNORM}),
+                        gi::TextureUsage::StorageWrite);
+          },
+          [this, io, frame, nearest, ubo, c = &ctx](gi::PassContext& pc) {
+            const auto masks = lightMasks(c->lights());
+            if (masks != contactMasks_) buildContact(*c, masks);
+            gi::vk::DescriptorWriter w;
+            w.buffer(0, ubo, frame)
+                .buffer(1, ubo, uniforms_.handle())
+                .sampled(2, pc.view(io->depth), nearest)
+                .buffer(3, ubo, pc.buffer(io->lights))
+                .buffer(4, ubo, pc.buffer(io->shadowViews))
+                .sampled(5, pc.view(io->shadowMaps), nearest)
+                .storageImage(6, pc.view(io->contact))
+                .sampled(7, pc.view(io->normal), nearest);
+            pc.dispatch(contactPipeline_, w, pc.extent(io->contact), kGroupX, kGroupY);
+          });
+      if (!bounce_) bb.put(res::kContactShadow, io->contact);
     }
 
     graph.addPass(
@@ -336,6 +377,11 @@ class SsdoEffect : public gi::Effect {
           if (layers_ > 1) io->peeled[0] = b.read(io->peeled[0]);
           io->surface = b.write(b.create("ssdo_surface", gi::TextureDesc{kPackedFormat}),
                                 gi::TextureUsage::StorageWrite);
+          if (bounce_ && contact_) io->contact = b.read(io->contact);
+          // Written and published only with the bounce; without it the image stands in for
+          // the binding (a storage image of the declared format).
+          io->direct = b.write(b.create(res::kDirectLight, gi::TextureDesc{kOutFormat}),
+                               gi::TextureUsage::StorageWrite);
           if (layers_ > 2) {
             for (size_t k = 1; k < io->peeled.size(); ++k) io->peeled[k] = b.read(io->peeled[k]);
             io->layers23 = b.write(b.create("ssdo_layers23", gi::TextureDesc{kLayersFormat}),
@@ -347,7 +393,7 @@ class SsdoEffect : public gi::Effect {
           // Light types and the environment's kind can change without a graph rebuild: the
           // specialized pipelines follow (built here, before the dispatches that use them).
           const auto masks = lightMasks(c->lights());
-          if (masks != surfaceMasks_) buildSurface(*c, masks);
+          if (masks != surfaceMasks_ || pcfRadius(*c) != pcf_) buildSurface(*c, masks);
           const uint32_t kind = environmentKind(c->frame());
           if (kind != environmentKind_) buildSsdo(*c, kind);
           gi::vk::DescriptorWriter w;
@@ -363,7 +409,11 @@ class SsdoEffect : public gi::Effect {
               .sampled(9, pc.view(io->shadowMaps), nearest)
               .storageImage(10, pc.view(io->surface))
               // The peeled layer (unused with one layer: the depth stands in).
-              .sampled(11, pc.view(layers_ > 1 ? io->peeled[0] : io->depth), nearest);
+              .sampled(11, pc.view(layers_ > 1 ? io->peeled[0] : io->depth), nearest)
+              // direct_light and the contact shadows (unused without the bounce and without
+              // contact shadows: the surface and the depth stand in).
+              .storageImage(12, pc.view(io->direct))
+              .sampled(13, pc.view(bounce_ && contact_ ? io->contact : io->depth), nearest);
           const VkExtent2D e = pc.extent(io->surface);
           pc.dispatch(surface_, w, e, kGroupX, kGroupY);
           if (layers_ > 2) {
@@ -445,34 +495,7 @@ class SsdoEffect : public gi::Effect {
         });
     bb.put(res::kAmbient, io->ambient);
     bb.put(res::kIndirect, io->indirect);
-
-    if (contact_) {
-      graph.addPass(
-          "ssdo_contact",
-          [&](gi::PassBuilder& b) {
-            io->surface = b.read(io->surface);
-            io->lights = b.read(bb.buffer(res::kLights));
-            io->shadowViews = b.read(bb.buffer(res::kShadowViews));
-            io->shadowMaps = b.read(bb.texture(res::kShadowMaps));
-            io->contact =
-                b.write(b.create(res::kContactShadow, gi::TextureDesc{VK_FORMAT_R8G8B8A8_UNORM}),
-                        gi::TextureUsage::StorageWrite);
-          },
-          [this, io, frame, nearest, ubo, c = &ctx](gi::PassContext& pc) {
-            const auto masks = lightMasks(c->lights());
-            if (masks != contactMasks_) buildContact(*c, masks);
-            gi::vk::DescriptorWriter w;
-            w.buffer(0, ubo, frame)
-                .buffer(1, ubo, uniforms_.handle())
-                .sampled(2, pc.view(io->surface), nearest)
-                .buffer(3, ubo, pc.buffer(io->lights))
-                .buffer(4, ubo, pc.buffer(io->shadowViews))
-                .sampled(5, pc.view(io->shadowMaps), nearest)
-                .storageImage(6, pc.view(io->contact));
-            pc.dispatch(contactPipeline_, w, pc.extent(io->contact), kGroupX, kGroupY);
-          });
-      bb.put(res::kContactShadow, io->contact);
-    }
+    if (bounce_) bb.put(res::kDirectLight, io->direct);
   }
 
  private:
@@ -498,18 +521,27 @@ class SsdoEffect : public gi::Effect {
                img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
     contactPipeline_ = gi::vk::Pipeline::compute(
         ctx.vulkan(), {std::begin(ssdo_contact_comp), std::end(ssdo_contact_comp)},
-        {{0, ubo}, {1, ubo}, {2, tex}, {3, ubo}, {4, ubo}, {5, tex}, {6, img}}, 0,
+        {{0, ubo}, {1, ubo}, {2, tex}, {3, ubo}, {4, ubo}, {5, tex}, {6, img}, {7, tex}}, 0,
         {contactSamples_, masks[0], masks[1]});
     contactMasks_ = masks;
   }
 
-  // The surface pipelines of the main view (with its layers) and of the additional cameras
-  // (one layer), specialized to the light types present.
+  // The engine's PCF radius (frame options), as the lighting pass's specialization.
+  static uint32_t pcfRadius(gi::EffectContext& ctx) {
+    return uint32_t(std::clamp(int(ctx.frame().options.x), 0, 3));
+  }
+
+  // The surface pipelines of the main view (with its layers; with the bounce it sums the lights
+  // as the lighting pass does, PCF and contact shadows included, and publishes them) and of the
+  // additional cameras (one layer; their senders' lights with a 1-tap shadow test), specialized
+  // to the light types present.
   void buildSurface(gi::EffectContext& ctx, std::array<uint32_t, 2> masks) {
     const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
                tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
                img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-    auto build = [&](uint32_t layers) {
+    pcf_ = pcfRadius(ctx);
+    auto build = [&](uint32_t layers, bool mainView) {
+      const bool direct = mainView && bounce_;
       return gi::vk::Pipeline::compute(
           ctx.vulkan(), {std::begin(ssdo_surface_comp), std::end(ssdo_surface_comp)},
           {{0, ubo},
@@ -523,11 +555,15 @@ class SsdoEffect : public gi::Effect {
            {8, ubo},
            {9, tex},
            {10, img},
-           {11, tex}},
-          0, {bounce_ ? 1u : 0u, masks[0], senderShadows_ ? masks[1] : 0u, layers});
+           {11, tex},
+           {12, img},
+           {13, tex}},
+          0,
+          {bounce_ ? 1u : 0u, masks[0], masks[1], layers, mainView ? pcf_ : 0u, direct ? 1u : 0u,
+           direct && contact_ ? 1u : 0u});
     };
-    surface_ = build(layers_);
-    if (cameras_ > 0) cameraSurface_ = build(1);
+    surface_ = build(layers_, true);
+    if (cameras_ > 0) cameraSurface_ = build(1, false);
     surfaceMasks_ = masks;
   }
 
@@ -572,8 +608,8 @@ class SsdoEffect : public gi::Effect {
       layersPipeline_;
   gi::vk::Buffer uniforms_;
   std::vector<std::shared_ptr<gi::ViewUniforms>> views_;  // the additional cameras
-  bool bounce_ = true, senderShadows_ = true;
-  uint32_t samples_ = 12, environmentKind_ = 0, layers_ = 1, cameras_ = 0;
+  bool bounce_ = true;
+  uint32_t samples_ = 12, environmentKind_ = 0, layers_ = 1, cameras_ = 0, pcf_ = 1;
   std::array<uint32_t, 2> surfaceMasks_{7, 7};
   bool contact_ = false;
   uint32_t contactSamples_ = 4;

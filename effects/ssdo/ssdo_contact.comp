@@ -22,13 +22,24 @@ layout(constant_id = 2) const int kShadowTypes = 7;  // the same for shadowed li
 
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 #include "ssdo_common.glsl"
-layout(set = 0, binding = 2) uniform usampler2D gSurface;  // ssdo_surface.comp
+// The G-buffer's depth and normal (not ssdo_surface's texel: with the bounce, ssdo_surface
+// reads this pass's output to apply it to the direct light it publishes).
+layout(set = 0, binding = 2) uniform sampler2D gDepth;
 #define GI_LIGHTS_SET 0
 #define GI_LIGHTS_BINDING 3
 #define GI_SHADOW_VIEWS_BINDING 4
 #define GI_SHADOW_MAPS_BINDING 5
 #include "lights.glsl"
 layout(set = 0, binding = 6, rgba8) uniform writeonly image2D outContact;
+layout(set = 0, binding = 7) uniform sampler2D gNormal;
+
+// 1 / view distance at pixel t from the reverse-Z depth ((d + P22) / P32, affine in d);
+// guards: sky, pixels without geometry and a degenerate projection read 0 (never in front).
+float inverseDepthAt(ivec2 t, float p22, float p32) {
+  float d = texelFetch(gDepth, t, 0).r;
+  float iz = abs(p32) > 1e-30 ? (d + p22) / p32 : 0.0;
+  return isSky(d) || !(iz > 0.0) || isinf(iz) ? 0.0 : iz;
+}
 
 // An occluder may lie up to this many bias lengths in front of Q along the view ray (Q is at
 // most b inside it along the light; the view ray crosses the same solid more obliquely).
@@ -64,9 +75,10 @@ void main() {
   ivec2 p = ivec2(gl_GlobalInvocationID.xy);
   ivec2 size = ivec2(frame.viewport.xy);
   if (p.x >= size.x || p.y >= size.y) return;
-  uvec4 centre = texelFetch(gSurface, p, 0);
-  float iz = uintBitsToFloat(centre.x);
   mat4 proj = frame.proj;
+  float p22 = proj[2][2], p32 = proj[3][2];
+  vec4 normalTexel = texelFetch(gNormal, p, 0);
+  float iz = normalTexel.w > 0.5 ? inverseDepthAt(p, p22, p32) : 0.0;
   float p00 = abs(proj[0][0]) > 1e-30 ? proj[0][0] : 1e-30;
   float p11 = abs(proj[1][1]) > 1e-30 ? proj[1][1] : 1e-30;
   float p20 = proj[2][0], p21 = proj[2][1];
@@ -74,7 +86,7 @@ void main() {
   // Guard: sky pixels (1 / z = 0) are left open (the loop still runs masked on llvmpipe).
   bool geometry = iz > 0.0;
   vec3 P = ssdoViewPosition(vec2(p) + 0.5, max(iz, 1e-30), invSize, p00, p11, p20, p21);
-  vec3 N = unpackNormal(centre.y);
+  vec3 N = safeNormalize(normalTexel.xyz, vec3(0.0, 0.0, 1.0));
 
   vec4 result = vec4(1.0);
   int shadowed = 0;
@@ -95,12 +107,11 @@ void main() {
       bool valid = b > 0.0 && w > kMinClipW && pix.x >= 0.0 && pix.y >= 0.0 &&
                    pix.x < sizeF.x && pix.y < sizeF.y;
       ivec2 t = ivec2(clamp(pix, vec2(0.0), sizeF - 1.0));
-      uvec4 surface = texelFetch(gSurface, t, 0);
-      float iS = uintBitsToFloat(surface.x);  // 0: sky, never in front
+      float iS = inverseDepthAt(t, p22, p32);  // 0: sky, never in front
       vec3 S = ssdoViewPosition(vec2(t) + 0.5, max(iS, 1e-30), invSize, p00, p11, p20, p21);
       float zS = -S.z;
       bool inFront = iS > 0.0 && zS < w && w - zS < kRangeScale * b;
-      bool behindPlane = dot(unpackNormalUnnormalized(surface.y), Q - S) < -kPlaneEpsilon * w;
+      bool behindPlane = dot(texelFetch(gNormal, t, 0).xyz, Q - S) < -kPlaneEpsilon * w;
       blocked += valid && inFront && behindPlane ? 1.0 : 0.0;
     }
     result[shadowed] = 1.0 - blocked / float(kSamples);

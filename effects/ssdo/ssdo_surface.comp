@@ -6,9 +6,13 @@
 // (ssdo_common.glsl): 1 / view distance, the view normal and, with the bounce, the pixel's
 // outgoing radiance as a sender. The lit image of this frame does not exist yet (SSDO runs
 // before lighting) and the previous frame's is not kept, so the sender radiance is this
-// frame's direct-light estimate: emission + diffuse albedo x (the lights through lightIncident
-// and shadowFactor, 1-tap shadow test, / pi + the engine's unoccluded environment irradiance
-// / pi). Lambertian senders: no specular.
+// frame's direct-light estimate: emission + diffuse albedo x (the lights, / pi + the engine's
+// unoccluded environment irradiance / pi). Lambertian senders: no specular. The lights are
+// summed exactly as the lighting pass sums them (sumLights, lights.glsl: PCF, contact shadows),
+// and in the main view (kDirectOut) their full radiance, specular included, is published as
+// "direct_light", which the lighting pass then uses instead of summing them again: with the
+// bounce the lights are evaluated once per frame, as in the paper, whose bounce reads the
+// direct-light buffer it has already rendered.
 layout(local_size_x = 32, local_size_y = 16) in;
 
 layout(constant_id = 0) const bool kBounce = true;
@@ -16,9 +20,14 @@ layout(constant_id = 1) const int kLightTypes = 7;   // bit mask: 1 directional,
 layout(constant_id = 2) const int kShadowTypes = 7;  // the same for shadowed lights
 // Depth layers (1 or 2): with 2, the peeled layer's 1 / view distance goes into the texel.
 layout(constant_id = 3) const int kLayers = 1;
+layout(constant_id = 4) const int kPcfRadius = 1;  // the engine's (frame.options.x), 0..3
+// Main view with the bounce: write the lights' radiance to outDirect ("direct_light").
+layout(constant_id = 5) const bool kDirectOut = false;
+// The contact shadows (ssdo_contact.comp) multiply the first four shadowed lights.
+layout(constant_id = 6) const bool kContactInput = false;
 #define GI_LIGHT_TYPES kLightTypes
 #define GI_SHADOW_TYPES kShadowTypes
-#define GI_PCF_RADIUS 0
+#define GI_PCF_RADIUS kPcfRadius
 
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 #include "ssdo_common.glsl"
@@ -34,6 +43,8 @@ layout(set = 0, binding = 6) uniform sampler2D gEmission;
 #include "lights.glsl"
 layout(set = 0, binding = 10, rgba32ui) uniform writeonly uimage2D outSurface;
 layout(set = 0, binding = 11) uniform sampler2D gLayer1;  // the peeled layer (kLayers 2)
+layout(set = 0, binding = 12, rgba16f) uniform writeonly image2D outDirect;  // kDirectOut
+layout(set = 0, binding = 13) uniform sampler2D gContact;  // kContactInput: contact_shadow
 
 void main() {
   ivec2 p = ivec2(gl_GlobalInvocationID.xy);
@@ -55,21 +66,23 @@ void main() {
     vec2 uv = (vec2(p) + 0.5) * frame.viewport.zw;
     vec3 pos = viewPositionFromDepth(frame.invProj, uv, depth);
     vec3 albedo = texelFetch(gAlbedo, p, 0).rgb;
-    float metallic = texelFetch(gMaterial, p, 0).g;
-    vec3 diffuse = albedo * (1.0 - metallic);
-    vec3 irradiance = vec3(0.0);
-    int count = lightCount();
-    for (int i = 0; i < count; ++i) {
-      Light light = lights[i];
-      vec3 l;
-      vec3 incident = lightIncident(light, pos, l);
-      float ndl = max(dot(n, l), 0.0);
-      irradiance += incident * ndl * shadowFactor(light, pos, ndl);
+    vec2 rm = texelFetch(gMaterial, p, 0).rg;
+    vec3 diffuse = albedo * (1.0 - rm.y);
+    vec4 contact = kContactInput ? texelFetch(gContact, p, 0) : vec4(1.0);
+    LightSum lightSum = sumLights(pos, n, safeNormalize(-pos, vec3(0.0, 0.0, 1.0)),
+                                  mix(vec3(0.04), albedo, rm.y), shininessOf(rm.x), contact,
+                                  kContactInput);
+    vec3 diffuseDirect = diffuse * lightSum.irradiance * (1.0 / 3.14159265358979);
+    if (kDirectOut) {
+      // Sky pixels: 0 (lighting writes the sky itself). Guard as below: finite, below the
+      // half-float maximum.
+      vec3 direct = geometry ? clamp(diffuseDirect + lightSum.specular, vec3(0.0), vec3(65000.0))
+                             : vec3(0.0);
+      direct = mix(direct, vec3(0.0), isnan(direct));
+      imageStore(outDirect, p, vec4(direct, 1.0));
     }
     vec3 nWorld = mat3(frame.invView) * n;
-    radiance = texelFetch(gEmission, p, 0).rgb +
-               diffuse * (irradiance * (1.0 / 3.14159265358979) +
-                          ssdoIrradianceOverPi(nWorld));
+    radiance = texelFetch(gEmission, p, 0).rgb + diffuseDirect + diffuse * ssdoIrradianceOverPi(nWorld);
     // Guard: half floats overflow to inf above 65504; non-finite inputs read 0.
     radiance = geometry ? clamp(radiance, vec3(0.0), vec3(65000.0)) : vec3(0.0);
     radiance = vec3(isnan(radiance.r) ? 0.0 : radiance.r, isnan(radiance.g) ? 0.0 : radiance.g,

@@ -7,7 +7,8 @@
 // is the engine's SH9 irradiance x albedo x ambient visibility ("ao"), unless an effect supplies
 // its replacement ("ambient", alpha 1: directional occlusion); "indirect" is added. All three
 // optional inputs default to neutral 1x1 textures (ao 1, ambient alpha 0, indirect 0); a fourth,
-// "contact_shadow" (1), scales the first four shadowed lights' shadow factors.
+// "contact_shadow" (1), scales the first four shadowed lights' shadow factors; a fifth,
+// "direct_light", replaces the evaluation of the lights (sumLights, lights.glsl).
 // Workgroup 32x16 (kScreenGroupX/Y in passes/builtin_passes.h): llvmpipe pays per workgroup.
 layout(local_size_x = 32, local_size_y = 16) in;
 
@@ -26,6 +27,9 @@ layout(constant_id = 6) const int kEnvironmentKind = 0;  // 0 sky, 1 constant, 2
 // "contact_shadow" (same modes): channel i multiplies the shadow factor of the i-th
 // shadow-casting light, the first four in `lights` order.
 layout(constant_id = 7) const int kContactInput = 0;
+// "direct_light" (same modes): the lights' radiance an effect computed already (e.g. for its
+// own use); it replaces this pass's evaluation of the lights (and with it the contact input).
+layout(constant_id = 8) const int kDirectInput = 0;
 #define GI_LIGHT_TYPES kLightTypes
 #define GI_SHADOW_TYPES kShadowTypes
 #define GI_PCF_RADIUS kPcfRadius
@@ -48,6 +52,7 @@ layout(set = 0, binding = 12) uniform sampler2D indirectTexture;  // linear, any
 // Equirect environment map (kind 2; a 1x1 dummy otherwise).
 layout(set = 0, binding = 13) uniform sampler2D environmentMap;
 layout(set = 0, binding = 14) uniform sampler2D contactTexture;  // linear, any size
+layout(set = 0, binding = 15) uniform sampler2D directTexture;   // linear, any size
 
 const float PI = 3.14159265358979;
 
@@ -80,33 +85,19 @@ void main() {
   vec3 albedo = texelFetch(gAlbedo, p, 0).rgb;
   vec2 rm = texelFetch(gMaterial, p, 0).rg;
   vec3 emission = texelFetch(gEmission, p, 0).rgb;
-  float roughness = max(rm.x, 0.03), metallic = rm.y;
+  float metallic = rm.y;
   vec3 v = safeNormalize(-pos, vec3(0, 0, 1));
   vec3 diffuseColor = albedo * (1.0 - metallic);
-  vec3 f0 = mix(vec3(0.04), albedo, metallic);
-  float shininess = clamp(2.0 / (roughness * roughness * roughness * roughness) - 2.0, 1.0, 4096.0);
 
   vec3 color = emission;
-  vec4 contact = kContactInput != 0 ? optionalInput(contactTexture, kContactInput, p, uv) : vec4(1.0);
-  int shadowed = 0;  // shadow-casting lights seen so far (the contact channel)
-  int count = lightCount();
-  for (int i = 0; i < count; ++i) {
-    Light light = lights[i];
-    // Counted before any `continue`: the channel follows `lights` order, not this pixel's.
-    int channel = shadowed;
-    if (kContactInput != 0 && light.shadow.x >= 0.0) ++shadowed;
-    vec3 l;
-    vec3 incident = lightIncident(light, pos, l);
-    float ndl = max(dot(n, l), 0.0);
-    if (ndl <= 0.0 || all(lessThanEqual(incident, vec3(0.0)))) continue;
-    float visibility = shadowFactor(light, pos, ndl);
-    if (kContactInput != 0 && light.shadow.x >= 0.0 && channel < 4)
-      visibility *= clamp(contact[channel], 0.0, 1.0);
-    if (visibility <= 0.0) continue;
-    vec3 h = safeNormalize(l + v, n);
-    float spec = (shininess + 8.0) / (8.0 * PI) * pow(max(dot(n, h), 0.0), shininess);
-    vec3 brdf = diffuseColor / PI + f0 * spec;
-    color += brdf * incident * ndl * visibility;
+  if (kDirectInput != 0) {
+    color += max(optionalInput(directTexture, kDirectInput, p, uv).rgb, vec3(0.0));
+  } else {
+    vec4 contact =
+        kContactInput != 0 ? optionalInput(contactTexture, kContactInput, p, uv) : vec4(1.0);
+    LightSum lightSum = sumLights(pos, n, v, mix(vec3(0.04), albedo, metallic),
+                                  shininessOf(rm.x), contact, kContactInput != 0);
+    color += diffuseColor * lightSum.irradiance * (1.0 / PI) + lightSum.specular;
   }
   vec4 ambient = kAmbientInput != 0 ? optionalInput(ambientTexture, kAmbientInput, p, uv) : vec4(0.0);
   if (ambient.a > 0.5) {

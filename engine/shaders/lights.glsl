@@ -129,4 +129,49 @@ float shadowFactor(Light light, vec3 pos, float ndl) {
   return lit / float((2 * k + 1) * (2 * k + 1));
 }
 
+// The scene's lights at one surface point as the lighting pass evaluates them (Lambert +
+// normalised Blinn-Phong, shadow maps): `irradiance` = sum of incident x cos x visibility (the
+// diffuse radiance is diffuseColor x irradiance / pi), `specular` = the Blinn-Phong radiance
+// toward `v` (f0 x normalised lobe x incident x cos x visibility). Channel i of `contact`
+// multiplies the visibility of the i-th shadow-casting light, the first four in `lights` order
+// (pass vec4(1.0) and useContact false for none). The one place this sum is written: the lighting
+// pass and any effect that publishes "direct_light" (the pass's replacement) share it.
+struct LightSum {
+  vec3 irradiance;
+  vec3 specular;
+};
+
+LightSum sumLights(vec3 pos, vec3 n, vec3 v, vec3 f0, float shininess, vec4 contact,
+                   bool useContact) {
+  LightSum sum = LightSum(vec3(0.0), vec3(0.0));
+  int shadowed = 0;  // shadow-casting lights seen so far (the contact channel)
+  int count = lightCount();
+  for (int i = 0; i < count; ++i) {
+    Light light = lights[i];
+    // Counted before any `continue`: the channel follows `lights` order, not this pixel's.
+    int channel = shadowed;
+    if (useContact && light.shadow.x >= 0.0) ++shadowed;
+    vec3 l;
+    vec3 incident = lightIncident(light, pos, l);
+    float ndl = max(dot(n, l), 0.0);
+    if (ndl <= 0.0 || all(lessThanEqual(incident, vec3(0.0)))) continue;
+    float visibility = shadowFactor(light, pos, ndl);
+    if (useContact && light.shadow.x >= 0.0 && channel < 4)
+      visibility *= clamp(contact[channel], 0.0, 1.0);
+    if (visibility <= 0.0) continue;
+    vec3 h = safeNormalize(l + v, n);
+    float spec = (shininess + 8.0) / (8.0 * 3.14159265358979) * pow(max(dot(n, h), 0.0), shininess);
+    vec3 e = incident * ndl * visibility;
+    sum.irradiance += e;
+    sum.specular += f0 * spec * e;
+  }
+  return sum;
+}
+
+// Blinn-Phong exponent of a G-buffer roughness (the lighting pass's mapping).
+float shininessOf(float roughness) {
+  float r = max(roughness, 0.03);
+  return clamp(2.0 / (r * r * r * r) - 2.0, 1.0, 4096.0);
+}
+
 #endif

@@ -48,6 +48,12 @@ inline constexpr const char* kIndirect = "indirect";  // RGBA16F outgoing indire
 // RGBA8 (any size, sampled bilinearly at the pixel's uv): channel i multiplies the shadow factor
 // of the i-th shadow-casting light (the first four in `lights` order), 1 = no change.
 inline constexpr const char* kContactShadow = "contact_shadow";
+// RGBA16F (any size): the outgoing radiance of the scene's lights (diffuse + specular, shadowed,
+// contact shadows applied), as sumLights in lights.glsl computes it, at every geometry pixel.
+// When published it *replaces* the lighting pass's own evaluation of the lights: an effect that
+// needs the direct light anyway (e.g. as the radiance of bounce senders) publishes it and the
+// lights are evaluated once. It then owns the contact shadows (publishing both is an error).
+inline constexpr const char* kDirectLight = "direct_light";
 inline constexpr const char* kOutput = "output";  // RGBA8 tonemapped final image
 inline constexpr const char* kFloor = "floor";    // RGBA8 cost-floor pass output
 // Buffer: the point representation (gi/surface_points.h), two vec4 per point: world

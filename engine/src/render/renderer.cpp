@@ -367,7 +367,8 @@ struct Renderer::Impl : EffectContext {
   }
 
   static bool isOptionalInput(const std::string& name) {
-    for (const char* n : {res::kAO, res::kAmbient, res::kIndirect, res::kContactShadow})
+    for (const char* n :
+         {res::kAO, res::kAmbient, res::kIndirect, res::kContactShadow, res::kDirectLight})
       if (name == n) return true;
     return false;
   }
@@ -422,6 +423,8 @@ struct Renderer::Impl : EffectContext {
                           {{0.0f, 0.0f, 0.0f, 0.0f}});
     graph.declareFallback(res::kContactShadow, VK_FORMAT_R8G8B8A8_UNORM,
                           {{1.0f, 1.0f, 1.0f, 1.0f}});
+    graph.declareFallback(res::kDirectLight, VK_FORMAT_R16G16B16A16_SFLOAT,
+                          {{0.0f, 0.0f, 0.0f, 0.0f}});
     // Engine data every pass may read: lights, shadow views, the environment.
     bb.put(res::kLights,
            graph.importBuffer(res::kLights, lightBuffer.handle(), lightBuffer.size()));

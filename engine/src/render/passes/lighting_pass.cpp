@@ -1,11 +1,12 @@
 // "lighting": composes the lit image from the G-buffer, the lights and shadow maps, the
-// environment and the optional inputs effects publish (ao, ambient, indirect, contact_shadow;
-// neutral when
-// absent: the fallbacks are declared once, in the renderer's buildGraph()).
+// environment and the optional inputs effects publish (ao, ambient, indirect, contact_shadow,
+// direct_light; neutral when absent: the fallbacks are declared once, in the renderer's
+// buildGraph()).
 #include <algorithm>
 #include <array>
 #include <map>
 
+#include "gi/errors.h"
 #include "gi/vk/pipeline.h"
 #include "render/passes/builtin_passes.h"
 
@@ -20,10 +21,10 @@ class LightingPass final : public Effect {
   EffectInfo info() const override {
     EffectInfo i{"lighting", "2",
                  "direct light with shadows + environment x ambient visibility + indirect"};
-    i.reads = {
-        res::kDepth,    res::kNormal,        res::kAlbedo,        res::kMaterial, res::kEmission,
-        res::kLights,   res::kShadowViews,   res::kShadowMaps,    res::kAO,       res::kAmbient,
-        res::kIndirect, res::kContactShadow, res::kEnvironmentMap};
+    i.reads = {res::kDepth,       res::kNormal,        res::kAlbedo,      res::kMaterial,
+               res::kEmission,    res::kLights,        res::kShadowViews, res::kShadowMaps,
+               res::kAO,          res::kAmbient,       res::kIndirect,    res::kContactShadow,
+               res::kDirectLight, res::kEnvironmentMap};
     i.writes = {res::kLit};
     return i;
   }
@@ -33,10 +34,11 @@ class LightingPass final : public Effect {
   }
   void addPasses(FrameGraph& graph, EffectContext& ctx, const SettingValues&) override {
     struct Io {
-      TextureHandle gbuffer[5], shadowMaps, ao, ambient, indirect, contact, environment, lit;
+      TextureHandle gbuffer[5], shadowMaps, ao, ambient, indirect, contact, direct, environment,
+          lit;
       BufferHandle lights, shadowViews;
-      // ao, ambient, indirect, contact_shadow: the neutral stand-in
-      bool fallback[4] = {true, true, true, true};
+      // ao, ambient, indirect, contact_shadow, direct_light: the neutral stand-in
+      bool fallback[5] = {true, true, true, true, true};
     };
     auto io = std::make_shared<Io>();
 
@@ -58,6 +60,14 @@ class LightingPass final : public Effect {
           io->fallback[2] = b.isFallback(io->indirect);
           io->contact = b.readOptional(res::kContactShadow);
           io->fallback[3] = b.isFallback(io->contact);
+          io->direct = b.readOptional(res::kDirectLight);
+          io->fallback[4] = b.isFallback(io->direct);
+          // The contact factors multiply single lights' shadows; a published direct_light has
+          // summed the lights already, so whoever publishes it must have applied them.
+          if (!io->fallback[3] && !io->fallback[4])
+            throw Error(ErrorKind::Usage, "",
+                        "both 'contact_shadow' and 'direct_light' are published: the effect "
+                        "that publishes direct_light must apply the contact shadows itself");
           io->environment = b.read(bb.texture(res::kEnvironmentMap));
           io->lit = b.write(b.create(res::kLit, TextureDesc{VK_FORMAT_R16G16B16A16_SFLOAT}),
                             TextureUsage::StorageWrite);
@@ -73,7 +83,8 @@ class LightingPass final : public Effect {
           };
           const vk::Pipeline& pipeline = variant(
               {inputMode(io->fallback[0], io->ao), inputMode(io->fallback[1], io->ambient),
-               inputMode(io->fallback[2], io->indirect), inputMode(io->fallback[3], io->contact)});
+               inputMode(io->fallback[2], io->indirect), inputMode(io->fallback[3], io->contact),
+               inputMode(io->fallback[4], io->direct)});
           vk::DescriptorWriter w;
           w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame);
           for (uint32_t i = 0; i < 5; ++i) w.sampled(1 + i, pc.view(io->gbuffer[i]), nearest);
@@ -85,7 +96,8 @@ class LightingPass final : public Effect {
               .sampled(11, pc.view(io->ambient), linear)
               .sampled(12, pc.view(io->indirect), linear)
               .sampled(13, pc.view(io->environment), s_.scene.linearRepeat())
-              .sampled(14, pc.view(io->contact), linear);
+              .sampled(14, pc.view(io->contact), linear)
+              .sampled(15, pc.view(io->direct), linear);
           pc.dispatch(pipeline, w, e, kScreenGroupX, kScreenGroupY);
         });
     bb.put(res::kLit, io->lit);
@@ -93,12 +105,12 @@ class LightingPass final : public Effect {
 
  private:
   // The lighting.comp specialization constants of one configuration (constant_id order).
-  using Variant = std::array<uint32_t, 8>;
+  using Variant = std::array<uint32_t, 9>;
 
   // The pipeline for this frame's lights, PCF radius, optional inputs (mode per input: 0
   // fallback, 1 same size, 2 other size) and environment kind, built on first use: a scene
   // needs one or two, and the disk pipeline cache keeps them between runs.
-  const vk::Pipeline& variant(const std::array<uint32_t, 4>& inputs) {
+  const vk::Pipeline& variant(const std::array<uint32_t, 5>& inputs) {
     uint32_t types = 0, shadowTypes = 0;
     for (const GpuLight& l : s_.lights.lights) {
       const uint32_t bit = 1u << std::clamp(int(l.directionType.w), 0, 2);
@@ -112,7 +124,8 @@ class LightingPass final : public Effect {
                       inputs[1],
                       inputs[2],
                       s_.environment.kind(),
-                      inputs[3]};
+                      inputs[3],
+                      inputs[4]};
     auto found = pipelines_.find(key);
     if (found != pipelines_.end()) return found->second;
     const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
@@ -134,7 +147,8 @@ class LightingPass final : public Effect {
                                              {11, tex},
                                              {12, tex},
                                              {13, tex},
-                                             {14, tex}},
+                                             {14, tex},
+                                             {15, tex}},
                                             0, {key.begin(), key.end()}))
         .first->second;
   }
