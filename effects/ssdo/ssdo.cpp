@@ -149,14 +149,16 @@ class SsdoEffect : public gi::Effect {
     buildSurface(ctx, lightMasks(ctx.lights()));
     buildSsdo(ctx, environmentKind(ctx.frame()));
     while (views_.size() < cameras_) views_.push_back(ctx.createView());
-    const std::vector<uint32_t> radius = {
-        uint32_t(std::clamp(settings.integer("blur_radius"), 0, gi::ssdo::kMaxBlurRadius))};
+    // The blur's radius and whether it carries the bounce term.
+    const std::vector<uint32_t> blurConstants = {
+        uint32_t(std::clamp(settings.integer("blur_radius"), 0, gi::ssdo::kMaxBlurRadius)),
+        bounce_ ? 1u : 0u};
     blurX_ =
         gi::vk::Pipeline::compute(vk, {std::begin(ssdo_blur_x_comp), std::end(ssdo_blur_x_comp)},
-                                  {{0, ubo}, {1, ubo}, {2, tex}, {3, img}}, 0, radius);
+                                  {{0, ubo}, {1, ubo}, {2, tex}, {3, img}}, 0, blurConstants);
     resolve_ = gi::vk::Pipeline::compute(
         vk, {std::begin(ssdo_resolve_comp), std::end(ssdo_resolve_comp)},
-        {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, tex}, {5, img}, {6, img}}, 0, radius);
+        {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, tex}, {5, img}, {6, img}}, 0, blurConstants);
     if (layers_ > 2)
       layersPipeline_ =
           gi::vk::Pipeline::compute(vk, {std::begin(ssdo_layers_comp), std::end(ssdo_layers_comp)},
@@ -464,8 +466,11 @@ class SsdoEffect : public gi::Effect {
                                gi::TextureUsage::StorageWrite);
           io->ambient = b.write(b.create(res::kAmbient, gi::TextureDesc{kOutFormat}),
                                 gi::TextureUsage::StorageWrite);
-          io->indirect = b.write(b.create(res::kIndirect, gi::TextureDesc{kOutFormat}),
-                                 gi::TextureUsage::StorageWrite);
+          // Without the bounce there is no indirect light to publish: the lighting pass's
+          // neutral 0 stands in (and its fetch is compiled out).
+          if (bounce_)
+            io->indirect = b.write(b.create(res::kIndirect, gi::TextureDesc{kOutFormat}),
+                                   gi::TextureUsage::StorageWrite);
         },
         [this, io, frame, nearest, ubo, blurRadius](gi::PassContext& pc) {
           const VkExtent2D e = pc.extent(io->ambient);
@@ -490,12 +495,14 @@ class SsdoEffect : public gi::Effect {
               .sampled(3, pc.view(io->albedo), nearest)
               .sampled(4, pc.view(io->material), nearest)
               .storageImage(5, pc.view(io->ambient))
-              .storageImage(6, pc.view(io->indirect));
+              .storageImage(6, pc.view(bounce_ ? io->indirect : io->ambient));
           pc.dispatch(resolve_, w, e, kGroupX, kGroupY);
         });
     bb.put(res::kAmbient, io->ambient);
-    bb.put(res::kIndirect, io->indirect);
-    if (bounce_) bb.put(res::kDirectLight, io->direct);
+    if (bounce_) {
+      bb.put(res::kIndirect, io->indirect);
+      bb.put(res::kDirectLight, io->direct);
+    }
   }
 
  private:

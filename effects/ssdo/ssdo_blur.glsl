@@ -15,6 +15,8 @@ layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 #include "ssdo_common.glsl"
 layout(set = 0, binding = 2) uniform usampler2D inRaw;
 layout(constant_id = 0) const int kRadius = 2;  // 0..gi::ssdo::kMaxBlurRadius: the loop unrolls
+// The bounce term (off: `bounce` is 0, never decoded: the blur then costs what one term does).
+layout(constant_id = 1) const bool kBounceTerm = true;
 
 // The blurred terms of pixel p; `centre` is its raw texel.
 void ssdoBlur(ivec2 p, ivec2 size, uvec4 centre, out vec3 direct, out vec3 bounce) {
@@ -37,7 +39,7 @@ void ssdoBlur(ivec2 p, ivec2 size, uvec4 centre, out vec3 direct, out vec3 bounc
   float slope = GI_BLUR_AXIS == 0 ? slopes.x : slopes.y;
   float tol = ssdo.blur.x, minCos2 = ssdo.blur.y * ssdo.blur.y;
   direct = unpackRgb9e5(centre.x);
-  bounce = unpackRgb9e5(centre.y);
+  bounce = kBounceTerm ? unpackRgb9e5(centre.y) : vec3(0.0);
   float weights = 1.0;
   for (int o = -kRadius; o <= kRadius; ++o) {
     if (o == 0) continue;
@@ -54,7 +56,7 @@ void ssdoBlur(ivec2 p, ivec2 size, uvec4 centre, out vec3 direct, out vec3 bounc
                 c > 0.0 && c * c > minCos2 * dot(n, n);
     float w = same ? (abs(o) == kRadius ? 0.5 : 1.0) : 0.0;
     direct += w * unpackRgb9e5(t.x);
-    bounce += w * unpackRgb9e5(t.y);
+    if (kBounceTerm) bounce += w * unpackRgb9e5(t.y);
     weights += w;
   }
   direct /= weights;  // weights >= 1: the centre always counts

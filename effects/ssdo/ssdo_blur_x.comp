@@ -14,5 +14,6 @@ void main() {
   uvec4 centre = texelFetch(inRaw, p, 0);
   vec3 direct, bounce;
   ssdoBlur(p, size, centre, direct, bounce);
-  imageStore(outRaw, p, uvec4(packRgb9e5(direct), packRgb9e5(bounce), centre.zw));
+  imageStore(outRaw, p,
+             uvec4(packRgb9e5(direct), kBounceTerm ? packRgb9e5(bounce) : 0u, centre.zw));
 }
