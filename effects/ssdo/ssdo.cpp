@@ -227,6 +227,12 @@ class SsdoEffect : public gi::Effect {
     const VkSampler nearest = ctx.nearestSampler();
     const VkDescriptorType ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
     gi::GpuScene& scene = ctx.scene();
+    // The lights, their shadow views and maps: read by every pass that sums or tests lights.
+    auto readLights = [&](gi::PassBuilder& b) {
+      io->lights = b.read(bb.buffer(res::kLights));
+      io->shadowViews = b.read(bb.buffer(res::kShadowViews));
+      io->shadowMaps = b.read(bb.texture(res::kShadowMaps));
+    };
 
     // Depth layer k (1..layers-1): the nearest surface strictly behind layer k-1 (layer 0: the
     // G-buffer's depth). One pass per layer: "ssdo_peel" (layer 1), "ssdo_peel2", "ssdo_peel3".
@@ -298,9 +304,7 @@ class SsdoEffect : public gi::Effect {
                                                    ce.width, ce.height}),
                           gi::TextureUsage::StorageWrite));
             }
-            io->lights = b.read(bb.buffer(res::kLights));
-            io->shadowViews = b.read(bb.buffer(res::kShadowViews));
-            io->shadowMaps = b.read(bb.texture(res::kShadowMaps));
+            readLights(b);
             // The cameras publish no direct light: a 1x1 image stands in for that binding.
             io->camDirect =
                 b.write(b.create("ssdo_camera_direct",
@@ -341,9 +345,7 @@ class SsdoEffect : public gi::Effect {
           [&](gi::PassBuilder& b) {
             io->depth = b.read(bb.texture(res::kDepth));
             io->normal = b.read(bb.texture(res::kNormal));
-            io->lights = b.read(bb.buffer(res::kLights));
-            io->shadowViews = b.read(bb.buffer(res::kShadowViews));
-            io->shadowMaps = b.read(bb.texture(res::kShadowMaps));
+            readLights(b);
             io->contact =
                 b.write(b.create(res::kContactShadow, gi::TextureDesc{VK_FORMAT_R8G8B8A8_UNORM}),
                         gi::TextureUsage::StorageWrite);
@@ -373,9 +375,7 @@ class SsdoEffect : public gi::Effect {
           io->albedo = b.read(bb.texture(res::kAlbedo));
           io->material = b.read(bb.texture(res::kMaterial));
           io->emission = b.read(bb.texture(res::kEmission));
-          io->lights = b.read(bb.buffer(res::kLights));
-          io->shadowViews = b.read(bb.buffer(res::kShadowViews));
-          io->shadowMaps = b.read(bb.texture(res::kShadowMaps));
+          readLights(b);
           if (layers_ > 1) io->peeled[0] = b.read(io->peeled[0]);
           io->surface = b.write(b.create("ssdo_surface", gi::TextureDesc{kPackedFormat}),
                                 gi::TextureUsage::StorageWrite);

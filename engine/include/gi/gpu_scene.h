@@ -109,8 +109,8 @@ class GpuScene {
                          std::span<const SceneView> views) = 0;
   // As drawDepth, with view i's DrawView record (scene_view.glsl) read on the GPU from `views`
   // at i x kDrawViewStride bytes and drawn into viewports[i]: views that an earlier pass of the
-  // same frame computed (the ISM effect's VPLs) without reading them back. The calling pass
-  // declares `views` a Uniform read; a record may clip everything (nothing drawn).
+  // same frame computed (e.g. from light sources it placed) without reading them back. The calling
+  // pass declares `views` a Uniform read; a record may clip everything (nothing drawn).
   virtual void drawDepthFromBuffer(PassContext& pc, const SceneTargets& targets, VkBuffer views,
                                    std::span<const VkRect2D> viewports) = 0;
   // The G-buffer set seen through `viewUniforms` (a FrameUniforms buffer: frameUniforms() or
