@@ -23,11 +23,12 @@
 #include "ism_blur_y.comp.h"
 #include "ism_blur_y_low.comp.h"
 #include "ism_bounce.comp.h"
-#include "ism_bounce_classic.comp.h"
 #include "ism_classic_atlas_view.comp.h"
 #include "ism_classic_views.comp.h"
 #include "ism_gather.comp.h"
 #include "ism_gather_classic.comp.h"
+#include "ism_irsm.comp.h"
+#include "ism_irsm_classic.comp.h"
 #include "ism_params.h"
 #include "ism_pull_push.comp.h"
 #include "ism_splat.comp.h"
@@ -117,9 +118,9 @@ class IsmEffect : public gi::Effect {
         {"block_size", SettingType::Int, 4, 1, gi::ism::kMaxBlock,
          "interleaving block k: each pixel of a k x k block gathers N_vpl / k^2 VPLs", true},
         {"bounces", SettingType::Int, 1, 1, gi::ism::kMaxBounces,
-         "indirect bounces: each bounce after the first samples `vpls` more VPLs from surface "
-         "points lit by the previous bounce's VPLs (with their maps' visibility), each with its "
-         "own map; vpls x bounces is capped at 1024",
+         "indirect bounces: each bounce after the first samples `vpls` more VPLs from the "
+         "previous bounce's imperfect reflective shadow maps (its VPLs' point subsets shaded "
+         "where their maps see them), each with its own map; vpls x bounces is capped at 1024",
          true},
         gi::SettingDesc::enumeration("mode", {"ism", "classic"}, 0,
                                      "ism: imperfect shadow maps from points; classic: accurate "
@@ -190,11 +191,10 @@ class IsmEffect : public gi::Effect {
     nearest_ = ctx.nearestSampler();
     // The engine keeps at least the points asked for: without the cap every subset fits.
     const bool wrap = uint64_t(c.total()) * uint64_t(c.perIsm) > gi::ism::kMaxPoints;
-    if (!c.classic)
+    // Classic mode needs points only for the later bounces' IRSMs (the same subsets).
+    if (!c.classic || c.bounces > 1)
       ctx.requestSurfacePoints(uint32_t(
           std::min<uint64_t>(uint64_t(c.total()) * uint64_t(c.perIsm), gi::ism::kMaxPoints)));
-    else if (c.bounces > 1)
-      ctx.requestSurfacePoints(gi::ism::kShadePoints);
 
     const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
                tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
@@ -217,18 +217,22 @@ class IsmEffect : public gi::Effect {
             vk, spv(std::begin(ism_pull_push_comp), std::end(ism_pull_push_comp)),
             {{1, ubo}, {2, img}}, 2 * sizeof(int32_t), {uint32_t(c.levels)});
     }
-    const std::vector<gi::vk::Binding> bounceBindings = {{1, ubo}, {2, ubo},  {3, ssbo}, {4, ssbo},
-                                                         {5, tex}, {6, ssbo}, {7, ssbo}};
-    const std::vector<uint32_t> bounceSpec = {uint32_t(c.vpls), uint32_t(gi::ism::kShadePoints)};
-    if (c.bounces > 1)
+    if (c.bounces > 1) {
+      const uint32_t entries = gi::ism::irsmEntries(c.perIsm), wraps = wrap ? 1 : 0;
+      irsm_ = c.classic
+                  ? gi::vk::Pipeline::compute(
+                        vk, spv(std::begin(ism_irsm_classic_comp), std::end(ism_irsm_classic_comp)),
+                        {{1, ubo}, {2, ubo}, {3, ssbo}, {4, ssbo}, {5, tex}, {6, ssbo}, {7, ssbo}},
+                        sizeof(int32_t), {entries, wraps})
+                  : gi::vk::Pipeline::compute(
+                        vk, spv(std::begin(ism_irsm_comp), std::end(ism_irsm_comp)),
+                        {{1, ubo}, {2, ubo}, {3, ssbo}, {4, ssbo}, {5, tex}, {6, ssbo}, {7, ssbo}},
+                        sizeof(int32_t), {entries, wraps});
       bounce_ =
-          c.classic
-              ? gi::vk::Pipeline::compute(
-                    vk, spv(std::begin(ism_bounce_classic_comp), std::end(ism_bounce_classic_comp)),
-                    bounceBindings, sizeof(int32_t), bounceSpec)
-              : gi::vk::Pipeline::compute(
-                    vk, spv(std::begin(ism_bounce_comp), std::end(ism_bounce_comp)), bounceBindings,
-                    sizeof(int32_t), bounceSpec);
+          gi::vk::Pipeline::compute(vk, spv(std::begin(ism_bounce_comp), std::end(ism_bounce_comp)),
+                                    {{1, ubo}, {3, ssbo}, {6, ssbo}, {7, ssbo}, {8, ssbo}},
+                                    sizeof(int32_t), {uint32_t(c.vpls), entries, wraps});
+    }
     atlasView_ = c.classic
                      ? gi::vk::Pipeline::compute(vk,
                                                  spv(std::begin(ism_classic_atlas_view_comp),
@@ -287,7 +291,7 @@ class IsmEffect : public gi::Effect {
     struct Io {
       gi::TextureHandle rsmDepth, rsmPos, rsmNormal, rsmFlux, atlas, depth, normal, albedo,
           material, raw, half, low, indirect, atlasView;
-      gi::BufferHandle cdf, vpls, points, shade, classicViews;
+      gi::BufferHandle cdf, vpls, points, irsm, irsmCells, classicViews;
     };
     auto io = std::make_shared<Io>();
     gi::Blackboard& bb = graph.blackboard();
@@ -599,39 +603,66 @@ class IsmEffect : public gi::Effect {
         });
   }
 
-  // Bounce `bounce` + 1's VPLs from points lit by bounce `bounce`'s (ism_bounce.glsl).
+  // Bounce `bounce` + 1's VPLs: bounce `bounce`'s VPLs' imperfect reflective shadow maps
+  // (ism_irsm.glsl), then importance sampling over them (ism_bounce.comp).
   template <class IoPtr>
   void addBounce(gi::FrameGraph& graph, gi::EffectContext& ctx, const IoPtr& io, int bounce) {
+    const Config c = cfg_;
+    const std::string n = std::to_string(bounce + 1);
+    const uint32_t entries = gi::ism::irsmEntries(c.perIsm), cellsPerVpl = (entries + 255) / 256;
+    const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
     graph.addPass(
-        "ism_bounce" + std::to_string(bounce + 1),
+        "ism_irsm" + n,
         [&](gi::PassBuilder& b) {
           io->points = b.read(io->points, gi::BufferUsage::StorageRead);
           io->atlas = b.read(io->atlas, gi::TextureUsage::Sampled, gi::Subresource::mipLevel(0));
           io->vpls = b.read(io->vpls, gi::BufferUsage::Uniform);
-          io->vpls = b.write(io->vpls, gi::BufferUsage::StorageWrite);
-          io->shade = b.write(
-              b.create("ism_shade" + std::to_string(bounce + 1),
-                       gi::BufferDesc{VkDeviceSize(5 * gi::ism::kShadePoints) * sizeof(float)}),
-              gi::BufferUsage::StorageWrite);
+          io->irsm = b.write(b.create("ism_irsm" + n, gi::BufferDesc{VkDeviceSize(c.vpls) *
+                                                                     entries * sizeof(glm::vec4)}),
+                             gi::BufferUsage::StorageWrite);
+          io->irsmCells =
+              b.write(b.create("ism_irsm_cells" + n,
+                               gi::BufferDesc{VkDeviceSize(c.vpls) * cellsPerVpl * sizeof(float)}),
+                      gi::BufferUsage::StorageWrite);
         },
-        [this, io, bounce, materials = ctx.scene().materials()](gi::PassContext& pc) {
-          const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
-                     ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-          if (cfg_.classic) {  // no splat pass sets the point count
+        [this, io, c, bounce, entries, materials = ctx.scene().materials()](gi::PassContext& pc) {
+          if (c.classic) {  // no splat pass sets the point count
             uploaded_.atlas.w = float(pc.bufferSize(io->points) / (2 * sizeof(glm::vec4)));
             uniforms_.write(&uploaded_.atlas, sizeof(glm::vec4),
                             offsetof(gi::ism::Uniforms, atlas));
           }
-          const int32_t b = bounce;
-          vkCmdPushConstants(pc.cmd(), bounce_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof b, &b);
+          const int32_t base = (bounce - 1) * c.vpls;
+          vkCmdPushConstants(pc.cmd(), irsm_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof base, &base);
           gi::vk::DescriptorWriter w;
           w.buffer(1, ubo, uniforms_.handle())
               .buffer(2, ubo, pc.buffer(io->vpls))
               .buffer(3, ssbo, pc.buffer(io->points))
               .buffer(4, ssbo, materials)
               .sampled(5, pc.view(io->atlas, gi::Subresource::mipLevel(0)), nearest_)
-              .buffer(6, ssbo, pc.buffer(io->shade))
-              .buffer(7, ssbo, pc.buffer(io->vpls));
+              .buffer(6, ssbo, pc.buffer(io->irsm))
+              .buffer(7, ssbo, pc.buffer(io->irsmCells));
+          pc.dispatch(irsm_, w, {entries, uint32_t(c.vpls)}, 256, 1);
+        });
+    graph.addPass(
+        "ism_bounce" + n,
+        [&](gi::PassBuilder& b) {
+          io->points = b.read(io->points, gi::BufferUsage::StorageRead);
+          io->irsm = b.read(io->irsm, gi::BufferUsage::StorageRead);
+          io->irsmCells = b.read(io->irsmCells, gi::BufferUsage::StorageRead);
+          io->irsmCells = b.write(io->irsmCells, gi::BufferUsage::StorageWrite);
+          // Adds this bounce's slots; the earlier bounces' stay.
+          io->vpls = b.read(io->vpls, gi::BufferUsage::StorageRead);
+          io->vpls = b.write(io->vpls, gi::BufferUsage::StorageWrite);
+        },
+        [this, io, bounce](gi::PassContext& pc) {
+          const int32_t b = bounce;
+          vkCmdPushConstants(pc.cmd(), bounce_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof b, &b);
+          gi::vk::DescriptorWriter w;
+          w.buffer(1, ubo, uniforms_.handle())
+              .buffer(3, ssbo, pc.buffer(io->points))
+              .buffer(6, ssbo, pc.buffer(io->irsm))
+              .buffer(7, ssbo, pc.buffer(io->irsmCells))
+              .buffer(8, ssbo, pc.buffer(io->vpls));
           pc.dispatch(bounce_, w, {1, 1}, 1, 1);
         });
   }
@@ -723,8 +754,8 @@ class IsmEffect : public gi::Effect {
   }
 
   Config cfg_;
-  gi::vk::Pipeline vpl_, splat_, pullPush_, upsample_, bounce_, gather_, blurX_, blurY_, atlasView_,
-      classicViews_;
+  gi::vk::Pipeline vpl_, splat_, pullPush_, upsample_, irsm_, bounce_, gather_, blurX_, blurY_,
+      atlasView_, classicViews_;
   VkSampler nearest_ = VK_NULL_HANDLE;
   gi::vk::Buffer uniforms_, vplBuffer_;
   gi::ism::Uniforms uploaded_{};

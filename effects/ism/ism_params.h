@@ -19,8 +19,12 @@ inline constexpr int kVplSlots = kMaxVpls + kMaxBlock * kMaxBlock;  // padded to
 inline constexpr int kMaxIsmResolution = 512;
 inline constexpr int kMaxPullPushLevels = 6;  // ism_pull_push.comp: 64 x 64 blocks
 inline constexpr int kMaxBounces = 3;
-// Surface points shaded per extra bounce as candidates for its VPLs (ism_bounce.glsl).
-inline constexpr uint32_t kShadePoints = 2048;
+// Imperfect reflective shadow maps (ism_irsm.glsl): of each VPL's point subset, the first
+// kIrsmPoints at most are shaded as its IRSM's entries (the next bounce's candidates).
+inline constexpr uint32_t kIrsmPoints = 4096;
+inline uint32_t irsmEntries(int pointsPerIsm) {
+  return std::min(uint32_t(pointsPerIsm), kIrsmPoints);
+}
 inline constexpr int kMaxSplatRadius = 2;
 inline constexpr uint32_t kMaxPoints = 1u << 21;  // surface points asked of the engine
 inline constexpr uint32_t kEmpty = 0xffffffffu;   // an ISM texel no point reached

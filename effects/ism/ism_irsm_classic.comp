@@ -1,4 +1,4 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #define ISM_CLASSIC 1
-#include "ism_bounce.glsl"
+#include "ism_irsm.glsl"
