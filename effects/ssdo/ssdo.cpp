@@ -34,6 +34,7 @@
 #include "ssdo.comp.h"          // const uint32_t ssdo_comp[]
 #include "ssdo_blur_x.comp.h"   // const uint32_t ssdo_blur_x_comp[]
 #include "ssdo_contact.comp.h"  // const uint32_t ssdo_contact_comp[]
+#include "ssdo_depth.comp.h"    // const uint32_t ssdo_depth_comp[]
 #include "ssdo_layers.comp.h"   // const uint32_t ssdo_layers_comp[]
 #include "ssdo_resolve.comp.h"  // const uint32_t ssdo_resolve_comp[]
 #include "ssdo_samples.h"
@@ -146,7 +147,7 @@ class SsdoEffect : public gi::Effect {
     contactSamples_ =
         uint32_t(std::clamp(settings.integer("contact_samples"), 1, kMaxContactSamples));
     contactMasks_.reset();  // the sample count may have changed: rebuilt on first use
-    buildSurface(ctx, lightMasks(ctx.lights()));
+    if (!depthInput()) buildSurface(ctx, lightMasks(ctx.lights()));
     buildSsdo(ctx, environmentKind(ctx.frame()));
     while (views_.size() < cameras_) views_.push_back(ctx.createView());
     // The blur's radius and whether it carries the bounce term.
@@ -367,78 +368,99 @@ class SsdoEffect : public gi::Effect {
       if (!bounce_) bb.put(res::kContactShadow, io->contact);
     }
 
-    graph.addPass(
-        "ssdo_surface",
-        [&](gi::PassBuilder& b) {
-          io->depth = b.read(bb.texture(res::kDepth));
-          io->normal = b.read(bb.texture(res::kNormal));
-          io->albedo = b.read(bb.texture(res::kAlbedo));
-          io->material = b.read(bb.texture(res::kMaterial));
-          io->emission = b.read(bb.texture(res::kEmission));
-          readLights(b);
-          if (layers_ > 1) io->peeled[0] = b.read(io->peeled[0]);
-          io->surface = b.write(b.create("ssdo_surface", gi::TextureDesc{kPackedFormat}),
-                                gi::TextureUsage::StorageWrite);
-          if (bounce_ && contact_) io->contact = b.read(io->contact);
-          // Written and published only with the bounce; without it the image stands in for
-          // the binding (a storage image of the declared format).
-          io->direct = b.write(b.create(res::kDirectLight, gi::TextureDesc{kOutFormat}),
-                               gi::TextureUsage::StorageWrite);
-          if (layers_ > 2) {
-            for (size_t k = 1; k < io->peeled.size(); ++k) io->peeled[k] = b.read(io->peeled[k]);
-            io->layers23 = b.write(b.create("ssdo_layers23", gi::TextureDesc{kLayersFormat}),
-                                   gi::TextureUsage::StorageWrite);
-          }
-        },
-        [this, io, values = &settings, frame, nearest, ubo, c = &ctx](gi::PassContext& pc) {
-          upload(*values);
-          // Light types and the environment's kind can change without a graph rebuild: the
-          // specialized pipelines follow (built here, before the dispatches that use them).
-          const auto masks = lightMasks(c->lights());
-          if (masks != surfaceMasks_ || pcfRadius(*c) != pcf_) buildSurface(*c, masks);
-          const uint32_t kind = environmentKind(c->frame());
-          if (kind != environmentKind_) buildSsdo(*c, kind);
-          gi::vk::DescriptorWriter w;
-          w.buffer(0, ubo, frame)
-              .buffer(1, ubo, uniforms_.handle())
-              .sampled(2, pc.view(io->depth), nearest)
-              .sampled(3, pc.view(io->normal), nearest)
-              .sampled(4, pc.view(io->albedo), nearest)
-              .sampled(5, pc.view(io->material), nearest)
-              .sampled(6, pc.view(io->emission), nearest)
-              .buffer(7, ubo, pc.buffer(io->lights))
-              .buffer(8, ubo, pc.buffer(io->shadowViews))
-              .sampled(9, pc.view(io->shadowMaps), nearest)
-              .storageImage(10, pc.view(io->surface))
-              // The peeled layer (unused with one layer: the depth stands in).
-              .sampled(11, pc.view(layers_ > 1 ? io->peeled[0] : io->depth), nearest)
-              // direct_light and the contact shadows (unused without the bounce and without
-              // contact shadows: the surface and the depth stand in).
-              .storageImage(12, pc.view(io->direct))
-              .sampled(13, pc.view(bounce_ && contact_ ? io->contact : io->depth), nearest);
-          const VkExtent2D e = pc.extent(io->surface);
-          pc.dispatch(surface_, w, e, kGroupX, kGroupY);
-          if (layers_ > 2) {
-            // Layers 2 and 3 into one R32UI texel (with 3 layers, layer 2 stands in for 3).
-            gi::vk::DescriptorWriter l;
-            l.buffer(0, ubo, frame)
-                .sampled(1, pc.view(io->peeled[1]), nearest)
-                .sampled(2, pc.view(io->peeled[layers_ > 3 ? 2 : 1]), nearest)
-                .storageImage(3, pc.view(io->layers23));
-            pc.dispatch(layersPipeline_, l, e, kGroupX, kGroupY);
-          }
-        });
+    // Directional occlusion alone reads the G-buffer depth directly (ssdo_depth.comp): no
+    // surface texels.
+    if (!depthInput())
+      graph.addPass(
+          "ssdo_surface",
+          [&](gi::PassBuilder& b) {
+            io->depth = b.read(bb.texture(res::kDepth));
+            io->normal = b.read(bb.texture(res::kNormal));
+            io->albedo = b.read(bb.texture(res::kAlbedo));
+            io->material = b.read(bb.texture(res::kMaterial));
+            io->emission = b.read(bb.texture(res::kEmission));
+            readLights(b);
+            if (layers_ > 1) io->peeled[0] = b.read(io->peeled[0]);
+            io->surface = b.write(b.create("ssdo_surface", gi::TextureDesc{kPackedFormat}),
+                                  gi::TextureUsage::StorageWrite);
+            if (bounce_ && contact_) io->contact = b.read(io->contact);
+            // Written and published only with the bounce; without it the image stands in for
+            // the binding (a storage image of the declared format).
+            io->direct = b.write(b.create(res::kDirectLight, gi::TextureDesc{kOutFormat}),
+                                 gi::TextureUsage::StorageWrite);
+            if (layers_ > 2) {
+              for (size_t k = 1; k < io->peeled.size(); ++k) io->peeled[k] = b.read(io->peeled[k]);
+              io->layers23 = b.write(b.create("ssdo_layers23", gi::TextureDesc{kLayersFormat}),
+                                     gi::TextureUsage::StorageWrite);
+            }
+          },
+          [this, io, values = &settings, frame, nearest, ubo, c = &ctx](gi::PassContext& pc) {
+            upload(*values);
+            // Light types and the environment's kind can change without a graph rebuild: the
+            // specialized pipelines follow (built here, before the dispatches that use them).
+            const auto masks = lightMasks(c->lights());
+            if (masks != surfaceMasks_ || pcfRadius(*c) != pcf_) buildSurface(*c, masks);
+            const uint32_t kind = environmentKind(c->frame());
+            if (kind != environmentKind_) buildSsdo(*c, kind);
+            gi::vk::DescriptorWriter w;
+            w.buffer(0, ubo, frame)
+                .buffer(1, ubo, uniforms_.handle())
+                .sampled(2, pc.view(io->depth), nearest)
+                .sampled(3, pc.view(io->normal), nearest)
+                .sampled(4, pc.view(io->albedo), nearest)
+                .sampled(5, pc.view(io->material), nearest)
+                .sampled(6, pc.view(io->emission), nearest)
+                .buffer(7, ubo, pc.buffer(io->lights))
+                .buffer(8, ubo, pc.buffer(io->shadowViews))
+                .sampled(9, pc.view(io->shadowMaps), nearest)
+                .storageImage(10, pc.view(io->surface))
+                // The peeled layer (unused with one layer: the depth stands in).
+                .sampled(11, pc.view(layers_ > 1 ? io->peeled[0] : io->depth), nearest)
+                // direct_light and the contact shadows (unused without the bounce and without
+                // contact shadows: the surface and the depth stand in).
+                .storageImage(12, pc.view(io->direct))
+                .sampled(13, pc.view(bounce_ && contact_ ? io->contact : io->depth), nearest);
+            const VkExtent2D e = pc.extent(io->surface);
+            pc.dispatch(surface_, w, e, kGroupX, kGroupY);
+            if (layers_ > 2) {
+              // Layers 2 and 3 into one R32UI texel (with 3 layers, layer 2 stands in for 3).
+              gi::vk::DescriptorWriter l;
+              l.buffer(0, ubo, frame)
+                  .sampled(1, pc.view(io->peeled[1]), nearest)
+                  .sampled(2, pc.view(io->peeled[layers_ > 3 ? 2 : 1]), nearest)
+                  .storageImage(3, pc.view(io->layers23));
+              pc.dispatch(layersPipeline_, l, e, kGroupX, kGroupY);
+            }
+          });
 
     graph.addPass(
         "ssdo",
         [&](gi::PassBuilder& b) {
-          io->surface = b.read(io->surface);
+          if (depthInput()) {
+            io->depth = b.read(bb.texture(res::kDepth));
+            io->normal = b.read(bb.texture(res::kNormal));
+          } else {
+            io->surface = b.read(io->surface);
+          }
           for (gi::TextureHandle& t : io->camSurface) t = b.read(t);
           if (layers_ > 2) io->layers23 = b.read(io->layers23);
           io->raw = b.write(b.create("ssdo_raw", gi::TextureDesc{kPackedFormat}),
                             gi::TextureUsage::StorageWrite);
         },
-        [this, io, frame, nearest, ubo, c = &ctx](gi::PassContext& pc) {
+        [this, io, values = &settings, frame, nearest, ubo, c = &ctx](gi::PassContext& pc) {
+          if (depthInput()) {  // what ssdo_surface's callback does otherwise
+            upload(*values);
+            const uint32_t kind = environmentKind(c->frame());
+            if (kind != environmentKind_) buildSsdo(*c, kind);
+            gi::vk::DescriptorWriter w;
+            w.buffer(0, ubo, frame)
+                .buffer(1, ubo, uniforms_.handle())
+                .storageImage(3, pc.view(io->raw))
+                .sampled(9, pc.view(io->depth), nearest)
+                .sampled(10, pc.view(io->normal), nearest);
+            pc.dispatch(ssdo_, w, pc.extent(io->raw), kGroupX, kGroupY);
+            return;
+          }
           uploadCameras(c->frame());
           gi::vk::DescriptorWriter w;
           w.buffer(0, ubo, frame)
@@ -506,6 +528,9 @@ class SsdoEffect : public gi::Effect {
   }
 
  private:
+  // Directional occlusion alone (no bounce, one layer, no cameras): the taps need only depth.
+  bool depthInput() const { return !bounce_ && layers_ == 1 && cameras_ == 0; }
+
   static uint32_t environmentKind(const gi::FrameUniforms& f) {
     return uint32_t(std::clamp(int(std::lround(f.skyHorizon.w)), 0, 2));
   }
@@ -514,10 +539,23 @@ class SsdoEffect : public gi::Effect {
     const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
                tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
                img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-    ssdo_ = gi::vk::Pipeline::compute(
-        ctx.vulkan(), {std::begin(ssdo_comp), std::end(ssdo_comp)},
-        {{0, ubo}, {1, ubo}, {2, tex}, {3, img}, {4, tex}, {5, tex}, {6, tex}, {7, tex}, {8, tex}},
-        0, {samples_, bounce_ ? 1u : 0u, kind, layers_, cameras_});
+    const std::vector<uint32_t> constants = {samples_, bounce_ ? 1u : 0u, kind, layers_, cameras_};
+    ssdo_ =
+        depthInput()
+            ? gi::vk::Pipeline::compute(
+                  ctx.vulkan(), {std::begin(ssdo_depth_comp), std::end(ssdo_depth_comp)},
+                  {{0, ubo}, {1, ubo}, {3, img}, {9, tex}, {10, tex}}, 0, constants)
+            : gi::vk::Pipeline::compute(ctx.vulkan(), {std::begin(ssdo_comp), std::end(ssdo_comp)},
+                                        {{0, ubo},
+                                         {1, ubo},
+                                         {2, tex},
+                                         {3, img},
+                                         {4, tex},
+                                         {5, tex},
+                                         {6, tex},
+                                         {7, tex},
+                                         {8, tex}},
+                                        0, constants);
     environmentKind_ = kind;
   }
 
