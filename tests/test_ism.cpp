@@ -185,18 +185,26 @@ class IsmTest : public test::EffectTest {
   // One VPL: a spot light below a small down-facing panel lights only the panel, whose one VPL
   // lights a floor with a box on it (`boxAnimation`: an "animation" entry for the box).
   Scene panelScene(const std::string& boxAnimation = "") {
-    return jsonScene("panel" + std::to_string(boxAnimation.size()), R"({
-      "models": [
+    return panelLitScene("panel" + std::to_string(boxAnimation.size()),
+                         R"(
         { "primitive": "plane", "size": 12, "material": { "base_color": [0.8, 0.8, 0.8] } },
         { "primitive": "box", "size": [1, 1.5, 1], "translation": [0, 0.75, 0], )" +
-                                                                        boxAnimation + R"(
-          "material": { "base_color": [0.8, 0.8, 0.8] } },
+                             boxAnimation + R"(
+          "material": { "base_color": [0.8, 0.8, 0.8] } },)",
+                         R"({ "position": [0, 6, 6], "target": [1, 0, 0] })");
+  }
+  // The only light is a spot below a small down-facing white panel at (-2, 2, 0): it lights
+  // just the panel, so every first-bounce VPL sits on it. `models`: the other models' entries,
+  // each followed by a comma; `camera`: the camera object.
+  Scene panelLitScene(const std::string& name, const std::string& models,
+                      const std::string& camera) {
+    return jsonScene(name, R"({ "models": [ )" + models + R"(
         { "primitive": "plane", "size": 0.5, "translation": [-2, 2, 0], "rotation": [180, 0, 0],
           "material": { "base_color": [1, 1, 1] } } ],
       "lights": [ { "type": "spot", "position": [-2, 1.5, 0], "direction": [0, 1, 0],
                     "intensity": 50, "inner_cone_deg": 5, "outer_cone_deg": 10,
                     "casts_shadows": false } ],
-      "camera": { "position": [0, 6, 6], "target": [1, 0, 0] },
+      "camera": )" + camera + R"(,
       "environment": { "type": "constant", "intensity": 0 } })");
   }
   // Geometry pixels with exactly zero indirect light (one VPL, no interleaving, no blur: a
@@ -441,8 +449,7 @@ TEST_F(IsmTest, CornellBoxBouncesIncreaseMonotonicallyAndConverge) {
 // floor's VPLs) is grey. Measured red / green 1.000 on the far wall; 1.37 with the IRSMs'
 // depth test removed (every point of a VPL's subset shaded).
 TEST_F(IsmTest, SecondBounceStartsOnlyWhereTheFirstBouncesVplsSee) {
-  const Scene s = jsonScene("irsm_wall", R"({
-      "models": [
+  const Scene s = panelLitScene("irsm_wall", R"(
         { "primitive": "plane", "size": 8, "translation": [-5, 0, 0],
           "material": { "base_color": [0.8, 0.8, 0.8] } },
         { "primitive": "box", "size": [0.2, 6, 8], "translation": [-1, 3, 0],
@@ -450,14 +457,8 @@ TEST_F(IsmTest, SecondBounceStartsOnlyWhereTheFirstBouncesVplsSee) {
         { "primitive": "plane", "size": 6, "translation": [4, 0, 0],
           "material": { "base_color": [0.8, 0.1, 0.1] } },
         { "primitive": "plane", "size": 6, "translation": [7, 3, 0], "rotation": [0, 0, 90],
-          "material": { "base_color": [0.8, 0.8, 0.8] } },
-        { "primitive": "plane", "size": 0.5, "translation": [-2, 2, 0], "rotation": [180, 0, 0],
-          "material": { "base_color": [1, 1, 1] } } ],
-      "lights": [ { "type": "spot", "position": [-2, 1.5, 0], "direction": [0, 1, 0],
-                    "intensity": 50, "inner_cone_deg": 5, "outer_cone_deg": 10,
-                    "casts_shadows": false } ],
-      "camera": { "position": [0, 16, 12], "target": [-1, 0, 0] },
-      "environment": { "type": "constant", "intensity": 0 } })");
+          "material": { "base_color": [0.8, 0.8, 0.8] } },)",
+                                R"({ "position": [0, 16, 12], "target": [-1, 0, 0] })");
   const std::vector<std::string> sets = {"ism.vpls=32", "ism.points_per_ism=32768",
                                          "ism.ism_resolution=128", "ism.pull_push_levels=2"};
   const Result one = render(s, with(sets, {"ism.bounces=1"}));
@@ -587,17 +588,9 @@ TEST_F(IsmTest, ClassicModeDrawsEveryBouncesMaps) {
 // from it.
 TEST_F(IsmTest, GlossyReceiverShowsTheVplHighlightAtTheMirrorDirection) {
   auto scene = [&](const std::string& name, const std::string& floor) {
-    return jsonScene("glossy_" + name, R"({
-      "models": [
-        { "primitive": "plane", "size": 12, "material": )" +
-                                           floor + R"( },
-        { "primitive": "plane", "size": 0.5, "translation": [-2, 2, 0], "rotation": [180, 0, 0],
-          "material": { "base_color": [1, 1, 1] } } ],
-      "lights": [ { "type": "spot", "position": [-2, 1.5, 0], "direction": [0, 1, 0],
-                    "intensity": 50, "inner_cone_deg": 5, "outer_cone_deg": 10,
-                    "casts_shadows": false } ],
-      "camera": { "position": [0, 6, 6], "target": [-1, 0, 1] },
-      "environment": { "type": "constant", "intensity": 0 } })");
+    return panelLitScene("glossy_" + name,
+                         R"({ "primitive": "plane", "size": 12, "material": )" + floor + "},",
+                         R"({ "position": [0, 6, 6], "target": [-1, 0, 1] })");
   };
   const Scene dielectric = scene("dielectric", R"({ "base_color": [0.8, 0.8, 0.8] })");
   const Scene metal = scene("metal", R"({ "base_color": [0.8, 0.8, 0.8], "metallic": 1 })");
