@@ -383,9 +383,7 @@ class IsmEffect : public gi::Effect {
             io->atlas = b.write(io->atlas, gi::TextureUsage::StorageWrite);
           },
           [this, io, c](gi::PassContext& pc) {
-            uploaded_.atlas.w = float(pc.bufferSize(io->points) / (2 * sizeof(glm::vec4)));
-            uniforms_.write(&uploaded_.atlas, sizeof(glm::vec4),
-                            offsetof(gi::ism::Uniforms, atlas));
+            uploadPointCount(pc, io->points);
             splat(pc, *io, c, 0);
           });
       addPullPush(graph, io, c, 0, "ism_pull_push");
@@ -519,6 +517,13 @@ class IsmEffect : public gi::Effect {
   }
 
  private:
+  // The surface points' count (two vec4 each) into the parameter block.
+  void uploadPointCount(gi::PassContext& pc, gi::BufferHandle points) {
+    const VkDeviceSize count = pc.bufferSize(points) / (2 * sizeof(glm::vec4));
+    uploaded_.atlas.w = float(count);
+    uniforms_.write(&uploaded_.atlas, sizeof(glm::vec4), offsetof(gi::ism::Uniforms, atlas));
+  }
+
   // Splats bounce `bounce`'s VPLs' point subsets into their tiles (mip 0).
   template <class IoT>
   void splat(gi::PassContext& pc, const IoT& io, const Config& c, int bounce) {
@@ -627,9 +632,7 @@ class IsmEffect : public gi::Effect {
         },
         [this, io, c, bounce, entries, materials = ctx.scene().materials()](gi::PassContext& pc) {
           if (c.classic) {  // no splat pass sets the point count
-            uploaded_.atlas.w = float(pc.bufferSize(io->points) / (2 * sizeof(glm::vec4)));
-            uniforms_.write(&uploaded_.atlas, sizeof(glm::vec4),
-                            offsetof(gi::ism::Uniforms, atlas));
+            uploadPointCount(pc, io->points);
           }
           const int32_t base = (bounce - 1) * c.vpls;
           vkCmdPushConstants(pc.cmd(), irsm_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof base, &base);
