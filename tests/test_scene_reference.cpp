@@ -568,6 +568,27 @@ TEST(ReferenceIndirect, InfiniteCornerUnderConstantSkyHasClosedForm) {
   s.quantity = ref::Quantity::DirectIndirect;
   checkAgainst(ref::render(scene, s), expected(a * L / 2, a * a * L / 4), 0.005, 300,
                "direct+indirect");
+  // k bounces: every point's outgoing radiance is a L / 2 + (a / 2) x the other plane's after
+  // k - 1 bounces, so direct+indirect = a L / 2 (1 + a/2 + ... + (a/2)^k).
+  for (uint32_t k : {2u, 3u}) {
+    s.bounces = k;
+    double sum = 0.0;
+    for (uint32_t i = 1; i <= k; ++i) sum += std::pow(a / 2.0, double(i));
+    checkAgainst(ref::render(scene, s), expected(a * L / 2, a * L / 2 * sum), 0.005, 300,
+                 k == 2 ? "2 bounces" : "3 bounces");
+  }
+}
+
+TEST(ReferenceIndirect, BouncesOutsideOneToEightAreRefused) {
+  SceneBuilder b;
+  addCorner(b, 10.0f, b.material(glm::vec3(0.5f)), b.material(glm::vec3(0.5f)));
+  b.camera({1.1f, 0.9f, 0.9f}, {0.2f, 0.15f, 0.0f}, 55.0f);
+  const Scene scene = b.done();
+  ref::Settings s = smallSettings(ref::Quantity::DirectIndirect, 1, 4, 4);
+  for (uint32_t k : {0u, ref::kMaxBounces + 1}) {
+    s.bounces = k;
+    EXPECT_THROW(ref::render(scene, s), Error) << k;
+  }
 }
 
 TEST(ReferenceIndirect, EmissiveSurfacesLightOnlyTheBounce) {

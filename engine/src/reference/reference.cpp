@@ -270,6 +270,30 @@ glm::vec3 cosineDirection(const glm::vec3& n, Rng& rng) {
   return Basis(n).toWorld(cosineHemisphere(u1, u2));
 }
 
+// The light diffuse surface y (material my) reflects towards the previous path vertex, one
+// sample: its direct light (lights with shadow rays) plus, along one cosine-sampled direction,
+// the environment or, with `more` bounces left, what the surface z met there sends (its
+// emission, unweighted: no vertex after the first samples the emitters directly, so this is
+// their only estimator there, plus the same reflection one level down). With more = 0 this is
+// the one-bounce estimator's vertex exactly (same random numbers, an occlusion ray).
+glm::vec3 reflected(const Shading& shading, const SurfaceHit& y, const SurfaceMaterial& my,
+                    uint32_t more, Rng& rng) {
+  const RayScene& rays = shading.rays();
+  glm::vec3 l = shading.directLights(y, my.diffuse);
+  const glm::vec3 dir = cosineDirection(y.shadingNormal, rng);
+  const glm::vec3 origin = RayScene::spawnOrigin(y);
+  if (more == 0) {
+    if (!rays.occluded(origin, dir, 0.0f, kInf)) l += my.diffuse * shading.environment(dir);
+    return l;
+  }
+  SurfaceHit z;
+  if (!rays.intersect(origin, dir, 0.0f, kInf, z)) return l + my.diffuse * shading.environment(dir);
+  const SurfaceMaterial mz = shading.material(z);
+  glm::vec3 lz = mz.emission;
+  if (mz.diffuse != glm::vec3(0.0f)) lz += reflected(shading, z, mz, more - 1, rng);
+  return l + my.diffuse * lz;
+}
+
 // One sample of the pixel's quantity (before the Alchemy transform).
 glm::vec3 sampleQuantity(const Settings& s, const Shading& shading, const Primary& p, Rng& rng) {
   const RayScene& rays = shading.rays();
@@ -301,18 +325,14 @@ glm::vec3 sampleQuantity(const Settings& s, const Shading& shading, const Primar
       SurfaceHit y;
       if (!rays.intersect(origin, dir, 0.0f, kInf, y))
         return p.base + emitted + p.material.diffuse * shading.environment(dir);
-      // One bounce: the radiance leaving y towards the pixel's point is its emission plus its
-      // direct light (lights with shadow rays, environment by one cosine sample).
+      // The radiance leaving y towards the pixel's point: its emission (MIS-weighted) plus
+      // what it reflects: its direct light (lights with shadow rays, environment by one cosine
+      // sample) and, with more bounces, the light of the further path (reflected()).
       const SurfaceMaterial my = shading.material(y);
       glm::vec3 ly(0.0f);
       if (my.emission != glm::vec3(0.0f))
         ly += my.emission * shading.bsdfWeight(p.hit, dir, y, my.emission);
-      if (my.diffuse != glm::vec3(0.0f)) {
-        ly += shading.directLights(y, my.diffuse);
-        const glm::vec3 dir2 = cosineDirection(y.shadingNormal, rng);
-        if (!rays.occluded(RayScene::spawnOrigin(y), dir2, 0.0f, kInf))
-          ly += my.diffuse * shading.environment(dir2);
-      }
+      if (my.diffuse != glm::vec3(0.0f)) ly += reflected(shading, y, my, s.bounces - 1, rng);
       return p.base + emitted + p.material.diffuse * ly;
     }
     case Quantity::Depth:
@@ -486,6 +506,7 @@ void validate(const Settings& s) {
   if (needsRadius && !(s.radius > 0.0f && std::isfinite(s.radius)))
     usage("radius must be a positive finite number");
   if (s.spp < 1) usage("samples per pixel must be at least 1");
+  if (s.bounces < 1 || s.bounces > kMaxBounces) usage("bounces must be 1..8");
   if (!(s.noiseTarget >= 0.0 && std::isfinite(s.noiseTarget)))
     usage("noise target must be a finite number >= 0");
   const AlchemyParams& a = s.alchemy;

@@ -149,13 +149,19 @@ struct Progress {
   double seconds = 0.0;       // since the start of render()
 };
 
+inline constexpr uint32_t kMaxBounces = 8;  // Settings::bounces
+
 struct Settings {
   uint32_t width = 320, height = 240;
   Quantity quantity = Quantity::AO;
   float radius = 0.5f;  // AO / AO split radius r, obscurance R, Alchemy (disk) r (world units)
   Membership membership = Membership::Sqrt;
   AlchemyParams alchemy;
-  uint32_t spp = 64;         // maximum samples per pixel
+  uint32_t spp = 64;  // maximum samples per pixel
+  // DirectIndirect: diffuse bounces after the direct light (1..kMaxBounces). Beyond the first,
+  // each bounce vertex continues the cosine-sampled path (emitters met on it unweighted: only
+  // the first vertex samples them directly).
+  uint32_t bounces = 1;
   double noiseTarget = 0.0;  // > 0: stop once the mean standard error is at most this
   uint32_t minSpp = 16;      // samples before the noise target is first checked
   uint64_t seed = 1;
