@@ -612,6 +612,15 @@ TEST(ReferenceIndirect, EmissiveSurfacesLightOnlyTheBounce) {
   checkAgainst(
       ref::render(scene, s), [&](glm::vec3 p) { return onFloor(p) ? a * Le / 2 : Le; }, 0.005, 300,
       "direct+indirect");
+  // Emitters seen but lighting nothing: the floor is dark, the wall keeps its radiance, at any
+  // number of bounces.
+  s.emitterLight = false;
+  for (uint32_t k : {1u, 3u}) {
+    s.bounces = k;
+    checkAgainst(
+        ref::render(scene, s), [&](glm::vec3 p) { return onFloor(p) ? 0.0 : Le; }, 1e-6, 300,
+        "direct+indirect without emitter light");
+  }
 }
 
 // Form factor from a differential area to a parallel rectangle at height h with one corner

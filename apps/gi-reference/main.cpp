@@ -30,6 +30,8 @@ const char* kUsage =
     "  --noise-target E       stop early once the mean per-pixel standard error is <= E\n"
     "  --min-spp N            samples before the noise target is checked (default 16)\n"
     "  --bounces N            direct+indirect: diffuse bounces, 1..8 (default 1)\n"
+    "  --no-emitter-light     direct+indirect: emissive surfaces are seen but light nothing\n"
+    "                         (the renderer's effects take light from the lights only)\n"
     "  --width W --height H   image size (default 320x240)\n"
     "  --seed S               random seed (default 1); a seed always gives the same image\n"
     "  --threads T            worker threads (default: all cores); does not change the image\n"
@@ -87,6 +89,8 @@ Options parseArgs(int argc, char** argv) {
       s.radius = float(a.numberAbove(0, 1e9));
     else if (a.is("--spp"))
       s.spp = uint32_t(a.integer(1, 1 << 24));
+    else if (a.is("--no-emitter-light"))
+      s.emitterLight = false;
     else if (a.is("--bounces"))
       s.bounces = uint32_t(a.integer(1, ref::kMaxBounces));
     else if (a.is("--min-spp"))
@@ -230,7 +234,8 @@ int run(const Options& o) {
   if (settings.quantity == ref::Quantity::Obscurance)
     std::printf(", membership %s", ref::membershipName(settings.membership));
   if (settings.quantity == ref::Quantity::DirectIndirect)
-    std::printf(", bounces %u", settings.bounces);
+    std::printf(", bounces %u%s", settings.bounces,
+                settings.emitterLight ? "" : ", emitters light nothing");
   std::printf("\n");
   std::printf("time %.3f s, %u samples per pixel, mean standard error %.6g (%zu geometry pixels)\n",
               r.seconds, r.spp, r.meanStdError, r.geometryPixels);

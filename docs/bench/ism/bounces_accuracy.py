@@ -1,6 +1,8 @@
 #!/usr/bin/env python3
 """ISM with 1, 2, 3 bounces against the path-traced reference with the same bounces
-(gi-reference --quantity direct+indirect --bounces K): NRMSE of the lit image, and the frame
+(gi-reference --quantity direct+indirect --bounces K --no-emitter-light: the VPLs come from
+the scene's lights only, so emissive surfaces such as the Cornell box's lamp quad are seen but
+light nothing in the reference either): NRMSE of the lit image, and the frame
 time (gi-render --timings: median frame; R interleaved repetitions, median [min, max]).
 
 usage: bounces_accuracy.py OUT.md REPS SCENE WxH SPP 'label=BIN [--set ...]' ...
@@ -33,7 +35,7 @@ rows = []
 first = {}  # K = 1: the reference's and each configuration's grey values, per pixel
 for k in (1, 2, 3):
     ref = f"{tmp}/ref{k}.pfm"
-    subprocess.run([ref_bin, "--scene", scene, "--quantity", "direct+indirect", "--bounces", str(k),
+    subprocess.run([ref_bin, "--scene", scene, "--quantity", "direct+indirect", "--bounces", str(k), "--no-emitter-light",
                     "--spp", spp, "--width", w, "--height", h, "--out", ref, "--gbuffer", f"{tmp}/g{k}"],
                    check=True, capture_output=True)
     _, _, n, rv = read_pfm(ref)

@@ -277,7 +277,7 @@ glm::vec3 cosineDirection(const glm::vec3& n, Rng& rng) {
 // their only estimator there, plus the same reflection one level down). With more = 0 this is
 // the one-bounce estimator's vertex exactly (same random numbers, an occlusion ray).
 glm::vec3 reflected(const Shading& shading, const SurfaceHit& y, const SurfaceMaterial& my,
-                    uint32_t more, Rng& rng) {
+                    uint32_t more, bool emitterLight, Rng& rng) {
   const RayScene& rays = shading.rays();
   glm::vec3 l = shading.directLights(y, my.diffuse);
   const glm::vec3 dir = cosineDirection(y.shadingNormal, rng);
@@ -289,8 +289,8 @@ glm::vec3 reflected(const Shading& shading, const SurfaceHit& y, const SurfaceMa
   SurfaceHit z;
   if (!rays.intersect(origin, dir, 0.0f, kInf, z)) return l + my.diffuse * shading.environment(dir);
   const SurfaceMaterial mz = shading.material(z);
-  glm::vec3 lz = mz.emission;
-  if (mz.diffuse != glm::vec3(0.0f)) lz += reflected(shading, z, mz, more - 1, rng);
+  glm::vec3 lz = emitterLight ? mz.emission : glm::vec3(0.0f);
+  if (mz.diffuse != glm::vec3(0.0f)) lz += reflected(shading, z, mz, more - 1, emitterLight, rng);
   return l + my.diffuse * lz;
 }
 
@@ -319,7 +319,7 @@ glm::vec3 sampleQuantity(const Settings& s, const Shading& shading, const Primar
     case Quantity::DirectIndirect: {
       // Light from emissive surfaces: sampled on the emitters and, below, by the cosine-
       // sampled bounce, combined by multiple importance sampling (balance heuristic).
-      const glm::vec3 emitted = p.material.diffuse == glm::vec3(0.0f)
+      const glm::vec3 emitted = p.material.diffuse == glm::vec3(0.0f) || !s.emitterLight
                                     ? glm::vec3(0.0f)
                                     : p.material.diffuse * shading.sampleEmitters(p.hit, rng);
       SurfaceHit y;
@@ -330,9 +330,10 @@ glm::vec3 sampleQuantity(const Settings& s, const Shading& shading, const Primar
       // sample) and, with more bounces, the light of the further path (reflected()).
       const SurfaceMaterial my = shading.material(y);
       glm::vec3 ly(0.0f);
-      if (my.emission != glm::vec3(0.0f))
+      if (my.emission != glm::vec3(0.0f) && s.emitterLight)
         ly += my.emission * shading.bsdfWeight(p.hit, dir, y, my.emission);
-      if (my.diffuse != glm::vec3(0.0f)) ly += reflected(shading, y, my, s.bounces - 1, rng);
+      if (my.diffuse != glm::vec3(0.0f))
+        ly += reflected(shading, y, my, s.bounces - 1, s.emitterLight, rng);
       return p.base + emitted + p.material.diffuse * ly;
     }
     case Quantity::Depth:

@@ -162,6 +162,10 @@ struct Settings {
   // each bounce vertex continues the cosine-sampled path (emitters met on it unweighted: only
   // the first vertex samples them directly).
   uint32_t bounces = 1;
+  // DirectIndirect: emissive surfaces light the others (true), or are only seen (false: what a
+  // renderer whose effects take light only from the scene's lights computes; the emitters'
+  // own pixels keep their radiance).
+  bool emitterLight = true;
   double noiseTarget = 0.0;  // > 0: stop once the mean standard error is at most this
   uint32_t minSpp = 16;      // samples before the noise target is first checked
   uint64_t seed = 1;
