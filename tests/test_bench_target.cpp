@@ -119,6 +119,23 @@ TEST(BenchTarget, ExcludeEmittersLeavesTheLampOut) {
   EXPECT_NE(c["nrmse"], a["nrmse"]);
 }
 
+// --no-emitter-light: the direct+indirect reference in which the default room's lamp (an
+// emissive quad) is seen but lights nothing, as for effects whose light comes from the lights
+// only; labelled, cached apart from the lit one, and a different score.
+TEST(BenchTarget, NoEmitterLightGivesItsOwnReference) {
+  const std::string dir = test::makeTempDir("bench-dark-emitters");
+  const std::string args = "--effects none --target direct+indirect";
+  const nlohmann::json lit = sweep(dir, "lit", args);
+  const nlohmann::json dark = sweep(dir, "dark", args + " --no-emitter-light");
+  const std::string litRef = row(lit, "none")["reference"],
+                    darkRef = row(dark, "none")["reference"];
+  EXPECT_EQ(litRef.find("dark-emitters"), std::string::npos) << litRef;
+  EXPECT_NE(darkRef.find("dark-emitters"), std::string::npos) << darkRef;
+  EXPECT_NE(row(dark, "none")["nrmse"], row(lit, "none")["nrmse"]);
+  std::printf("engine alone vs direct+indirect: NRMSE %.4f lit emitters, %.4f dark\n",
+              row(lit, "none")["nrmse"].get<double>(), row(dark, "none")["nrmse"].get<double>());
+}
+
 TEST(BenchTarget, BadTargetFailsBeforeRendering) {
   const std::string dir = test::makeTempDir("bench-target-bad");
   const std::string out = dir + "/out";

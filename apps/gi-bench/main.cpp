@@ -82,6 +82,9 @@ const char* kUsage =
     "                        own, the same for every method, and where rasteriser and ray\n"
     "                        tracer put an emitter's edge in different pixels that edge\n"
     "                        (radiance many times its surroundings') can dominate the NRMSE\n"
+    "  --no-emitter-light    direct+indirect references: emissive surfaces are seen but light\n"
+    "                        nothing (as for effects whose light comes from the lights only,\n"
+    "                        e.g. ISM's VPLs; the Cornell box's lamp is an emissive quad)\n"
     "  --ao-split            AO effects: split the reference's occlusion into what the depth\n"
     "                        buffer holds, off-screen and hidden occluders (gi-reference\n"
     "                        --quantity ao-split) and report where the effect cannot converge\n"
@@ -122,6 +125,7 @@ struct Options {
   bool quick = false, calibrate = false, progress = true, validation = false, aoSplit = false;
   std::optional<ref::Quantity> target;  // --target: one light quantity for every configuration
   bool excludeEmitters = false;         // --exclude-emitters
+  bool emitterLight = true;             // false: --no-emitter-light
   bool isolatePasses = false;
   double budgetMs = 0.0, headroom = 0.1;
   std::string metric = "ssim";  // --calibrate: what "most accurate" means
@@ -187,6 +191,8 @@ Options parseArgs(int argc, char** argv) {
       o.target = ref::parseQuantity(q);
     } else if (a.is("--exclude-emitters"))
       o.excludeEmitters = true;
+    else if (a.is("--no-emitter-light"))
+      o.emitterLight = false;
     else if (a.is("--ao-split"))
       o.aoSplit = true;
     else if (a.is("--isolate-passes"))
@@ -302,8 +308,11 @@ Comparison litAgainst(Comparison c, ref::Quantity target) {
   return c;
 }
 
-std::string referenceLabel(const ReferenceSpec& spec, uint32_t spp) {
-  return gi::bench::label(spec) + " spp=" + std::to_string(spp);
+// "dark-emitters": a direct+indirect reference whose emissive surfaces light nothing
+// (--no-emitter-light).
+std::string referenceLabel(const ReferenceSpec& spec, uint32_t spp, bool emitterLight) {
+  const bool dark = !emitterLight && spec.quantity == ref::Quantity::DirectIndirect;
+  return gi::bench::label(spec) + " spp=" + std::to_string(spp) + (dark ? " dark-emitters" : "");
 }
 
 // ---- Reference cache -------------------------------------------------------------------------
@@ -347,7 +356,8 @@ std::string cacheStem(const Options& o, const LoadedScene& s, const ReferenceKey
     key << buf;
   }
   key << '|' << o.width << 'x' << o.height << '|' << gi::bench::keyText(k.spec) << '|' << o.refSpp
-      << '|' << o.refSeed << '|' << s.scene.triangleCount();
+      << '|' << o.refSeed << '|' << s.scene.triangleCount()
+      << (o.emitterLight ? "" : "|dark-emitters");
   char hex[17];
   std::snprintf(hex, sizeof hex, "%016llx",
                 static_cast<unsigned long long>(fnv1a(s.contents, fnv1a(key.str()))));
@@ -384,6 +394,7 @@ Reference computeReference(const Options& o, const LoadedScene& s, const Referen
   rs.spp = o.refSpp;
   rs.minSpp = std::min(rs.minSpp, o.refSpp);
   rs.seed = o.refSeed;
+  rs.emitterLight = o.emitterLight;
   ref::Result res = ref::render(s.scene, rs);
   r = Reference{res.value, res.depth, res.split, res.spp, res.meanStdError, res.seconds, false};
   fs::create_directories(o.cache);
@@ -1027,7 +1038,7 @@ int runSweep(const Options& o) {
     r.floorMs = m.floor.median;
     r.wallMs = m.wall.median;
     r.compared = c.comparison.resource;
-    r.reference = referenceLabel(c.comparison.target, target.spp);
+    r.reference = referenceLabel(c.comparison.target, target.spp, o.emitterLight);
     r.referenceSpp = target.spp;
     r.referenceStdError = target.meanStdError;
     r.nrmse = vsTarget.metrics.nrmse;
@@ -1035,7 +1046,7 @@ int runSweep(const Options& o) {
     r.pixels = vsTarget.metrics.pixels;
     r.referenceSeconds = target.seconds;
     r.split = vsTarget.split;
-    r.declared = referenceLabel(c.comparison.declared, declared.spp);
+    r.declared = referenceLabel(c.comparison.declared, declared.spp, o.emitterLight);
     r.declaredStdError = declared.meanStdError;
     r.declaredNrmse = vsDeclared.metrics.nrmse;
     if (gaps[i]) {
@@ -1214,9 +1225,11 @@ int runCalibrate(const Options& o) {
       cheapest = std::min(cheapest, t.median);
     }
     it.choice = gi::bench::chooseCalibrated(cands, limit);
-    std::printf("\n%s against %s\n%-40s %10s %21s %12s %10s %8s %5s\n", it.label.c_str(),
-                referenceLabel(it.cmp.target, refs.at(ReferenceKey{0, it.cmp.target}).spp).c_str(),
-                "settings", "frame ms", intervalHeader, "cost bound", "NRMSE", "SSIM", "fits");
+    std::printf(
+        "\n%s against %s\n%-40s %10s %21s %12s %10s %8s %5s\n", it.label.c_str(),
+        referenceLabel(it.cmp.target, refs.at(ReferenceKey{0, it.cmp.target}).spp, o.emitterLight)
+            .c_str(),
+        "settings", "frame ms", intervalHeader, "cost bound", "NRMSE", "SSIM", "fits");
     for (size_t ci = 0; ci < it.candidates.size(); ++ci) {
       const Interval& t = measured[it.firstJob + ci].total;
       std::printf("%-40s %10.3f [%8.3f, %8.3f] %12.3f %10.5f %8.5f %5s\n", it.labels[ci].c_str(),
@@ -1254,7 +1267,8 @@ int runCalibrate(const Options& o) {
                " ms, NRMSE " + formatDouble(mt.nrmse) + ", SSIM " + formatDouble(mt.ssim);
     nlohmann::json item;
     item["effects"] = it.label;
-    item["reference"] = referenceLabel(it.cmp.target, refs.at(ReferenceKey{0, it.cmp.target}).spp);
+    item["reference"] =
+        referenceLabel(it.cmp.target, refs.at(ReferenceKey{0, it.cmp.target}).spp, o.emitterLight);
     item["chosen"] = it.labels[b];
     item["margin_ms"] = it.choice.marginMs;
     item["noise_margin_ms"] = it.choice.noiseMarginMs;
