@@ -85,6 +85,8 @@ const char* kUsage =
     "  --no-emitter-light    direct+indirect references: emissive surfaces are seen but light\n"
     "                        nothing (as for effects whose light comes from the lights only,\n"
     "                        e.g. ISM's VPLs; the Cornell box's lamp is an emissive quad)\n"
+    "  --ref-bounces N       direct+indirect references: diffuse bounces, 1..8 (default 1;\n"
+    "                        e.g. for ism.bounces=N)\n"
     "  --ao-split            AO effects: split the reference's occlusion into what the depth\n"
     "                        buffer holds, off-screen and hidden occluders (gi-reference\n"
     "                        --quantity ao-split) and report where the effect cannot converge\n"
@@ -126,6 +128,7 @@ struct Options {
   std::optional<ref::Quantity> target;  // --target: one light quantity for every configuration
   bool excludeEmitters = false;         // --exclude-emitters
   bool emitterLight = true;             // false: --no-emitter-light
+  uint32_t refBounces = 1;              // --ref-bounces
   bool isolatePasses = false;
   double budgetMs = 0.0, headroom = 0.1;
   std::string metric = "ssim";  // --calibrate: what "most accurate" means
@@ -193,6 +196,8 @@ Options parseArgs(int argc, char** argv) {
       o.excludeEmitters = true;
     else if (a.is("--no-emitter-light"))
       o.emitterLight = false;
+    else if (a.is("--ref-bounces"))
+      o.refBounces = uint32_t(a.integer(1, ref::kMaxBounces));
     else if (a.is("--ao-split"))
       o.aoSplit = true;
     else if (a.is("--isolate-passes"))
@@ -308,11 +313,13 @@ Comparison litAgainst(Comparison c, ref::Quantity target) {
   return c;
 }
 
-// "dark-emitters": a direct+indirect reference whose emissive surfaces light nothing
-// (--no-emitter-light).
-std::string referenceLabel(const ReferenceSpec& spec, uint32_t spp, bool emitterLight) {
-  const bool dark = !emitterLight && spec.quantity == ref::Quantity::DirectIndirect;
-  return gi::bench::label(spec) + " spp=" + std::to_string(spp) + (dark ? " dark-emitters" : "");
+// Direct+indirect references also name their bounces (--ref-bounces) and "dark-emitters"
+// (--no-emitter-light: emissive surfaces light nothing).
+std::string referenceLabel(const ReferenceSpec& spec, uint32_t spp, const Options& o) {
+  const bool light = spec.quantity == ref::Quantity::DirectIndirect;
+  return gi::bench::label(spec) + " spp=" + std::to_string(spp) +
+         (light && o.refBounces > 1 ? " bounces=" + std::to_string(o.refBounces) : "") +
+         (light && !o.emitterLight ? " dark-emitters" : "");
 }
 
 // ---- Reference cache -------------------------------------------------------------------------
@@ -357,7 +364,7 @@ std::string cacheStem(const Options& o, const LoadedScene& s, const ReferenceKey
   }
   key << '|' << o.width << 'x' << o.height << '|' << gi::bench::keyText(k.spec) << '|' << o.refSpp
       << '|' << o.refSeed << '|' << s.scene.triangleCount()
-      << (o.emitterLight ? "" : "|dark-emitters");
+      << (o.emitterLight ? "" : "|dark-emitters") << "|bounces" << o.refBounces;
   char hex[17];
   std::snprintf(hex, sizeof hex, "%016llx",
                 static_cast<unsigned long long>(fnv1a(s.contents, fnv1a(key.str()))));
@@ -395,6 +402,7 @@ Reference computeReference(const Options& o, const LoadedScene& s, const Referen
   rs.minSpp = std::min(rs.minSpp, o.refSpp);
   rs.seed = o.refSeed;
   rs.emitterLight = o.emitterLight;
+  rs.bounces = o.refBounces;
   ref::Result res = ref::render(s.scene, rs);
   r = Reference{res.value, res.depth, res.split, res.spp, res.meanStdError, res.seconds, false};
   fs::create_directories(o.cache);
@@ -1038,7 +1046,7 @@ int runSweep(const Options& o) {
     r.floorMs = m.floor.median;
     r.wallMs = m.wall.median;
     r.compared = c.comparison.resource;
-    r.reference = referenceLabel(c.comparison.target, target.spp, o.emitterLight);
+    r.reference = referenceLabel(c.comparison.target, target.spp, o);
     r.referenceSpp = target.spp;
     r.referenceStdError = target.meanStdError;
     r.nrmse = vsTarget.metrics.nrmse;
@@ -1046,7 +1054,7 @@ int runSweep(const Options& o) {
     r.pixels = vsTarget.metrics.pixels;
     r.referenceSeconds = target.seconds;
     r.split = vsTarget.split;
-    r.declared = referenceLabel(c.comparison.declared, declared.spp, o.emitterLight);
+    r.declared = referenceLabel(c.comparison.declared, declared.spp, o);
     r.declaredStdError = declared.meanStdError;
     r.declaredNrmse = vsDeclared.metrics.nrmse;
     if (gaps[i]) {
@@ -1227,8 +1235,7 @@ int runCalibrate(const Options& o) {
     it.choice = gi::bench::chooseCalibrated(cands, limit);
     std::printf(
         "\n%s against %s\n%-40s %10s %21s %12s %10s %8s %5s\n", it.label.c_str(),
-        referenceLabel(it.cmp.target, refs.at(ReferenceKey{0, it.cmp.target}).spp, o.emitterLight)
-            .c_str(),
+        referenceLabel(it.cmp.target, refs.at(ReferenceKey{0, it.cmp.target}).spp, o).c_str(),
         "settings", "frame ms", intervalHeader, "cost bound", "NRMSE", "SSIM", "fits");
     for (size_t ci = 0; ci < it.candidates.size(); ++ci) {
       const Interval& t = measured[it.firstJob + ci].total;
@@ -1268,7 +1275,7 @@ int runCalibrate(const Options& o) {
     nlohmann::json item;
     item["effects"] = it.label;
     item["reference"] =
-        referenceLabel(it.cmp.target, refs.at(ReferenceKey{0, it.cmp.target}).spp, o.emitterLight);
+        referenceLabel(it.cmp.target, refs.at(ReferenceKey{0, it.cmp.target}).spp, o);
     item["chosen"] = it.labels[b];
     item["margin_ms"] = it.choice.marginMs;
     item["noise_margin_ms"] = it.choice.noiseMarginMs;
