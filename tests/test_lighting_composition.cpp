@@ -80,7 +80,7 @@ class ConstantEffect : public Effect {
 constexpr VkFormat kRGBA16F = VK_FORMAT_R16G16B16A16_SFLOAT;
 
 struct Frame {
-  ImageRGBA32F lit, depth;
+  ImageRGBA32F lit, depth, albedo, material;
   ImageRGBA8 output;
   std::vector<std::string> passes;
 };
@@ -93,7 +93,8 @@ Frame renderWith(vk::Context& ctx, const Scene& scene, EffectRegistry& reg,
   for (const std::string& e : effects) rs.effects.push_back({e, reg.defaultSettings(e)});
   Renderer r(ctx, scene, rs, &reg);
   r.renderFrame();
-  return {r.readTarget("lit"), r.readTarget("depth"), r.readOutput(), r.passNames()};
+  return {r.readTarget("lit"),      r.readTarget("depth"), r.readTarget("albedo"),
+          r.readTarget("material"), r.readOutput(),        r.passNames()};
 }
 
 class LightingCompositionTest : public VulkanTest {};
@@ -149,6 +150,39 @@ TEST_F(LightingCompositionTest, AmbientReplacesTheEnvironmentTermAndIndirectAdds
     EXPECT_NEAR(indirect.lit.pixels[i + 2] - plain.lit.pixels[i + 2], 0.5f, 4e-3f);
   }
   EXPECT_GT(geometry, plain.lit.pixels.size() / 8);
+}
+
+// ambient with alpha 2 is per unit diffuse albedo: the lighting pass multiplies it by
+// albedo x (1 - metallic) (G-buffer albedo decoded from sRGB on the CPU here). Tolerance 1%:
+// lavapipe's sRGB decode differs from the exact curve by up to ~0.6% (measured), plus the
+// half-float lit image (2^-11 relative).
+TEST_F(LightingCompositionTest, AmbientWithAlphaTwoIsMultipliedByTheDiffuseAlbedo) {
+  Scene scene = loadScene("default");
+  scene.lights.clear();
+  for (Node& n : scene.nodes) n.light = -1;
+  for (Material& m : scene.materials) m.emission = glm::vec3(0.0f);
+  EffectRegistry reg;
+  reg.add([] {
+    return std::make_unique<ConstantEffect>(
+        "ambient_per_albedo", EffectStage::BeforeLighting, std::vector<std::string>{},
+        std::vector<ConstantEffect::Output>{{"ambient", kRGBA16F, {{0.5f, 1.0f, 2.0f, 2.0f}}}});
+  });
+  const Frame f = renderWith(ctx(), scene, reg, {"ambient_per_albedo"});
+  const float term[3] = {0.5f, 1.0f, 2.0f};
+  size_t geometry = 0, differs = 0;
+  for (size_t i = 0; i < f.lit.pixels.size(); i += 4) {
+    if (f.depth.pixels[i] <= 0.0f) continue;  // sky: not composed
+    ++geometry;
+    const float diffuse = 1.0f - f.material.pixels[i + 1];
+    for (int c = 0; c < 3; ++c) {
+      const float expected = term[c] * f.albedo.pixels[i + c] * diffuse;
+      ASSERT_NEAR(f.lit.pixels[i + c], expected, 0.01f * expected + 1e-4f) << i / 4 << " " << c;
+      // Not the alpha-1 reading (the term itself) unless the albedo happens to be 1.
+      if (std::abs(f.lit.pixels[i + c] - term[c]) > 0.01f * term[c]) ++differs;
+    }
+  }
+  EXPECT_GT(geometry, f.lit.pixels.size() / 8);
+  EXPECT_GT(differs, geometry);  // most pixels' albedo is not white
 }
 
 // contact_shadow: channel 0 scales the first *shadow-casting* light's direct term (here the

@@ -5,7 +5,8 @@
 // Lighting composition from the G-buffer: emission + direct light (Lambert + normalised
 // Blinn-Phong, PCF shadow maps) + the environment term + indirect light. The environment term
 // is the engine's SH9 irradiance x albedo x ambient visibility ("ao"), unless an effect supplies
-// its replacement ("ambient", alpha 1: directional occlusion); "indirect" is added. All three
+// its replacement ("ambient", alpha 1: directional occlusion; alpha 2: the same per unit diffuse
+// albedo, multiplied here); "indirect" is added. All three
 // optional inputs default to neutral 1x1 textures (ao 1, ambient alpha 0, indirect 0); a fourth,
 // "contact_shadow" (1), scales the first four shadowed lights' shadow factors; a fifth,
 // "direct_light", replaces the evaluation of the lights (sumLights, lights.glsl).
@@ -101,7 +102,8 @@ void main() {
   }
   vec4 ambient = kAmbientInput != 0 ? optionalInput(ambientTexture, kAmbientInput, p, uv) : vec4(0.0);
   if (ambient.a > 0.5) {
-    color += max(ambient.rgb, vec3(0.0));
+    // alpha 2: the effect left the diffuse albedo to this pass, which reads it anyway.
+    color += max(ambient.rgb, vec3(0.0)) * (ambient.a > 1.5 ? diffuseColor : vec3(1.0));
   } else {
     vec3 nWorld = mat3(frame.invView) * n;
     float ao = kAoInput != 0 ? clamp(optionalInput(aoTexture, kAoInput, p, uv).r, 0.0, 1.0) : 1.0;

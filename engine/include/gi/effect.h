@@ -42,7 +42,9 @@ inline constexpr const char* kLit = "lit";            // RGBA16F lit image (line
 // effects/README.md.
 inline constexpr const char* kAO = "ao";  // R ambient visibility of the environment term, 1 = open
 // RGBA16F: rgb the outgoing radiance of the environment term (albedo included), a = 1 where it
-// replaces the engine's SH9 x albedo x AO term (directional occlusion), 0 to keep the engine's.
+// replaces the engine's SH9 x albedo x AO term (directional occlusion), 0 to keep the engine's;
+// a = 2: rgb is that radiance per unit diffuse albedo (irradiance / pi), and the lighting pass
+// multiplies it by albedo x (1 - metallic), which it reads anyway (the effect need not).
 inline constexpr const char* kAmbient = "ambient";
 inline constexpr const char* kIndirect = "indirect";  // RGBA16F outgoing indirect radiance, added
 // RGBA8 (any size, sampled bilinearly at the pixel's uv): channel i multiplies the shadow factor
