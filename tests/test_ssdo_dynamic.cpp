@@ -34,8 +34,8 @@ class SsdoDynamicTest : public test::EffectTest {
   }
   static test::SsdoFrame grab(Renderer& r) {
     r.renderFrame();
-    return test::SsdoFrame(r.readTarget("ambient"), r.readTarget("indirect"), r.readTarget("depth"),
-                           r.camera());
+    return test::SsdoFrame(test::ssdoAmbientRadiance(r), r.readTarget("indirect"),
+                           r.readTarget("depth"), r.camera());
   }
 };
 

@@ -35,7 +35,7 @@ class SsdoLayersTest : public test::EffectTest {
     if (passes) *passes = r.passNames();
     // Without the bounce SSDO publishes no "indirect": an empty image stands in.
     const bool bounce = std::find(sets.begin(), sets.end(), "ssdo.bounce=false") == sets.end();
-    return test::SsdoFrame(r.readTarget("ambient"),
+    return test::SsdoFrame(test::ssdoAmbientRadiance(r),
                            bounce ? r.readTarget("indirect") : ImageRGBA32F{},
                            r.readTarget("depth"), r.camera());
   }

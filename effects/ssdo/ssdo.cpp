@@ -1,8 +1,9 @@
 // Screen-space directional occlusion with one indirect bounce (Ritschel, Grosch, Seidel 2009;
 // seed 000; README.md). Four dispatches: per pixel what a tap reads (1/z, normal, sender
 // radiance: ssdo_surface.comp), the samples (ssdo.comp), a geometry-aware separable blur whose
-// y half multiplies by the diffuse albedo (ssdo_blur_x.comp, ssdo_resolve.comp). Publishes
-// "ambient" (alpha 1: replaces the engine's environment x AO term) and "indirect" (added).
+// y half writes the outputs (ssdo_blur_x.comp, ssdo_resolve.comp; ssdo_resolve_ambient.comp
+// without the bounce). Publishes "ambient" (alpha 2: per unit diffuse albedo, replaces the
+// engine's environment x AO term) and "indirect" (x the diffuse albedo, added).
 // Optional (seed 000 §4), only built when asked: up to three more depth layers peeled through
 // the engine's layered-depth draw (`layers` 2..4, passes ssdo_peel, ssdo_peel2, ssdo_peel3;
 // layers 2 and 3 packed by ssdo_layers.comp), and `cameras` low-resolution
@@ -31,12 +32,13 @@
 #include "gi/lights.h"
 #include "gi/vk/pipeline.h"
 #include "gi/vk/resources.h"
-#include "ssdo.comp.h"          // const uint32_t ssdo_comp[]
-#include "ssdo_blur_x.comp.h"   // const uint32_t ssdo_blur_x_comp[]
-#include "ssdo_contact.comp.h"  // const uint32_t ssdo_contact_comp[]
-#include "ssdo_depth.comp.h"    // const uint32_t ssdo_depth_comp[]
-#include "ssdo_layers.comp.h"   // const uint32_t ssdo_layers_comp[]
-#include "ssdo_resolve.comp.h"  // const uint32_t ssdo_resolve_comp[]
+#include "ssdo.comp.h"                  // const uint32_t ssdo_comp[]
+#include "ssdo_blur_x.comp.h"           // const uint32_t ssdo_blur_x_comp[]
+#include "ssdo_contact.comp.h"          // const uint32_t ssdo_contact_comp[]
+#include "ssdo_depth.comp.h"            // const uint32_t ssdo_depth_comp[]
+#include "ssdo_layers.comp.h"           // const uint32_t ssdo_layers_comp[]
+#include "ssdo_resolve.comp.h"          // const uint32_t ssdo_resolve_comp[]
+#include "ssdo_resolve_ambient.comp.h"  // const uint32_t ssdo_resolve_ambient_comp[]
 #include "ssdo_samples.h"
 #include "ssdo_surface.comp.h"  // const uint32_t ssdo_surface_comp[]
 
@@ -105,6 +107,10 @@ class SsdoEffect : public gi::Effect {
                                 "this (1 / max(d^2, d_min^2))"),
         {"blur_radius", SettingType::Int, 2, 0, gi::ssdo::kMaxBlurRadius,
          "geometry-aware blur radius in pixels (0: none; even radii cancel the 4x4 pattern)", true},
+        {"blur_normals", SettingType::Bool, 1, 0, 1,
+         "the blur also rejects neighbours whose normal differs by more than acos(0.8) "
+         "(off: the tangent-plane depth test alone, which lets creases blend over the radius)",
+         true},
         {"layers", SettingType::Int, 1, 1, gi::ssdo::kMaxLayers,
          "depth layers (2..4: depth peeling, layers - 1 peel passes; a sample is blocked only "
          "inside the solid intervals [layer 0, layer 1] and [layer 2, layer 3]: thin objects "
@@ -150,16 +156,22 @@ class SsdoEffect : public gi::Effect {
     if (!depthInput()) buildSurface(ctx, lightMasks(ctx.lights()));
     buildSsdo(ctx, environmentKind(ctx.frame()));
     while (views_.size() < cameras_) views_.push_back(ctx.createView());
-    // The blur's radius and whether it carries the bounce term.
+    // The blur's radius, whether it carries the bounce term and tests normals.
     const std::vector<uint32_t> blurConstants = {
         uint32_t(std::clamp(settings.integer("blur_radius"), 0, gi::ssdo::kMaxBlurRadius)),
-        bounce_ ? 1u : 0u};
+        bounce_ ? 1u : 0u, settings.flag("blur_normals") ? 1u : 0u};
     blurX_ =
         gi::vk::Pipeline::compute(vk, {std::begin(ssdo_blur_x_comp), std::end(ssdo_blur_x_comp)},
                                   {{0, ubo}, {1, ubo}, {2, tex}, {3, img}}, 0, blurConstants);
-    resolve_ = gi::vk::Pipeline::compute(
-        vk, {std::begin(ssdo_resolve_comp), std::end(ssdo_resolve_comp)},
-        {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, tex}, {5, img}, {6, img}}, 0, blurConstants);
+    resolve_ =
+        bounce_
+            ? gi::vk::Pipeline::compute(
+                  vk, {std::begin(ssdo_resolve_comp), std::end(ssdo_resolve_comp)},
+                  {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, tex}, {5, img}, {6, img}}, 0,
+                  blurConstants)
+            : gi::vk::Pipeline::compute(
+                  vk, {std::begin(ssdo_resolve_ambient_comp), std::end(ssdo_resolve_ambient_comp)},
+                  {{0, ubo}, {1, ubo}, {2, tex}, {5, img}}, 0, blurConstants);
     if (layers_ > 2)
       layersPipeline_ =
           gi::vk::Pipeline::compute(vk, {std::begin(ssdo_layers_comp), std::end(ssdo_layers_comp)},
@@ -475,14 +487,16 @@ class SsdoEffect : public gi::Effect {
           pc.dispatch(ssdo_, w, pc.extent(io->raw), kGroupX, kGroupY);
         });
 
-    // Blur along x into `half`, then along y with the albedo into the outputs (radius 0: only
-    // the albedo, pass "ssdo_resolve").
+    // Blur along x into `half`, then along y into the outputs (radius 0: no blur, pass
+    // "ssdo_resolve").
     graph.addPass(
         blurRadius > 0 ? "ssdo_blur" : "ssdo_resolve",
         [&](gi::PassBuilder& b) {
           io->raw = b.read(io->raw);
-          io->albedo = b.read(bb.texture(res::kAlbedo));
-          io->material = b.read(bb.texture(res::kMaterial));
+          if (bounce_) {  // the albedo for `indirect` (`ambient` is per unit albedo)
+            io->albedo = b.read(bb.texture(res::kAlbedo));
+            io->material = b.read(bb.texture(res::kMaterial));
+          }
           if (blurRadius > 0)
             io->half = b.write(b.create("ssdo_blur_x", gi::TextureDesc{kPackedFormat}),
                                gi::TextureUsage::StorageWrite);
@@ -514,10 +528,11 @@ class SsdoEffect : public gi::Effect {
           w.buffer(0, ubo, frame)
               .buffer(1, ubo, uniforms_.handle())
               .sampled(2, in, nearest, inLayout)
-              .sampled(3, pc.view(io->albedo), nearest)
-              .sampled(4, pc.view(io->material), nearest)
-              .storageImage(5, pc.view(io->ambient))
-              .storageImage(6, pc.view(bounce_ ? io->indirect : io->ambient));
+              .storageImage(5, pc.view(io->ambient));
+          if (bounce_)
+            w.sampled(3, pc.view(io->albedo), nearest)
+                .sampled(4, pc.view(io->material), nearest)
+                .storageImage(6, pc.view(io->indirect));
           pc.dispatch(resolve_, w, e, kGroupX, kGroupY);
         });
     bb.put(res::kAmbient, io->ambient);

@@ -132,7 +132,7 @@ void main() {
   float iz = uintBitsToFloat(centre.x);
   // Guard: sky pixels and pixels without geometry get no samples (all terms 0).
   if (!(iz > 0.0)) {
-    imageStore(outRaw, p, uvec4(0u, 0u, 0u, centre.y));
+    imageStore(outRaw, p, uvec4(0u, 0u, 0u, 0u));
     return;
   }
   mat4 proj = frame.proj;
@@ -322,5 +322,5 @@ void main() {
   direct *= 1.0 / float(kSamples);
   bounce *= ssdo.params.z;
   imageStore(outRaw, p,
-             uvec4(packRgb9e5(direct), packRgb9e5(bounce), centre.x, centre.y));
+             uvec4(packRgb9e5(direct), packRgb9e5(bounce), centre.x, packBlurNormal(N)));
 }

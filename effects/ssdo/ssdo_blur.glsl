@@ -6,7 +6,8 @@
 // 4x4 sample-set pattern gets the same weight and the pattern cancels on flat regions (as in
 // effects/ssao). Edge stopping: a neighbour gets weight 0 when its view distance differs by
 // more than the tolerance from the centre's tangent plane extended to it (depth
-// discontinuities, creases) or its normal differs by more than acos(min cosine).
+// discontinuities, and creases once they leave the plane) or, with `blur_normals`, its normal
+// differs by more than acos(min cosine) (creases from their first pixel on).
 //
 // Include after defining GI_BLUR_AXIS (0: x, 1: y) and declaring the outputs.
 layout(local_size_x = 32, local_size_y = 16) in;
@@ -17,6 +18,8 @@ layout(set = 0, binding = 2) uniform usampler2D inRaw;
 layout(constant_id = 0) const int kRadius = 2;  // 0..gi::ssdo::kMaxBlurRadius: the loop unrolls
 // The bounce term (off: `bounce` is 0, never decoded: the blur then costs what one term does).
 layout(constant_id = 1) const bool kBounceTerm = true;
+// The normal test (`blur_normals`; off: the plane test alone, as the engine's blur).
+layout(constant_id = 2) const bool kNormalTest = true;
 
 // The blurred terms of pixel p; `centre` is its raw texel.
 void ssdoBlur(ivec2 p, ivec2 size, uvec4 centre, out vec3 direct, out vec3 bounce) {
@@ -27,7 +30,7 @@ void ssdoBlur(ivec2 p, ivec2 size, uvec4 centre, out vec3 direct, out vec3 bounc
   float p20 = proj[2][0], p21 = proj[2][1];
   vec2 invSize = frame.viewport.zw;
   float ic = uintBitsToFloat(centre.z);
-  vec3 N = unpackNormal(centre.w);
+  vec3 N = safeNormalize(unpackBlurNormal(centre.w), vec3(0.0, 0.0, 1.0));
   // The centre's tangent plane predicts 1/z along the axis: 1/z is affine in screen space on a
   // plane, d(1/z)/dpixel = (1/z) N.xy dD / (N.D) for the view ray D (z = -1) (effects/ssao).
   // Guard: a grazing plane (N.D near 0) predicts a constant.
@@ -50,10 +53,12 @@ void ssdoBlur(ivec2 p, ivec2 size, uvec4 centre, out vec3 direct, out vec3 bounc
     float pred = ic + slope * float(o);
     // |1/iq - 1/pred| < tol without a division (iq, pred > 0); the normals within acos(min
     // cosine), without normalizing the neighbour's: (N.n)^2 > c^2 |n|^2.
-    vec3 n = unpackNormalUnnormalized(t.w);
-    float c = dot(N, n);
-    bool same = inside && pred > 0.0 && iq > 0.0 && abs(pred - iq) < tol * iq * pred &&
-                c > 0.0 && c * c > minCos2 * dot(n, n);
+    bool same = inside && pred > 0.0 && iq > 0.0 && abs(pred - iq) < tol * iq * pred;
+    if (kNormalTest) {
+      vec3 n = unpackBlurNormal(t.w);
+      float c = dot(N, n);
+      same = same && c > 0.0 && c * c > minCos2 * dot(n, n);
+    }
     float w = same ? (abs(o) == kRadius ? 0.5 : 1.0) : 0.0;
     direct += w * unpackRgb9e5(t.x);
     if (kBounceTerm) bounce += w * unpackRgb9e5(t.y);

@@ -6,7 +6,8 @@
 //   snorm 16x2), z, w the sender's outgoing radiance (half rg, half b) and, with depth peeling,
 //   w's high half the 1 / view distance of the second depth layer (half; 0: none).
 // Raw / x-blurred texel (RGBA32UI), written by ssdo.comp and the x blur, read by the blur:
-//   x directional term (rgb9e5), y bounce term (rgb9e5), z 1 / view distance, w view normal.
+//   x directional term (rgb9e5), y bounce term (rgb9e5), z 1 / view distance, w view normal
+//   (packBlurNormal; 0 on sky pixels).
 #ifndef SSDO_COMMON_GLSL
 #define SSDO_COMMON_GLSL
 
@@ -32,20 +33,22 @@ uint packNormal(vec3 n) {
   vec2 e = n.z >= 0.0 ? n.xy : (1.0 - abs(n.yx)) * ssdoSignNotZero(n.xy);
   return packSnorm2x16(e);
 }
-// The octahedral decode without normalization (length in [1/sqrt(3), 1]).
-vec3 unpackNormalUnnormalized(uint p) {
-  vec2 e = unpackSnorm2x16(p);
-  vec3 n = vec3(e, 1.0 - abs(e.x) - abs(e.y));
-  float t = max(-n.z, 0.0);
-  n.xy -= t * ssdoSignNotZero(n.xy);
-  return n;
-}
 vec3 unpackNormal(uint p) {
   vec2 e = unpackSnorm2x16(p);
   vec3 n = vec3(e, 1.0 - abs(e.x) - abs(e.y));
   float t = max(-n.z, 0.0);
   n.xy -= t * ssdoSignNotZero(n.xy);
   return safeNormalize(n, vec3(0.0, 0.0, 1.0));
+}
+
+// The blur's normal (raw texel w): 10-bit snorm x, y, z, decoded per tap in a third of the
+// octahedral decode's instructions. Unnormalized on decode (within 1/511 of unit length).
+uint packBlurNormal(vec3 n) {
+  uvec3 q = uvec3(clamp(n * 511.5 + 511.5, 0.0, 1023.0));
+  return q.x | (q.y << 10) | (q.z << 20);
+}
+vec3 unpackBlurNormal(uint p) {
+  return vec3(uvec3(p, p >> 10, p >> 20) & 1023u) * (2.0 / 1023.0) - 1.0;
 }
 
 // Shared-exponent RGB (9-bit mantissas, 5-bit exponent; as VK_FORMAT_E5B9G9R9): non-negative,
@@ -55,13 +58,18 @@ uint packRgb9e5(vec3 c) {
   c = vec3(c.r > 0.0 ? min(c.r, kRgb9e5Max) : 0.0, c.g > 0.0 ? min(c.g, kRgb9e5Max) : 0.0,
            c.b > 0.0 ? min(c.b, kRgb9e5Max) : 0.0);
   float m = max(c.r, max(c.g, c.b));
-  int e = max(-16, int(floor(log2(max(m, 1e-30))))) + 16;  // biased shared exponent, >= 0
-  float denom = exp2(float(e - 24));
-  if (floor(m / denom + 0.5) >= 512.0) {
-    denom *= 2.0;
+  // floor(log2(m)) read from the float's exponent bits (exact; llvmpipe's log2 and exp2 are
+  // polynomial approximations and cost more than the rest of the packing), then the biased
+  // shared exponent e >= 0 (below 2^-16 every channel rounds to 0 anyway).
+  int e = max(-16, int(floatBitsToUint(max(m, 1e-30)) >> 23) - 127) + 16;
+  // 2^(24 - e) built from its bits (exponent 120..151: a normal float): multiplying by it is
+  // exact, where dividing by 2^(e - 24) cost a division per channel.
+  float scale = uintBitsToFloat(uint(151 - e) << 23);
+  if (floor(m * scale + 0.5) >= 512.0) {
+    scale *= 0.5;
     e += 1;
   }
-  uvec3 q = uvec3(min(floor(c / denom + 0.5), vec3(511.0)));
+  uvec3 q = uvec3(min(floor(c * scale + 0.5), vec3(511.0)));
   return q.r | (q.g << 9) | (q.b << 18) | (uint(clamp(e, 0, 31)) << 27);
 }
 vec3 unpackRgb9e5(uint p) {

@@ -10,9 +10,27 @@
 #include <glm/glm.hpp>
 
 #include "gi/image_io.h"
+#include "gi/renderer.h"
 #include "gi/scene.h"
 
 namespace gi::test {
+
+// SSDO's `ambient` as the outgoing radiance the lighting pass adds: SSDO publishes it per unit
+// diffuse albedo (alpha 2), and the lighting pass multiplies by albedo x (1 - metallic); this
+// does the same with the G-buffer read back (albedo decoded from sRGB). Texels with alpha 1
+// (already radiance) are kept.
+inline ImageRGBA32F ssdoAmbientRadiance(Renderer& r) {
+  ImageRGBA32F ambient = r.readTarget("ambient");
+  const ImageRGBA32F albedo = r.readTarget("albedo"), material = r.readTarget("material");
+  for (size_t i = 0; i + 3 < ambient.pixels.size(); i += 4) {
+    if (!(ambient.pixels[i + 3] > 1.5f)) continue;
+    const float metallic = material.pixels[i + 1];
+    for (size_t c = 0; c < 3; ++c)
+      ambient.pixels[i + c] *= albedo.pixels[i + c] * (1.0f - metallic);
+    ambient.pixels[i + 3] = 1.0f;
+  }
+  return ambient;
+}
 
 struct SsdoFrame {
   SsdoFrame(ImageRGBA32F ambientIn, ImageRGBA32F indirectIn, ImageRGBA32F depthIn,
