@@ -118,12 +118,17 @@ TEST_F(LightingCompositionTest, NeutralInputsReproduceTheImageWithoutEffectsBitF
             neutral.passes.end());
 }
 
-TEST_F(LightingCompositionTest, AmbientReplacesTheEnvironmentTermAndIndirectAdds) {
-  // No lights, no emission: lit = the environment term (+ indirect) on geometry.
+// The default room without lights and emission: lit = the environment term (+ indirect).
+Scene environmentOnlyScene() {
   Scene scene = loadScene("default");
   scene.lights.clear();
   for (Node& n : scene.nodes) n.light = -1;
   for (Material& m : scene.materials) m.emission = glm::vec3(0.0f);
+  return scene;
+}
+
+TEST_F(LightingCompositionTest, AmbientReplacesTheEnvironmentTermAndIndirectAdds) {
+  const Scene scene = environmentOnlyScene();
   EffectRegistry reg;
   reg.add([] {
     return std::make_unique<ConstantEffect>(
@@ -157,10 +162,7 @@ TEST_F(LightingCompositionTest, AmbientReplacesTheEnvironmentTermAndIndirectAdds
 // lavapipe's sRGB decode differs from the exact curve by up to ~0.6% (measured), plus the
 // half-float lit image (2^-11 relative).
 TEST_F(LightingCompositionTest, AmbientWithAlphaTwoIsMultipliedByTheDiffuseAlbedo) {
-  Scene scene = loadScene("default");
-  scene.lights.clear();
-  for (Node& n : scene.nodes) n.light = -1;
-  for (Material& m : scene.materials) m.emission = glm::vec3(0.0f);
+  const Scene scene = environmentOnlyScene();
   EffectRegistry reg;
   reg.add([] {
     return std::make_unique<ConstantEffect>(
