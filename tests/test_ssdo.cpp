@@ -37,7 +37,9 @@ class SsdoTest : public test::VulkanTest {
     ASSERT_TRUE(registry.has("ssdo")) << "ssdo plugin missing from " << test::binPath("plugins");
   }
   struct Result {
-    ImageRGBA32F ambient, indirect, lit, depth;
+    // ambient: as radiance (albedo applied, as the lighting pass does); ambientRaw: as SSDO
+    // publishes it, per unit diffuse albedo (alpha 2).
+    ImageRGBA32F ambient, ambientRaw, indirect, lit, depth;
     CameraView camera;
     int w = 0, h = 0;
     glm::vec3 px(const ImageRGBA32F& img, int x, int y) const {
@@ -72,6 +74,7 @@ class SsdoTest : public test::VulkanTest {
     Result res;
     if (effect == "ssdo") {
       res.ambient = test::ssdoAmbientRadiance(r);
+      res.ambientRaw = r.readTarget("ambient");
       if (std::find(sets.begin(), sets.end(), "ssdo.bounce=false") == sets.end())
         res.indirect = r.readTarget("indirect");
     }
@@ -128,6 +131,11 @@ TEST_F(SsdoTest, OpenPlaneUnderAConstantEnvironmentIsAlbedoTimesRadiance) {
       if (ssdo.sky(x, y)) continue;
       ++checked;
       const glm::vec3 a = ssdo.px(ssdo.ambient, x, y), engine = none.px(none.lit, x, y);
+      // Per unit albedo SSDO's own value is L itself: only the rgb9e5 packing (2^-9 of the
+      // largest channel, exact rounding) and the half-float output (2^-11) stand between.
+      const glm::vec3 raw = ssdo.px(ssdo.ambientRaw, x, y), L = 1.5f * glm::vec3(0.6f, 0.4f, 0.2f);
+      ASSERT_EQ(ssdo.ambientRaw.pixels[(size_t(y) * ssdo.w + x) * 4 + 3], 2.0f) << "alpha 2";
+      for (int c = 0; c < 3; ++c) ASSERT_NEAR(raw[c], L[c], 0.9f / 512.0f) << x << "," << y;
       for (int c = 0; c < 3; ++c) {
         ASSERT_NEAR(a[c], expected[c], 0.01f * expected[c]) << x << "," << y << " channel " << c;
         ASSERT_NEAR(ssdo.px(ssdo.lit, x, y)[c], engine[c], 0.01f * engine[c]) << x << "," << y;
