@@ -105,7 +105,7 @@ inline constexpr std::array<int, 16> kBayer4 = {0, 8,  2, 10, 12, 4, 14, 6,
 
 // Set used by pixel (x, y) with m sets.
 inline int setOf(int x, int y, int m) {
-  return kBayer4[size_t((y & 3) * 4 + (x & 3))] % std::max(m, 1);
+  return kBayer4[size_t(y & 3) * 4 + size_t(x & 3)] % std::max(m, 1);
 }
 
 // Sample i of pixel (x, y), as the shader sees it.
