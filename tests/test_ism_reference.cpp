@@ -1,8 +1,11 @@
 // The ISM plugin against the Embree reference: the Cornell box's lit image with one ISM bounce
-// is close to the ray-traced direct + one-bounce image, and much closer than direct light alone.
+// is close to the ray-traced direct + one-bounce image, and much closer than direct light alone;
+// environment VPLs bring an environment-lit scene much closer to its ray-traced direct light.
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <fstream>
 
 #include "gi/effect_config.h"
 #include "gi/reference/reference.h"
@@ -110,6 +113,46 @@ TEST_F(IsmReference, CornellBoxOneBounceMatchesTheReference) {
   std::printf("NRMSE with gather_scale=2: %.3f\n", half);
   EXPECT_LT(half, 0.23);
   EXPECT_LT(half, ism + 0.02);
+}
+
+// Environment VPLs against the ray-traced direct light of a floor with a box under a constant
+// white environment (its only light): the engine's unshadowed environment term misses the
+// box's shadow and the floor's half of the box's sky; 256 environment VPLs with 64^2
+// orthographic ISMs get both, and so do classic orthographic maps drawn from the triangles.
+// Measured (160x120, reference 1024 spp): NRMSE 0.035 (classic maps 0.028) against the engine
+// term's 0.103. Thresholds: each below 0.05 and below 0.6 x the engine's.
+TEST_F(IsmReference, EnvironmentVplsShadowTheEnvironmentLikeTheReference) {
+  const std::string path = ::testing::TempDir() + "/ism_env_reference.json";
+  {
+    std::ofstream f(path);
+    f << R"({ "models": [
+        { "primitive": "plane", "size": 10, "material": { "base_color": [0.8, 0.8, 0.8] } },
+        { "primitive": "box", "size": [1, 1, 1], "translation": [0, 0.5, 0],
+          "material": { "base_color": [0.8, 0.8, 0.8] } } ],
+      "lights": [ { "type": "directional", "direction": [0, -1, 0], "intensity": 0 } ],
+      "camera": { "position": [0, 4, 5], "target": [0, 0, 0] },
+      "environment": { "type": "constant", "color": [1, 1, 1], "intensity": 1 } })";
+  }
+  const Scene scene = loadSceneJson(path);
+  ref::Settings s;
+  s.quantity = ref::Quantity::Direct;
+  s.width = kW;
+  s.height = kH;
+  s.spp = 1024;
+  s.threads = 2;
+  const ref::Result r = ref::render(scene, s);
+  const double env = nrmse(lit(scene, {"ism"}, {"ism.environment_vpls=256"}), r);
+  const double classic =
+      nrmse(lit(scene, {"ism"}, {"ism.environment_vpls=256", "ism.mode=classic"}), r);
+  const double engine = nrmse(lit(scene, {"ism"}, {}), r);
+  std::printf(
+      "NRMSE vs ray-traced direct light: environment VPLs %.3f (classic maps %.3f), engine "
+      "term %.3f\n",
+      env, classic, engine);
+  EXPECT_LT(env, 0.05);
+  EXPECT_LT(env, 0.6 * engine);
+  EXPECT_LT(classic, 0.05);
+  EXPECT_LT(classic, 0.6 * engine);
 }
 
 }  // namespace

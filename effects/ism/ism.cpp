@@ -25,6 +25,7 @@
 #include "ism_bounce.comp.h"
 #include "ism_classic_atlas_view.comp.h"
 #include "ism_classic_views.comp.h"
+#include "ism_env_vpl.comp.h"
 #include "ism_gather.comp.h"
 #include "ism_gather_classic.comp.h"
 #include "ism_irsm.comp.h"
@@ -64,6 +65,10 @@ struct Config {
   int vpls = 256, padded = 256, block = 4, perPixel = 16, res = 64, perRow = 16, rows = 16;
   int perIsm = 1024, levels = 2, rsm = 64, splat = 1, blurExtra = 0, bounces = 1, scale = 1;
   int total() const { return vpls * bounces; }  // VPLs of all bounces (one tile each)
+  // Environment VPLs (ism_env_vpl.comp): count, padded to whole k x k blocks, per pixel; their
+  // tiles follow the point VPLs' in the atlas.
+  int env = 0, envPadded = 0, envPerPixel = 0;
+  int tiles() const { return total() + envPadded; }
   bool classic = false;
   bool glossy = false;  // Phong receivers (ism_glossy.glsl)
   float phong = 0.0f;   // Phong exponent, 0: from the roughness
@@ -80,10 +85,19 @@ class IsmEffect : public gi::Effect {
     i.description =
         "instant radiosity with imperfect shadow maps (Ritschel et al. 2008): VPLs from the "
         "primary light's RSM, point-splatted paraboloid ISMs with pull-push, interleaved "
-        "gathering, geometry-aware blur; 1 to 3 diffuse bounces";
+        "gathering, geometry-aware blur; 1 to 3 diffuse bounces; optionally the environment as "
+        "directional VPLs with orthographic ISMs";
     i.stage = gi::EffectStage::BeforeLighting;
-    i.reads = {res::kDepth, res::kNormal, res::kAlbedo, res::kMaterial, res::kSurfacePoints};
-    i.writes = {res::kIndirect, kAtlasView};
+    i.reads = {res::kDepth,
+               res::kNormal,
+               res::kAlbedo,
+               res::kMaterial,
+               res::kSurfacePoints,
+               res::kEnvironmentMap,
+               res::kEnvironmentSampling};
+    // ambient: published (as "nothing") only with environment VPLs, which then carry the
+    // environment's light in "indirect", shadowed, in place of the engine's unshadowed term.
+    i.writes = {res::kIndirect, res::kAmbient, kAtlasView};
     i.debugView = res::kIndirect;
     i.estimates = gi::GroundTruth::IndirectLight;
     return i;
@@ -161,6 +175,16 @@ class IsmEffect : public gi::Effect {
          "glossy receivers' Phong exponent n (0: from each pixel's roughness, the lighting "
          "pass's Blinn-Phong exponent / 4, within [1, 128])",
          true},
+        {"environment_vpls", SettingType::Int, 0, 0, gi::ism::kMaxEnvVpls,
+         "directional VPLs importance-sampled from the environment map, each with an "
+         "orthographic ISM (seed 002 §5): the environment's light, shadowed, replaces the "
+         "engine's unshadowed environment term (0: off; classic mode: orthographic maps "
+         "drawn from the triangles)",
+         true},
+        {"environment_normal_offset", SettingType::Float, 2.0, 0.0, 8.0,
+         "environment VPLs: receivers look up their orthographic maps from this many texels "
+         "along their normal (with the constant `bias`; see ism_lookup.glsl)",
+         false},
     };
   }
 
@@ -175,26 +199,29 @@ class IsmEffect : public gi::Effect {
     const int k2 = c.block * c.block;
     c.perPixel = (c.total() + k2 - 1) / k2;
     c.padded = c.perPixel * k2;
+    c.classic = s.option("mode") == "classic";
+    c.env = std::clamp(s.integer("environment_vpls"), 0, gi::ism::kMaxEnvVpls);
+    c.envPerPixel = (c.env + k2 - 1) / k2;
+    c.envPadded = c.envPerPixel * k2;
     c.res = floorPow2(std::clamp(s.integer("ism_resolution"), 8, gi::ism::kMaxIsmResolution));
-    c.perRow = int(std::ceil(std::sqrt(double(c.total()))));
-    c.rows = (c.total() + c.perRow - 1) / c.perRow;
+    c.perRow = int(std::ceil(std::sqrt(double(c.tiles()))));
+    c.rows = (c.tiles() + c.perRow - 1) / c.perRow;
     c.perIsm = s.integer("points_per_ism");
     c.levels = std::clamp(s.integer("pull_push_levels"), 0, log2i(c.res));
     c.rsm = s.integer("rsm_resolution");
     c.splat = s.integer("splat_radius");
     c.blurExtra = s.integer("blur_radius");
     c.scale = std::clamp(s.integer("gather_scale"), 1, 4);
-    c.classic = s.option("mode") == "classic";
     c.glossy = s.flag("glossy");
     c.phong = float(s.number("phong_exponent"));
     cfg_ = c;
     nearest_ = ctx.nearestSampler();
     // The engine keeps at least the points asked for: without the cap every subset fits.
-    const bool wrap = uint64_t(c.total()) * uint64_t(c.perIsm) > gi::ism::kMaxPoints;
+    const bool wrap = uint64_t(c.tiles()) * uint64_t(c.perIsm) > gi::ism::kMaxPoints;
     // Classic mode needs points only for the later bounces' IRSMs (the same subsets).
     if (!c.classic || c.bounces > 1)
       ctx.requestSurfacePoints(uint32_t(
-          std::min<uint64_t>(uint64_t(c.total()) * uint64_t(c.perIsm), gi::ism::kMaxPoints)));
+          std::min<uint64_t>(uint64_t(c.tiles()) * uint64_t(c.perIsm), gi::ism::kMaxPoints)));
 
     const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
                tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
@@ -203,20 +230,34 @@ class IsmEffect : public gi::Effect {
     vpl_ = gi::vk::Pipeline::compute(
         vk, spv(std::begin(ism_vpl_comp), std::end(ism_vpl_comp)),
         {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, tex}, {5, ssbo}, {6, ssbo}});
-    if (c.classic)
-      classicViews_ = gi::vk::Pipeline::compute(
-          vk, spv(std::begin(ism_classic_views_comp), std::end(ism_classic_views_comp)),
-          {{1, ubo}, {2, ubo}, {3, ssbo}}, 2 * sizeof(int32_t));
+    if (c.classic) {
+      auto views = [&](bool ortho) {
+        return gi::vk::Pipeline::compute(
+            vk, spv(std::begin(ism_classic_views_comp), std::end(ism_classic_views_comp)),
+            {{1, ubo}, {2, ubo}, {3, ssbo}}, 3 * sizeof(int32_t), {uint32_t(ortho)});
+      };
+      classicViews_ = views(false);
+      if (c.env > 0) envClassicViews_ = views(true);
+    }
     if (!c.classic) {
       splat_ =
           gi::vk::Pipeline::compute(vk, spv(std::begin(ism_splat_comp), std::end(ism_splat_comp)),
-                                    {{1, ubo}, {2, ubo}, {3, ssbo}, {4, img}}, sizeof(int32_t),
-                                    {uint32_t(c.splat), uint32_t(wrap ? 1 : 0)});
+                                    {{1, ubo}, {2, ubo}, {3, ssbo}, {4, img}}, 2 * sizeof(int32_t),
+                                    {uint32_t(c.splat), uint32_t(wrap ? 1 : 0), 0u});
+      if (c.env > 0)
+        envSplat_ = gi::vk::Pipeline::compute(
+            vk, spv(std::begin(ism_splat_comp), std::end(ism_splat_comp)),
+            {{1, ubo}, {2, ubo}, {3, ssbo}, {4, img}}, 2 * sizeof(int32_t),
+            {uint32_t(c.splat), uint32_t(wrap ? 1 : 0), 1u});
       if (c.levels > 0)
         pullPush_ = gi::vk::Pipeline::compute(
             vk, spv(std::begin(ism_pull_push_comp), std::end(ism_pull_push_comp)),
             {{1, ubo}, {2, img}}, 2 * sizeof(int32_t), {uint32_t(c.levels)});
     }
+    if (c.env > 0)
+      envVpl_ = gi::vk::Pipeline::compute(
+          vk, spv(std::begin(ism_env_vpl_comp), std::end(ism_env_vpl_comp)),
+          {{1, ubo}, {2, tex}, {3, ssbo}, {4, ssbo}});
     if (c.bounces > 1) {
       const uint32_t entries = gi::ism::irsmEntries(c.perIsm), wraps = wrap ? 1 : 0;
       irsm_ = c.classic
@@ -241,11 +282,14 @@ class IsmEffect : public gi::Effect {
                      : gi::vk::Pipeline::compute(
                            vk, spv(std::begin(ism_atlas_view_comp), std::end(ism_atlas_view_comp)),
                            {{0, tex}, {1, img}});
-    const std::vector<uint32_t> gatherSpec = {uint32_t(c.perPixel), uint32_t(c.block),
-                                              uint32_t(c.scale), uint32_t(c.glossy),
-                                              glm::floatBitsToUint(c.phong)};
-    const std::vector<gi::vk::Binding> gatherBindings = {{0, ubo}, {1, ubo}, {2, ubo}, {3, tex},
-                                                         {4, tex}, {5, tex}, {6, img}, {7, tex}};
+    const std::vector<uint32_t> gatherSpec = {uint32_t(c.perPixel),
+                                              uint32_t(c.block),
+                                              uint32_t(c.scale),
+                                              uint32_t(c.glossy),
+                                              glm::floatBitsToUint(c.phong),
+                                              uint32_t(c.envPerPixel)};
+    const std::vector<gi::vk::Binding> gatherBindings = {
+        {0, ubo}, {1, ubo}, {2, ubo}, {3, tex}, {4, tex}, {5, tex}, {6, img}, {7, tex}, {8, ubo}};
     gather_ =
         c.classic
             ? gi::vk::Pipeline::compute(
@@ -284,6 +328,13 @@ class IsmEffect : public gi::Effect {
           VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true);
       std::fill_n(static_cast<char*>(vplBuffer_.mapped()), vplBuffer_.size(), 0);
     }
+    // The environment VPLs' table: bound to the gathering also when there are none (zeros).
+    if (!envBuffer_) {
+      envBuffer_ = gi::vk::Buffer(
+          vk, kVplBytes * gi::ism::kVplSlots,
+          VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true);
+      std::fill_n(static_cast<char*>(envBuffer_.mapped()), envBuffer_.size(), 0);
+    }
   }
 
   void addPasses(gi::FrameGraph& graph, gi::EffectContext& ctx,
@@ -291,7 +342,8 @@ class IsmEffect : public gi::Effect {
     struct Io {
       gi::TextureHandle rsmDepth, rsmPos, rsmNormal, rsmFlux, atlas, depth, normal, albedo,
           material, raw, half, low, indirect, atlasView;
-      gi::BufferHandle cdf, vpls, points, irsm, irsmCells, classicViews;
+      gi::BufferHandle cdf, vpls, points, irsm, irsmCells, classicViews, envVpls, envSampling;
+      gi::TextureHandle envMap, ambient;
     };
     auto io = std::make_shared<Io>();
     gi::Blackboard& bb = graph.blackboard();
@@ -386,7 +438,7 @@ class IsmEffect : public gi::Effect {
             uploadPointCount(pc, io->points);
             splat(pc, *io, c, 0);
           });
-      addPullPush(graph, io, c, 0, "ism_pull_push");
+      addPullPush(graph, io, c, 0, c.vpls, "ism_pull_push");
       for (int bounce = 1; bounce < c.bounces; ++bounce) {
         addBounce(graph, ctx, io, bounce);
         const std::string n = std::to_string(bounce + 1);
@@ -401,16 +453,19 @@ class IsmEffect : public gi::Effect {
                   b.write(io->atlas, gi::TextureUsage::StorageWrite, gi::Subresource::mipLevel(0));
             },
             [this, io, c, bounce](gi::PassContext& pc) { splat(pc, *io, c, bounce); });
-        addPullPush(graph, io, c, bounce, "ism_pull_push" + n);
+        addPullPush(graph, io, c, bounce * c.vpls, (bounce + 1) * c.vpls, "ism_pull_push" + n);
       }
+      if (c.env > 0) addEnvironmentVpls(graph, ctx, io);
     } else {
       addClassicMaps(graph, ctx, io,
-                     absolute(gi::kSceneDepthFormat, c.atlasWidth(), c.atlasHeight()), 0);
+                     absolute(gi::kSceneDepthFormat, c.atlasWidth(), c.atlasHeight()),
+                     bounceRange(0));
       if (c.bounces > 1) io->points = graph.blackboard().buffer(res::kSurfacePoints);
       for (int bounce = 1; bounce < c.bounces; ++bounce) {
         addBounce(graph, ctx, io, bounce);
-        addClassicMaps(graph, ctx, io, {}, bounce);
+        addClassicMaps(graph, ctx, io, {}, bounceRange(bounce));
       }
+      if (c.env > 0) addEnvironmentVpls(graph, ctx, io);
     }
 
     // The atlas as a debug view (culled unless viewed).
@@ -439,6 +494,7 @@ class IsmEffect : public gi::Effect {
           io->vpls = b.read(io->vpls, gi::BufferUsage::Uniform);
           io->atlas = b.read(io->atlas, gi::TextureUsage::Sampled, gi::Subresource::mipLevel(0));
           io->material = b.read(bb.texture(res::kMaterial));  // glossy: roughness
+          if (c.env > 0) io->envVpls = b.read(io->envVpls, gi::BufferUsage::Uniform);
           io->raw = b.write(b.create("ism_raw", rawDesc), gi::TextureUsage::StorageWrite);
         },
         [this, io, c, frame, nearest, params, ubo](gi::PassContext& pc) {
@@ -450,7 +506,8 @@ class IsmEffect : public gi::Effect {
               .sampled(4, pc.view(io->normal), nearest)
               .sampled(5, pc.view(io->atlas, gi::Subresource::mipLevel(0)), nearest)
               .storageImage(6, pc.view(io->raw))
-              .sampled(7, pc.view(io->material), nearest);
+              .sampled(7, pc.view(io->material), nearest)
+              .buffer(8, ubo, c.env > 0 ? pc.buffer(io->envVpls) : envBuffer_.handle());
           pc.descriptors().bind(pc.cmd(), gather_, w);
           const VkExtent2D e = pc.extent(io->raw);
           const uint32_t k = uint32_t(c.block);
@@ -528,8 +585,9 @@ class IsmEffect : public gi::Effect {
   template <class IoT>
   void splat(gi::PassContext& pc, const IoT& io, const Config& c, int bounce) {
     const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    const int32_t base = bounce * c.vpls;
-    vkCmdPushConstants(pc.cmd(), splat_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof base, &base);
+    const std::array<int32_t, 2> range = {bounce * c.vpls, bounce * c.vpls};  // VPL, tile
+    vkCmdPushConstants(pc.cmd(), splat_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof range,
+                       range.data());
     gi::vk::DescriptorWriter w;
     w.buffer(1, ubo, uniforms_.handle())
         .buffer(2, ubo, pc.buffer(io.vpls))
@@ -538,9 +596,9 @@ class IsmEffect : public gi::Effect {
     pc.dispatch(splat_, w, {uint32_t(c.perIsm), uint32_t(c.vpls)}, 256, 1);
   }
 
-  // Pull-push over the tiles of bounce `bounce`'s VPLs.
+  // Pull-push over tiles [first, end) (one bounce's VPLs, or the environment VPLs).
   template <class IoPtr>
-  void addPullPush(gi::FrameGraph& graph, const IoPtr& io, const Config& c, int bounce,
+  void addPullPush(gi::FrameGraph& graph, const IoPtr& io, const Config& c, int first, int end,
                    const std::string& name) {
     if (c.levels == 0) return;
     graph.addPass(
@@ -550,8 +608,8 @@ class IsmEffect : public gi::Effect {
           io->atlas = b.read(io->atlas, gi::TextureUsage::StorageRead);
           io->atlas = b.write(io->atlas, gi::TextureUsage::StorageWrite);
         },
-        [this, io, c, bounce](gi::PassContext& pc) {
-          const std::array<int32_t, 2> tiles = {bounce * c.vpls, (bounce + 1) * c.vpls};
+        [this, io, first, end](gi::PassContext& pc) {
+          const std::array<int32_t, 2> tiles = {first, end};
           vkCmdPushConstants(pc.cmd(), pullPush_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof tiles,
                              tiles.data());
           gi::vk::DescriptorWriter w;
@@ -563,49 +621,137 @@ class IsmEffect : public gi::Effect {
         });
   }
 
-  // Classic mode: bounce `bounce`'s VPLs' paraboloid views, written on the GPU from this
-  // frame's VPL table (no read-back: the maps are current, not one frame late), then their
-  // maps drawn from the triangles into their tiles (bounce 0 creates and clears the atlas).
+  // Environment VPLs (seed 002 §5): sampled from the environment map (ism_env_vpl.comp), their
+  // orthographic maps splatted into the tiles after the point VPLs' and pull-pushed; and
+  // "ambient" published as nothing (alpha 1, rgb 0): the environment's light now arrives,
+  // shadowed, with the gathering's "indirect", so the engine's unshadowed term must go.
+  template <class IoPtr>
+  void addEnvironmentVpls(gi::FrameGraph& graph, gi::EffectContext& ctx, const IoPtr& io) {
+    const Config c = cfg_;
+    gi::Blackboard& bb = graph.blackboard();
+    const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    io->envVpls = graph.importBuffer("ism_env_vpls", envBuffer_.handle(), envBuffer_.size());
+    graph.addPass(
+        "ism_env_vpl",
+        [&](gi::PassBuilder& b) {
+          io->envMap = b.read(bb.texture(res::kEnvironmentMap));
+          io->envSampling =
+              b.read(bb.buffer(res::kEnvironmentSampling), gi::BufferUsage::StorageRead);
+          io->envVpls = b.write(io->envVpls, gi::BufferUsage::StorageWrite);
+        },
+        [this, io, c, ubo, ssbo](gi::PassContext& pc) {
+          gi::vk::DescriptorWriter w;
+          w.buffer(1, ubo, uniforms_.handle())
+              .sampled(2, pc.view(io->envMap), nearest_)
+              .buffer(3, ssbo, pc.buffer(io->envSampling))
+              .buffer(4, ssbo, pc.buffer(io->envVpls));
+          pc.dispatch(envVpl_, w, {uint32_t(c.envPadded), 1}, 64, 1);
+        });
+    if (c.classic) {
+      addClassicMaps(graph, ctx, io, {}, ClassicRange{"", 0, c.env, c.total(), true});
+    } else {
+      addEnvSplat(graph, io);
+      addPullPush(graph, io, c, c.total(), c.total() + c.envPadded, "ism_env_pull_push");
+    }
+    graph.addPass(
+        "ism_env_ambient",
+        [&](gi::PassBuilder& b) {
+          gi::TextureDesc one{kOutFormat, gi::SizeClass::Absolute, 1.0f, 1, 1};
+          io->ambient = b.write(b.create("ism_ambient", one), gi::TextureUsage::TransferDst);
+        },
+        [io](gi::PassContext& pc) {
+          const VkClearColorValue nothing{.float32 = {0.0f, 0.0f, 0.0f, 1.0f}};
+          const VkImageSubresourceRange range{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+          vkCmdClearColorImage(pc.cmd(), pc.image(io->ambient),
+                               VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &nothing, 1, &range);
+        });
+    bb.put(res::kAmbient, io->ambient);
+  }
+  // The environment VPLs' orthographic ISMs: their point subsets splatted into their tiles.
+  template <class IoPtr>
+  void addEnvSplat(gi::FrameGraph& graph, const IoPtr& io) {
+    const Config c = cfg_;
+    const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    graph.addPass(
+        "ism_env_splat",
+        [&](gi::PassBuilder& b) {
+          io->envVpls = b.read(io->envVpls, gi::BufferUsage::Uniform);
+          io->points = b.read(io->points, gi::BufferUsage::StorageRead);
+          io->atlas = b.read(io->atlas, gi::TextureUsage::StorageRead);
+          io->atlas = b.write(io->atlas, gi::TextureUsage::StorageWrite);
+        },
+        [this, io, c, ubo, ssbo](gi::PassContext& pc) {
+          const std::array<int32_t, 2> range = {0, c.total()};  // VPL, tile
+          vkCmdPushConstants(pc.cmd(), envSplat_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof range,
+                             range.data());
+          gi::vk::DescriptorWriter w;
+          w.buffer(1, ubo, uniforms_.handle())
+              .buffer(2, ubo, pc.buffer(io->envVpls))
+              .buffer(3, ssbo, pc.buffer(io->points))
+              .storageImage(4, pc.view(io->atlas, gi::Subresource::mipLevel(0)));
+          pc.dispatch(envSplat_, w, {uint32_t(c.perIsm), uint32_t(c.env)}, 256, 1);
+        });
+  }
+
+  // The VPLs a classic-map pass pair draws: [first, first + count) of the point VPL table (one
+  // bounce), or of the environment VPLs' (orthographic views), into tiles from firstTile.
+  struct ClassicRange {
+    std::string suffix;  // of the pass names
+    int first = 0, count = 0, firstTile = 0;
+    bool environment = false;
+  };
+  ClassicRange bounceRange(int bounce) const {
+    const Config& c = cfg_;
+    return {bounce == 0 ? "" : std::to_string(bounce + 1), bounce * c.vpls, c.vpls, bounce * c.vpls,
+            false};
+  }
+
+  // Classic mode: the views of range r's VPLs (paraboloids, or orthographic for the environment
+  // VPLs), written on the GPU from this frame's VPL table (no read-back: the maps are current,
+  // not one frame late), then their maps drawn from the triangles into their tiles (the range
+  // at tile 0 creates and clears the atlas).
   template <class IoPtr>
   void addClassicMaps(gi::FrameGraph& graph, gi::EffectContext& ctx, const IoPtr& io,
-                      const gi::TextureDesc& atlas, int bounce) {
-    const Config c = cfg_;
-    const std::string n = bounce == 0 ? "" : std::to_string(bounce + 1);
+                      const gi::TextureDesc& atlas, const ClassicRange& r) {
+    const std::string prefix = r.environment ? "ism_env" : "ism";
+    const std::string views = prefix + "_classic_views" + r.suffix;
     graph.addPass(
-        "ism_classic_views" + n,
+        views,
         [&](gi::PassBuilder& b) {
-          io->vpls = b.read(io->vpls, gi::BufferUsage::Uniform);
+          if (r.environment)
+            io->envVpls = b.read(io->envVpls, gi::BufferUsage::Uniform);
+          else
+            io->vpls = b.read(io->vpls, gi::BufferUsage::Uniform);
           io->classicViews =
-              b.write(b.create("ism_classic_views" + n,
-                               gi::BufferDesc{gi::kDrawViewStride * VkDeviceSize(c.vpls)}),
+              b.write(b.create(views, gi::BufferDesc{gi::kDrawViewStride * VkDeviceSize(r.count)}),
                       gi::BufferUsage::StorageWrite);
         },
-        [this, io, c, bounce](gi::PassContext& pc) {
-          const std::array<int32_t, 2> range = {bounce * c.vpls, c.vpls};
-          vkCmdPushConstants(pc.cmd(), classicViews_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof range,
+        [this, io, r](gi::PassContext& pc) {
+          const gi::vk::Pipeline& p = r.environment ? envClassicViews_ : classicViews_;
+          const std::array<int32_t, 3> range = {r.first, r.count, r.firstTile};
+          vkCmdPushConstants(pc.cmd(), p.layout(), VK_SHADER_STAGE_ALL, 0, sizeof range,
                              range.data());
           gi::vk::DescriptorWriter w;
           w.buffer(1, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms_.handle())
-              .buffer(2, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, pc.buffer(io->vpls))
+              .buffer(2, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
+                      pc.buffer(r.environment ? io->envVpls : io->vpls))
               .buffer(3, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, pc.buffer(io->classicViews));
-          pc.dispatch(classicViews_, w, {uint32_t(c.vpls), 1}, 64, 1);
+          pc.dispatch(p, w, {uint32_t(r.count), 1}, 64, 1);
         });
     graph.addPass(
-        "ism_classic_sm" + n,
+        prefix + "_classic_sm" + r.suffix,
         [&](gi::PassBuilder& b) {
           ctx.scene().declareRead(b);
           io->classicViews = b.read(io->classicViews, gi::BufferUsage::Uniform);
-          if (bounce == 0) {
+          if (r.firstTile == 0) {
             io->atlas =
                 b.write(b.create("ism_classic_atlas", atlas), gi::TextureUsage::DepthAttachment);
-          } else {  // keeps the earlier bounces' tiles
+          } else {  // keeps the earlier tiles
             io->atlas = b.read(io->atlas, gi::TextureUsage::DepthAttachment);
             io->atlas = b.write(io->atlas, gi::TextureUsage::DepthAttachment);
           }
         },
-        [this, io, c, bounce, cx = &ctx](gi::PassContext& pc) {
-          drawClassic(pc, *cx, *io, c, bounce);
-        });
+        [this, io, r, cx = &ctx](gi::PassContext& pc) { drawClassic(pc, *cx, *io, r); });
   }
 
   // Bounce `bounce` + 1's VPLs: bounce `bounce`'s VPLs' imperfect reflective shadow maps
@@ -693,6 +839,15 @@ class IsmEffect : public gi::Effect {
     u.gather = glm::vec4(dMin * dMin, k, k * k, float(s.number("strength")));
     u.blur = glm::vec4(float(s.number("blur_tolerance")), 0.9f, float(s.number("splat_scale")),
                        float(c.total()));
+    glm::vec3 lo, hi;
+    ctx.scene().bounds(lo, hi);
+    const glm::vec3 centre = 0.5f * (lo + hi);
+    const float radius = 0.5f * extent;
+    const bool finite =
+        std::isfinite(centre.x) && std::isfinite(centre.y) && std::isfinite(centre.z);
+    u.envSphere = glm::vec4(finite ? centre : glm::vec3(0.0f), radius);
+    u.envVpls =
+        glm::vec4(c.env, c.envPadded, c.total(), float(s.number("environment_normal_offset")));
     uniforms_.write(&u, sizeof u);
     uploaded_ = u;
   }
@@ -740,27 +895,28 @@ class IsmEffect : public gi::Effect {
     }
   }
 
-  // Classic reference: bounce `bounce`'s VPLs (their views written by ism_classic_views) as
-  // paraboloid depth maps drawn from the triangles, one atlas tile each.
+  // Classic reference: range r's VPLs (their views written by ism_classic_views) as depth maps
+  // drawn from the triangles, one atlas tile each.
   template <class IoT>
-  void drawClassic(gi::PassContext& pc, gi::EffectContext& ctx, const IoT& io, const Config& c,
-                   int bounce) {
+  void drawClassic(gi::PassContext& pc, gi::EffectContext& ctx, const IoT& io,
+                   const ClassicRange& r) {
+    const Config& c = cfg_;
     std::vector<VkRect2D> tiles;
-    for (int i = bounce * c.vpls; i < (bounce + 1) * c.vpls; ++i)
+    for (int i = r.firstTile; i < r.firstTile + r.count; ++i)
       tiles.push_back({{int32_t((i % c.perRow) * c.res), int32_t((i / c.perRow) * c.res)},
                        {uint32_t(c.res), uint32_t(c.res)}});
     gi::SceneTargets t;
     t.depth = pc.view(io.atlas);
     t.extent = pc.extent(io.atlas);
-    t.clear = bounce == 0;
+    t.clear = r.firstTile == 0;
     ctx.scene().drawDepthFromBuffer(pc, t, pc.buffer(io.classicViews), tiles);
   }
 
   Config cfg_;
   gi::vk::Pipeline vpl_, splat_, pullPush_, upsample_, irsm_, bounce_, gather_, blurX_, blurY_,
-      atlasView_, classicViews_;
+      atlasView_, classicViews_, envVpl_, envSplat_, envClassicViews_;
   VkSampler nearest_ = VK_NULL_HANDLE;
-  gi::vk::Buffer uniforms_, vplBuffer_;
+  gi::vk::Buffer uniforms_, vplBuffer_, envBuffer_;
   gi::ism::Uniforms uploaded_{};
 };
 

@@ -14,6 +14,8 @@ layout(set = 0, binding = 1, std140) uniform IsmParams {
   vec4 pull;    // pull threshold, push threshold, levels, scene extent
   vec4 gather;  // d_min^2, block k, k^2, strength
   vec4 blur;    // plane tolerance, min normal cosine, splat scale, VPLs of all bounces
+  vec4 envSphere;  // environment VPLs' orthographic maps: scene centre, bounding radius R
+  vec4 envVpls;    // environment VPLs: count, padded count, first tile, normal offset (texels)
 } ism;
 
 // One VPL: position (w 1: valid), normal, flux (rgb, W).
@@ -43,6 +45,19 @@ ivec2 ismTexel(uint tile, vec3 dir, vec3 s, vec3 u, float c) {
   ivec2 t = clamp(ivec2((p * 0.5 + 0.5) * float(res)), ivec2(0), ivec2(res - 1));
   return ismTileOrigin(tile) + t;
 }
+
+// Environment VPL (direction d to the sky): its orthographic map looks along -d at the scene's
+// bounding sphere (centre c, radius R), basis s, u = ismBasis(-d) (the view's x and y, as a
+// paraboloid's around its axis). Texel of position p in tile `tile`, and p's depth
+// R - (p - c).d: 0 on the sphere's sky side, 2R on the far side.
+ivec2 ismOrthoTexel(uint tile, vec3 p, vec3 s, vec3 u) {
+  vec3 q = p - ism.envSphere.xyz;
+  vec2 disk = vec2(dot(q, s), dot(q, u)) / max(ism.envSphere.w, 1e-30);
+  int res = int(ism.atlas.x);
+  ivec2 t = clamp(ivec2((disk * 0.5 + 0.5) * float(res)), ivec2(0), ivec2(res - 1));
+  return ismTileOrigin(tile) + t;
+}
+float ismOrthoDepth(vec3 p, vec3 d) { return ism.envSphere.w - dot(p - ism.envSphere.xyz, d); }
 
 uint ismHash(uint x) {
   x ^= x >> 16;

@@ -9,6 +9,9 @@
 // SCALE > 1: gathered at 1 / SCALE resolution, output pixel p for G-buffer pixel p x SCALE
 // (ism_upsample.comp brings it back to full resolution).
 // GLOSSY: x, y are RGB9E5 irradiance and its Phong-weighted sum (ism_glossy.glsl).
+// ENV_PER_PIXEL > 0: environment VPLs (ism_env_vpl.comp) too, interleaved the same way (pixel
+// phase gathers env VPLs phase + j K^2), E_i max(n.d_i, 0) x visibility from their
+// orthographic maps; `strength` scales the VPLs' indirect light, not the environment's.
 #include "common.glsl"
 #include "ism_common.glsl"
 #include "ism_glossy.glsl"
@@ -18,6 +21,7 @@ layout(constant_id = 1) const int K = 4;
 layout(constant_id = 2) const int SCALE = 1;
 layout(constant_id = 3) const bool GLOSSY = false;
 layout(constant_id = 4) const float PHONG_EXPONENT = 0.0;  // 0: from the roughness
+layout(constant_id = 5) const int ENV_PER_PIXEL = 0;       // ceil(N_env / K^2)
 layout(local_size_x = 32, local_size_y = 16) in;
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 layout(set = 0, binding = 2, std140) uniform Vpls { Vpl vpls[ISM_VPL_SLOTS]; };
@@ -26,6 +30,7 @@ layout(set = 0, binding = 4) uniform sampler2D gNormal;
 #include "ism_lookup.glsl"
 layout(set = 0, binding = 6, rgba32ui) uniform writeonly uimage2D outRaw;
 layout(set = 0, binding = 7) uniform sampler2D gMaterial;  // GLOSSY: roughness
+layout(set = 0, binding = 8, std140) uniform EnvVpls { Vpl envVpls[ISM_VPL_SLOTS]; };
 
 // The receiver's BRDF (diffuse, + Phong when GLOSSY): adds VPL v's irradiance at x to e and,
 // when glossy, its Phong-weighted share to spec (view: unit direction to the camera).
@@ -66,8 +71,17 @@ void main() {
     uint i = phase + uint(j * K * K);
     reflectVpl(vpls[i], min(i, uint(ism.blur.w) - 1u), x, n, view, exponent, e, spec);
   }
-  e = min(e * (ism.gather.z * ism.gather.w), vec3(65000.0));  // guard: half floats
-  spec = min(spec * (ism.gather.z * ism.gather.w), vec3(65000.0));
+  vec3 envE = vec3(0.0), envSpec = vec3(0.0);
+  for (int j = 0; j < ENV_PER_PIXEL; ++j) {
+    uint i = phase + uint(j * K * K);
+    Vpl v = envVpls[i];
+    vec3 ei = envVplIrradiance(v, uint(ism.envVpls.z) + i, x, n);
+    envE += ei;
+    if (GLOSSY) envSpec += ei * ismPhongLobe(-v.position.xyz, n, view, exponent);
+  }
+  // guard: half floats
+  e = min(e * (ism.gather.z * ism.gather.w) + envE * ism.gather.z, vec3(65000.0));
+  spec = min(spec * (ism.gather.z * ism.gather.w) + envSpec * ism.gather.z, vec3(65000.0));
   uvec2 value = GLOSSY ? uvec2(ismPackRgb9e5(e), ismPackRgb9e5(spec))
                        : uvec2(packHalf2x16(e.rg), packHalf2x16(vec2(e.b, 0.0)));
   imageStore(outRaw, p, uvec4(value, floatBitsToUint(length(viewPos)), packNormal(viewN)));

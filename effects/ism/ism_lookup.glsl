@@ -37,4 +37,25 @@ vec3 vplIrradiance(Vpl v, uint tile, vec3 x, vec3 n) {
   return v.flux.rgb * (visible * cv * cr / (3.14159265 * max(d2, ism.gather.x)));
 }
 
+// Irradiance at x (normal n) from environment VPL v (direction d to the sky, irradiance E at
+// normal incidence) whose orthographic map is tile `tile`: E max(n.d, 0) x visibility. The
+// receiver is looked up from x + n x ism.envVpls.w texels (normal offset: an orthographic
+// texel holds one depth for a surface whose depth changes by texel x tan(theta) across it, so
+// a depth bias alone either shadows the floor itself at low elevations or leaks under
+// occluders), with the constant bias.
+vec3 envVplIrradiance(Vpl v, uint tile, vec3 x, vec3 n) {
+  vec3 d = v.position.xyz, s, u;
+  ismBasis(-d, s, u);
+  float texel = 2.0 * ism.envSphere.w / ism.atlas.x;
+  vec3 xo = x + n * (ism.envVpls.w * texel);
+  ivec2 t = ismOrthoTexel(tile, xo, s, u);
+#ifdef ISM_CLASSIC
+  float stored = storedDistance(t) - ism.bias.z;  // the classic view's eye is near beyond R
+#else
+  float stored = storedDistance(t);
+#endif
+  float visible = ismOrthoDepth(xo, d) - ism.bias.x <= stored ? 1.0 : 0.0;
+  return v.flux.rgb * (visible * max(dot(n, d), 0.0));
+}
+
 #endif

@@ -25,6 +25,9 @@ inline constexpr uint32_t kIrsmPoints = 4096;
 inline uint32_t irsmEntries(int pointsPerIsm) {
   return std::min(uint32_t(pointsPerIsm), kIrsmPoints);
 }
+// Environment VPLs (seed 002 §5, "Environment Maps"): at most this many directional VPLs
+// sampled from the environment map, each with an orthographic ISM (their own uniform table).
+inline constexpr int kMaxEnvVpls = 1024;
 inline constexpr int kMaxSplatRadius = 2;
 inline constexpr uint32_t kMaxPoints = 1u << 21;  // surface points asked of the engine
 inline constexpr uint32_t kEmpty = 0xffffffffu;   // an ISM texel no point reached
@@ -38,14 +41,16 @@ inline constexpr float kMaxPhongExponent = 128.0f;
 
 // std140 mirror of IsmParams (ism_common.glsl); vec4 members only.
 struct Uniforms {
-  glm::vec4 rsm;     // width, height, vpl count, padded count (whole k x k blocks)
-  glm::vec4 atlas;   // tile resolution, tiles per row, points per ISM, surface point count
-  glm::vec4 bias;    // constant (world), slope (per unit distance), near, far (classic SMs)
-  glm::vec4 pull;    // pull threshold, push threshold (world, level 0), levels, scene extent
-  glm::vec4 gather;  // d_min^2, block k, k^2 (VPL subset weight), strength
-  glm::vec4 blur;    // plane tolerance (relative depth), min normal cosine, splat scale, seed
+  glm::vec4 rsm;        // width, height, vpl count, padded count (whole k x k blocks)
+  glm::vec4 atlas;      // tile resolution, tiles per row, points per ISM, surface point count
+  glm::vec4 bias;       // constant (world), slope (per unit distance), near, far (classic SMs)
+  glm::vec4 pull;       // pull threshold, push threshold (world, level 0), levels, scene extent
+  glm::vec4 gather;     // d_min^2, block k, k^2 (VPL subset weight), strength
+  glm::vec4 blur;       // plane tolerance (relative depth), min normal cosine, splat scale, seed
+  glm::vec4 envSphere;  // environment VPLs' orthographic maps: scene centre, bounding radius R
+  glm::vec4 envVpls;    // environment VPLs: count, padded count, first tile, normal offset (texels)
 };
-static_assert(sizeof(Uniforms) == 6 * sizeof(glm::vec4));
+static_assert(sizeof(Uniforms) == 8 * sizeof(glm::vec4));
 
 // The paraboloid basis of a VPL with normal n, the same as SceneView::paraboloid's view matrix
 // (lookAlong: up +y, or +z when n is nearly vertical), so ISMs and classic maps share texels.
@@ -77,6 +82,17 @@ inline glm::vec3 vplIrradiance(const glm::vec3& x, const glm::vec3& n, const glm
   const glm::vec3 dir = w / std::sqrt(d2);
   const float cv = std::max(glm::dot(nv, dir), 0.0f), cr = std::max(-glm::dot(n, dir), 0.0f);
   return phi * (cv * cr / (3.14159265f * std::max(d2, dMin * dMin)));
+}
+
+// The sample point of environment VPL slot i of n (ism_env_vpl.comp; `phases` = k^2, the
+// interleaving's phases, slot i = phase + j k^2): ((i + 0.5) / n, radical inverse of j +
+// (phase + 0.5) / k^2 mod 1). Each phase's slots form a stratified set, and so do all slots.
+inline glm::vec2 envSamplePoint(uint32_t i, uint32_t n, uint32_t phases) {
+  uint32_t j = i / phases, bits = 0;
+  for (int b = 0; b < 32; ++b) bits |= ((j >> b) & 1u) << (31 - b);
+  const float second =
+      float(bits) * 2.3283064365386963e-10f + (float(i % phases) + 0.5f) / float(phases);
+  return {(float(i) + 0.5f) / float(n), second - std::floor(second)};
 }
 
 // Energy-normalised Phong lobe (n + 2) / (2 pi) cos^n(alpha) for light travelling along w
