@@ -252,7 +252,7 @@ class IsmEffect : public gi::Effect {
       if (c.levels > 0)
         pullPush_ = gi::vk::Pipeline::compute(
             vk, spv(std::begin(ism_pull_push_comp), std::end(ism_pull_push_comp)),
-            {{1, ubo}, {2, img}}, 2 * sizeof(int32_t), {uint32_t(c.levels)});
+            {{1, ubo}, {2, img}}, 3 * sizeof(int32_t), {uint32_t(c.levels)});
     }
     if (c.env > 0)
       envVpl_ = gi::vk::Pipeline::compute(
@@ -608,8 +608,11 @@ class IsmEffect : public gi::Effect {
           io->atlas = b.read(io->atlas, gi::TextureUsage::StorageRead);
           io->atlas = b.write(io->atlas, gi::TextureUsage::StorageWrite);
         },
-        [this, io, first, end](gi::PassContext& pc) {
-          const std::array<int32_t, 2> tiles = {first, end};
+        [this, io, c, first, end](gi::PassContext& pc) {
+          // Only the 64-texel block rows that hold the range's tile rows.
+          const int rowBegin = first / c.perRow * c.res / 64;
+          const int rowEnd = ((end - 1) / c.perRow + 1) * c.res;  // texel row past the range
+          const std::array<int32_t, 3> tiles = {first, end, rowBegin};
           vkCmdPushConstants(pc.cmd(), pullPush_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof tiles,
                              tiles.data());
           gi::vk::DescriptorWriter w;
@@ -617,7 +620,7 @@ class IsmEffect : public gi::Effect {
               .storageImage(2, pc.view(io->atlas));
           pc.descriptors().bind(pc.cmd(), pullPush_, w);
           const VkExtent2D e = pc.extent(io->atlas);
-          vkCmdDispatch(pc.cmd(), (e.width + 63) / 64, (e.height + 63) / 64, 1);
+          vkCmdDispatch(pc.cmd(), (e.width + 63) / 64, uint32_t((rowEnd + 63) / 64 - rowBegin), 1);
         });
   }
 

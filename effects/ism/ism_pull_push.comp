@@ -13,7 +13,9 @@
 
 layout(constant_id = 0) const int LEVELS = 1;  // 1..6
 layout(local_size_x = 16, local_size_y = 16) in;
-layout(push_constant) uniform Push { int tileBegin, tileEnd; };  // tiles of one bounce
+// Tiles [tileBegin, tileEnd) (one bounce's, or the environment VPLs'); the dispatch covers only
+// the 64-texel block rows from firstBlockRow that hold them (an idle workgroup still costs).
+layout(push_constant) uniform Push { int tileBegin, tileEnd, firstBlockRow; };
 layout(set = 0, binding = 2, r32ui) uniform uimage2D atlas;
 
 // Levels 2..6 of the 64 x 64 block: 16^2 + 8^2 + 4^2 + 2^2 + 1 texels.
@@ -46,7 +48,7 @@ void main() {
   ivec2 size = imageSize(atlas);
   int shift = findLSB(int(ism.atlas.x));
   ivec2 lid = ivec2(gl_LocalInvocationID.xy);
-  ivec2 origin = ivec2(gl_WorkGroupID.xy) * 64 + lid * 4;
+  ivec2 origin = (ivec2(gl_WorkGroupID.xy) + ivec2(0, firstBlockRow)) * 64 + lid * 4;
   uint t0[16];
   for (int i = 0; i < 16; ++i) {
     ivec2 q = origin + ivec2(i % 4, i / 4);
