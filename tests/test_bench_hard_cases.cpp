@@ -71,6 +71,17 @@ TEST_F(HardCasesTest, StaticCameraDoesNotFlickerOver64Frames) {
   sweep(o);
 }
 
+// The ISM's environment VPLs (off by default) on every hard case, glossy receivers included
+// (a sky-only view, grazing planes, albedo 1, a closed box the environment cannot reach, ...),
+// 8 static frames each.
+TEST_F(HardCasesTest, IsmEnvironmentVplsStayFiniteAndInRangeOnEveryHardCase) {
+  bench::HardCaseOptions o;
+  o.effects = {"ism"};
+  o.sets = {"ism.environment_vpls=64", "ism.glossy=true"};
+  o.flickerFrames = 8;
+  sweep(o);
+}
+
 // Every effect joins: the sweep covers the registry, not a list.
 TEST_F(HardCasesTest, SweepCoversEveryRegisteredEffect) {
   bench::HardCaseOptions o;

@@ -353,6 +353,9 @@ std::vector<HardCaseRun> runHardCases(vk::Context& ctx, const EffectRegistry& re
       HardCaseRun run{hc.name, effect};
       EffectOverrides ov;
       ov.effects = effect == "none" ? std::vector<std::string>{} : std::vector{effect};
+      // Only the settings of the effect that runs (resolveEffects rejects the others').
+      for (const std::string& set : options.sets)
+        if (set.rfind(effect + ".", 0) == 0) ov.sets.push_back(set);
       RenderSettings rs;
       rs.width = options.width;
       rs.height = options.height;

@@ -36,6 +36,9 @@ struct HardCaseOptions {
   int flickerFrames = 64;
   std::vector<std::string> effects;  // empty: every registered effect and "none"
   std::vector<std::string> cases;    // empty: every case
+  // Settings for the effects, "effect.key=value" (as gi-render --set): e.g. the ISM's
+  // environment VPLs, which its defaults leave off.
+  std::vector<std::string> sets;
 };
 
 // Largest change allowed between two frames of a static camera, relative to max(1, |value|):

@@ -53,6 +53,7 @@ const char* kUsage =
     "                [--grid EFFECT.KEY=V1,V2,...]... [options]\n"
     "       gi-bench --quick --out DIR                  (CI smoke sweep, a few seconds)\n"
     "       gi-bench --hard-cases --out DIR [--effects A,B] [--cases C,D] [--frames K]\n"
+    "                [--set EFFECT.KEY=V]...\n"
     "                (every effect x hard scenes: no NaN/Inf in any texture, ranges, flicker)\n"
     "       gi-bench --calibrate --budget-ms B --width W --height H [--scene S]\n"
     "                [--effects E] --out PRESET.json\n"
@@ -104,6 +105,7 @@ const char* kUsage =
     "                        sees noise and interleave patterns that a biased estimator's\n"
     "                        NRMSE hides (SSAO's NRMSE is ~flat from 1 to 64 samples)\n"
     "  --cases A,B           --hard-cases: only these cases (default: all)\n"
+    "  --set E.K=V           --hard-cases: a setting of effect E for its runs (repeatable)\n"
     "  --no-progress         no progress lines on stderr\n"
     "  --validation          Vulkan validation layers (also GI_VALIDATION=1)\n"
     "  --device NAME         Vulkan device by name or index (also GI_DEVICE)\n"
@@ -124,6 +126,7 @@ struct Options {
   int frames = 5, reps = 5;
   bool hardCases = false;
   std::vector<std::string> cases;  // --hard-cases: a subset
+  std::vector<std::string> sets;   // --hard-cases: effect settings
   bool quick = false, calibrate = false, progress = true, validation = false, aoSplit = false;
   std::optional<ref::Quantity> target;  // --target: one light quantity for every configuration
   bool excludeEmitters = false;         // --exclude-emitters
@@ -187,6 +190,8 @@ Options parseArgs(int argc, char** argv) {
       o.hardCases = true;
     else if (a.is("--cases"))
       o.cases = a.list();
+    else if (a.is("--set"))
+      o.sets.push_back(a.value());
     else if (a.is("--target")) {
       const std::string q = a.value();
       if (q != "direct" && q != "direct+indirect")
@@ -228,6 +233,8 @@ Options parseArgs(int argc, char** argv) {
       usageError(o.out, "--calibrate writes a preset: --out must end in .json");
   }
   if (!o.hardCases && !o.cases.empty()) usageError("--cases", "only applies to --hard-cases");
+  if (!o.hardCases && !o.sets.empty())
+    usageError("--set", "only applies to --hard-cases (sweeps use --grid)");
   if (o.target && (o.aoSplit || o.calibrate || o.hardCases))
     usageError("--target", "excludes --ao-split, --calibrate and --hard-cases");
   if (o.hardCases) {
@@ -1336,6 +1343,7 @@ int runHardCaseSweep(const Options& o) {
   hc.height = o.height;
   hc.flickerFrames = o.frames;
   hc.cases = o.cases;
+  hc.sets = o.sets;
   if (o.effects)
     for (const std::string& item : *o.effects) hc.effects.push_back(item);
   gi::vk::Context ctx = makeContext(o);
