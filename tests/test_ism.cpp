@@ -7,7 +7,8 @@
 // lobe's normalisation and bounds (CPU), a highlight at the VPL's mirror direction (GPU).
 // Classic mode's maps are this frame's (its first frame already has the shadow). Environment
 // VPLs: an open floor gets the environment's light through them alone (the engine's term is
-// replaced, not doubled), a box shadows the floor beside it, a black environment adds nothing.
+// replaced, not doubled), a box shadows the floor beside it and the shadow follows the box when
+// it moves, a black environment adds nothing.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -264,12 +265,15 @@ class IsmTest : public test::EffectTest {
     return either > 0 ? double(both) / either : 1.0;
   }
   // A floor (albedo 0.8) under a white constant environment, its only light (the light is
-  // off: a scene without one gets a default sun); `box`: a unit box on it at the origin.
-  Scene environmentScene(const std::string& name, bool box, float intensity = 1.0f) {
+  // off: a scene without one gets a default sun); `box`: a unit box on it at the origin
+  // (`boxAnimation`: an "animation" entry for it).
+  Scene environmentScene(const std::string& name, bool box, float intensity = 1.0f,
+                         const std::string& boxAnimation = "") {
     return jsonScene(name, R"({ "models": [
         { "primitive": "plane", "size": 10, "material": { "base_color": [0.8, 0.8, 0.8] } })" +
                                std::string(box ? R"(,
-        { "primitive": "box", "size": [1, 1, 1], "translation": [0, 0.5, 0],
+        { "primitive": "box", "size": [1, 1, 1], "translation": [0, 0.5, 0], )" +
+                                                     boxAnimation + R"(
           "material": { "base_color": [0.8, 0.8, 0.8] } })"
                                                : "") +
                                R"( ],
@@ -871,6 +875,28 @@ TEST_F(IsmTest, EnvironmentVplsShadowTheFloorBesideABox) {
     }
     expectFinite(env.indirect);
   }
+}
+
+// The environment's shadow follows an animated box (the orthographic ISMs are splatted from
+// the surface points, which follow the deformed geometry): a looping clip slides it from
+// x = -2 (t = 0) to x = 1 (t = 1.5); the floor beside its start is darker at t = 0 than at
+// t = 1.5, and the floor beside its end the other way round (measured 0.42 vs 0.80, 0.40 vs
+// 0.79).
+TEST_F(IsmTest, EnvironmentVplShadowFollowsAnAnimatedBox) {
+  const Scene s = environmentScene("env_moving", true, 1.0f,
+                                   R"("animation": { "translation": { "times": [0, 2],
+                                        "values": [[-2, 0.5, 0], [2, 0.5, 0]] } },)");
+  const Result start = render(s, {"ism.environment_vpls=256"}, 2, true, 0.0);
+  const Result end = render(s, {"ism.environment_vpls=256"}, 2, true, 1.5);
+  const glm::ivec2 left = start.pixelOf({-2.6f, 0.0f, 0.2f});
+  const glm::ivec2 right = start.pixelOf({1.6f, 0.0f, 0.2f});
+  const auto at = [](const Result& r, glm::ivec2 p) { return luminance(r.px(r.lit, p.x, p.y)); };
+  std::printf("beside the start: %.3f (t 0) vs %.3f (t 1.5); beside the end: %.3f vs %.3f\n",
+              at(start, left), at(end, left), at(start, right), at(end, right));
+  EXPECT_LT(at(start, left), 0.9f * at(end, left));
+  EXPECT_LT(at(end, right), 0.9f * at(start, right));
+  expectFinite(start.indirect);
+  expectFinite(end.indirect);
 }
 
 // A black environment gives environment VPLs nothing to carry (the sampler's black-map tables:
