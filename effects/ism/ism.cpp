@@ -342,7 +342,7 @@ class IsmEffect : public gi::Effect {
     struct Io {
       gi::TextureHandle rsmDepth, rsmPos, rsmNormal, rsmFlux, atlas, depth, normal, albedo,
           material, raw, half, low, indirect, atlasView;
-      gi::BufferHandle cdf, vpls, points, irsm, irsmCells, classicViews, envVpls, envSampling;
+      gi::BufferHandle cdf, vpls, points, envVpls, envSampling;
       gi::TextureHandle envMap, ambient;
     };
     auto io = std::make_shared<Io>();
@@ -718,6 +718,9 @@ class IsmEffect : public gi::Effect {
                       const gi::TextureDesc& atlas, const ClassicRange& r) {
     const std::string prefix = r.environment ? "ism_env" : "ism";
     const std::string views = prefix + "_classic_views" + r.suffix;
+    // This pair's own views buffer (a shared member of io would name the last pair's by the
+    // time the passes run: every pass is set up first).
+    auto mine = std::make_shared<gi::BufferHandle>();
     graph.addPass(
         views,
         [&](gi::PassBuilder& b) {
@@ -725,11 +728,11 @@ class IsmEffect : public gi::Effect {
             io->envVpls = b.read(io->envVpls, gi::BufferUsage::Uniform);
           else
             io->vpls = b.read(io->vpls, gi::BufferUsage::Uniform);
-          io->classicViews =
+          *mine =
               b.write(b.create(views, gi::BufferDesc{gi::kDrawViewStride * VkDeviceSize(r.count)}),
                       gi::BufferUsage::StorageWrite);
         },
-        [this, io, r](gi::PassContext& pc) {
+        [this, io, r, mine](gi::PassContext& pc) {
           const gi::vk::Pipeline& p = r.environment ? envClassicViews_ : classicViews_;
           const std::array<int32_t, 3> range = {r.first, r.count, r.firstTile};
           vkCmdPushConstants(pc.cmd(), p.layout(), VK_SHADER_STAGE_ALL, 0, sizeof range,
@@ -738,14 +741,14 @@ class IsmEffect : public gi::Effect {
           w.buffer(1, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms_.handle())
               .buffer(2, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
                       pc.buffer(r.environment ? io->envVpls : io->vpls))
-              .buffer(3, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, pc.buffer(io->classicViews));
+              .buffer(3, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, pc.buffer(*mine));
           pc.dispatch(p, w, {uint32_t(r.count), 1}, 64, 1);
         });
     graph.addPass(
         prefix + "_classic_sm" + r.suffix,
         [&](gi::PassBuilder& b) {
           ctx.scene().declareRead(b);
-          io->classicViews = b.read(io->classicViews, gi::BufferUsage::Uniform);
+          *mine = b.read(*mine, gi::BufferUsage::Uniform);
           if (r.firstTile == 0) {
             io->atlas =
                 b.write(b.create("ism_classic_atlas", atlas), gi::TextureUsage::DepthAttachment);
@@ -754,7 +757,9 @@ class IsmEffect : public gi::Effect {
             io->atlas = b.write(io->atlas, gi::TextureUsage::DepthAttachment);
           }
         },
-        [this, io, r, cx = &ctx](gi::PassContext& pc) { drawClassic(pc, *cx, *io, r); });
+        [this, io, r, mine, cx = &ctx](gi::PassContext& pc) {
+          drawClassic(pc, *cx, *io, *mine, r);
+        });
   }
 
   // Bounce `bounce` + 1's VPLs: bounce `bounce`'s VPLs' imperfect reflective shadow maps
@@ -765,21 +770,28 @@ class IsmEffect : public gi::Effect {
     const std::string n = std::to_string(bounce + 1);
     const uint32_t entries = gi::ism::irsmEntries(c.perIsm), cellsPerVpl = (entries + 255) / 256;
     const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    // This bounce's own IRSM buffers (a member of io would name the last bounce's by the time
+    // the passes run: every pass is set up first).
+    struct Irsm {
+      gi::BufferHandle irsm, cells;
+    };
+    auto own = std::make_shared<Irsm>();
     graph.addPass(
         "ism_irsm" + n,
         [&](gi::PassBuilder& b) {
           io->points = b.read(io->points, gi::BufferUsage::StorageRead);
           io->atlas = b.read(io->atlas, gi::TextureUsage::Sampled, gi::Subresource::mipLevel(0));
           io->vpls = b.read(io->vpls, gi::BufferUsage::Uniform);
-          io->irsm = b.write(b.create("ism_irsm" + n, gi::BufferDesc{VkDeviceSize(c.vpls) *
-                                                                     entries * sizeof(glm::vec4)}),
-                             gi::BufferUsage::StorageWrite);
-          io->irsmCells =
+          own->irsm = b.write(b.create("ism_irsm" + n, gi::BufferDesc{VkDeviceSize(c.vpls) *
+                                                                      entries * sizeof(glm::vec4)}),
+                              gi::BufferUsage::StorageWrite);
+          own->cells =
               b.write(b.create("ism_irsm_cells" + n,
                                gi::BufferDesc{VkDeviceSize(c.vpls) * cellsPerVpl * sizeof(float)}),
                       gi::BufferUsage::StorageWrite);
         },
-        [this, io, c, bounce, entries, materials = ctx.scene().materials()](gi::PassContext& pc) {
+        [this, io, own, c, bounce, entries,
+         materials = ctx.scene().materials()](gi::PassContext& pc) {
           if (c.classic) {  // no splat pass sets the point count
             uploadPointCount(pc, io->points);
           }
@@ -791,29 +803,29 @@ class IsmEffect : public gi::Effect {
               .buffer(3, ssbo, pc.buffer(io->points))
               .buffer(4, ssbo, materials)
               .sampled(5, pc.view(io->atlas, gi::Subresource::mipLevel(0)), nearest_)
-              .buffer(6, ssbo, pc.buffer(io->irsm))
-              .buffer(7, ssbo, pc.buffer(io->irsmCells));
+              .buffer(6, ssbo, pc.buffer(own->irsm))
+              .buffer(7, ssbo, pc.buffer(own->cells));
           pc.dispatch(irsm_, w, {entries, uint32_t(c.vpls)}, 256, 1);
         });
     graph.addPass(
         "ism_bounce" + n,
         [&](gi::PassBuilder& b) {
           io->points = b.read(io->points, gi::BufferUsage::StorageRead);
-          io->irsm = b.read(io->irsm, gi::BufferUsage::StorageRead);
-          io->irsmCells = b.read(io->irsmCells, gi::BufferUsage::StorageRead);
-          io->irsmCells = b.write(io->irsmCells, gi::BufferUsage::StorageWrite);
+          own->irsm = b.read(own->irsm, gi::BufferUsage::StorageRead);
+          own->cells = b.read(own->cells, gi::BufferUsage::StorageRead);
+          own->cells = b.write(own->cells, gi::BufferUsage::StorageWrite);
           // Adds this bounce's slots; the earlier bounces' stay.
           io->vpls = b.read(io->vpls, gi::BufferUsage::StorageRead);
           io->vpls = b.write(io->vpls, gi::BufferUsage::StorageWrite);
         },
-        [this, io, bounce](gi::PassContext& pc) {
+        [this, io, own, bounce](gi::PassContext& pc) {
           const int32_t b = bounce;
           vkCmdPushConstants(pc.cmd(), bounce_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof b, &b);
           gi::vk::DescriptorWriter w;
           w.buffer(1, ubo, uniforms_.handle())
               .buffer(3, ssbo, pc.buffer(io->points))
-              .buffer(6, ssbo, pc.buffer(io->irsm))
-              .buffer(7, ssbo, pc.buffer(io->irsmCells))
+              .buffer(6, ssbo, pc.buffer(own->irsm))
+              .buffer(7, ssbo, pc.buffer(own->cells))
               .buffer(8, ssbo, pc.buffer(io->vpls));
           pc.dispatch(bounce_, w, {1, 1}, 1, 1);
         });
@@ -902,7 +914,7 @@ class IsmEffect : public gi::Effect {
   // drawn from the triangles, one atlas tile each.
   template <class IoT>
   void drawClassic(gi::PassContext& pc, gi::EffectContext& ctx, const IoT& io,
-                   const ClassicRange& r) {
+                   gi::BufferHandle views, const ClassicRange& r) {
     const Config& c = cfg_;
     std::vector<VkRect2D> tiles;
     for (int i = r.firstTile; i < r.firstTile + r.count; ++i)
@@ -912,7 +924,7 @@ class IsmEffect : public gi::Effect {
     t.depth = pc.view(io.atlas);
     t.extent = pc.extent(io.atlas);
     t.clear = r.firstTile == 0;
-    ctx.scene().drawDepthFromBuffer(pc, t, pc.buffer(io.classicViews), tiles);
+    ctx.scene().drawDepthFromBuffer(pc, t, pc.buffer(views), tiles);
   }
 
   Config cfg_;
