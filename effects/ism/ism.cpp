@@ -321,19 +321,14 @@ class IsmEffect : public gi::Effect {
     if (!uniforms_)
       uniforms_ =
           gi::vk::Buffer(vk, sizeof(gi::ism::Uniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true);
-    // Host-visible: zero-filled once from the host (slots no VPL pass wrote read as no light).
-    if (!vplBuffer_) {
-      vplBuffer_ = gi::vk::Buffer(
+    // VPL tables, host-visible: zero-filled once from the host (slots no VPL pass wrote read
+    // as no light). The environment VPLs' is bound to the gathering also when there are none.
+    for (gi::vk::Buffer* table : {&vplBuffer_, &envBuffer_}) {
+      if (*table) continue;
+      *table = gi::vk::Buffer(
           vk, kVplBytes * gi::ism::kVplSlots,
           VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true);
-      std::fill_n(static_cast<char*>(vplBuffer_.mapped()), vplBuffer_.size(), 0);
-    }
-    // The environment VPLs' table: bound to the gathering also when there are none (zeros).
-    if (!envBuffer_) {
-      envBuffer_ = gi::vk::Buffer(
-          vk, kVplBytes * gi::ism::kVplSlots,
-          VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT | VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true);
-      std::fill_n(static_cast<char*>(envBuffer_.mapped()), envBuffer_.size(), 0);
+      std::fill_n(static_cast<char*>(table->mapped()), table->size(), 0);
     }
   }
 
@@ -584,16 +579,23 @@ class IsmEffect : public gi::Effect {
   // Splats bounce `bounce`'s VPLs' point subsets into their tiles (mip 0).
   template <class IoT>
   void splat(gi::PassContext& pc, const IoT& io, const Config& c, int bounce) {
+    splatTiles(pc, splat_, io.vpls, io, bounce * c.vpls, bounce * c.vpls, c.vpls);
+  }
+  // Splats `count` VPLs of table `vpls` from `first` into tiles from `firstTile` with `pipeline`
+  // (ism_splat.comp: paraboloids, or orthographic for the environment VPLs).
+  template <class IoT>
+  void splatTiles(gi::PassContext& pc, const gi::vk::Pipeline& pipeline, gi::BufferHandle vpls,
+                  const IoT& io, int first, int firstTile, int count) {
     const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    const std::array<int32_t, 2> range = {bounce * c.vpls, bounce * c.vpls};  // VPL, tile
-    vkCmdPushConstants(pc.cmd(), splat_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof range,
+    const std::array<int32_t, 2> range = {first, firstTile};
+    vkCmdPushConstants(pc.cmd(), pipeline.layout(), VK_SHADER_STAGE_ALL, 0, sizeof range,
                        range.data());
     gi::vk::DescriptorWriter w;
     w.buffer(1, ubo, uniforms_.handle())
-        .buffer(2, ubo, pc.buffer(io.vpls))
+        .buffer(2, ubo, pc.buffer(vpls))
         .buffer(3, ssbo, pc.buffer(io.points))
         .storageImage(4, pc.view(io.atlas, gi::Subresource::mipLevel(0)));
-    pc.dispatch(splat_, w, {uint32_t(c.perIsm), uint32_t(c.vpls)}, 256, 1);
+    pc.dispatch(pipeline, w, {uint32_t(cfg_.perIsm), uint32_t(count)}, 256, 1);
   }
 
   // Pull-push over tiles [first, end) (one bounce's VPLs, or the environment VPLs).
@@ -674,7 +676,6 @@ class IsmEffect : public gi::Effect {
   template <class IoPtr>
   void addEnvSplat(gi::FrameGraph& graph, const IoPtr& io) {
     const Config c = cfg_;
-    const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
     graph.addPass(
         "ism_env_splat",
         [&](gi::PassBuilder& b) {
@@ -683,16 +684,8 @@ class IsmEffect : public gi::Effect {
           io->atlas = b.read(io->atlas, gi::TextureUsage::StorageRead);
           io->atlas = b.write(io->atlas, gi::TextureUsage::StorageWrite);
         },
-        [this, io, c, ubo, ssbo](gi::PassContext& pc) {
-          const std::array<int32_t, 2> range = {0, c.total()};  // VPL, tile
-          vkCmdPushConstants(pc.cmd(), envSplat_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof range,
-                             range.data());
-          gi::vk::DescriptorWriter w;
-          w.buffer(1, ubo, uniforms_.handle())
-              .buffer(2, ubo, pc.buffer(io->envVpls))
-              .buffer(3, ssbo, pc.buffer(io->points))
-              .storageImage(4, pc.view(io->atlas, gi::Subresource::mipLevel(0)));
-          pc.dispatch(envSplat_, w, {uint32_t(c.perIsm), uint32_t(c.env)}, 256, 1);
+        [this, io, c](gi::PassContext& pc) {
+          splatTiles(pc, envSplat_, io->envVpls, *io, 0, c.total(), c.env);
         });
   }
 

@@ -58,6 +58,7 @@ ivec2 ismOrthoTexel(uint tile, vec3 p, vec3 s, vec3 u) {
   return ismTileOrigin(tile) + t;
 }
 float ismOrthoDepth(vec3 p, vec3 d) { return ism.envSphere.w - dot(p - ism.envSphere.xyz, d); }
+float ismOrthoTexelSide() { return 2.0 * ism.envSphere.w / ism.atlas.x; }  // world units
 
 uint ismHash(uint x) {
   x ^= x >> 16;

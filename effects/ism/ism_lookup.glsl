@@ -46,8 +46,7 @@ vec3 vplIrradiance(Vpl v, uint tile, vec3 x, vec3 n) {
 vec3 envVplIrradiance(Vpl v, uint tile, vec3 x, vec3 n) {
   vec3 d = v.position.xyz, s, u;
   ismBasis(-d, s, u);
-  float texel = 2.0 * ism.envSphere.w / ism.atlas.x;
-  vec3 xo = x + n * (ism.envVpls.w * texel);
+  vec3 xo = x + n * (ism.envVpls.w * ismOrthoTexelSide());
   ivec2 t = ismOrthoTexel(tile, xo, s, u);
 #ifdef ISM_CLASSIC
   float stored = storedDistance(t) - ism.bias.z;  // the classic view's eye is near beyond R

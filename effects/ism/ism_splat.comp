@@ -41,8 +41,8 @@ void main() {
     ismBasis(-d, s, u);  // the view's axis, as the classic maps' (ism_classic_views.comp)
     t = ismOrthoTexel(tile, pa.xyz, s, u);
     depth = floatBitsToUint(max(ismOrthoDepth(pa.xyz, d), 0.0));
-    float texel = 2.0 * ism.envSphere.w / res;  // a texel's side in world units
-    radius = clamp(int(0.5 * sqrt(max(pa.w, 0.0)) / max(texel, 1e-30) * ism.blur.z), 0, MAX_SPLAT);
+    float side = max(ismOrthoTexelSide(), 1e-30);
+    radius = clamp(int(0.5 * sqrt(max(pa.w, 0.0)) / side * ism.blur.z), 0, MAX_SPLAT);
   } else {
     vec3 w = pa.xyz - vpl.position.xyz;
     float d = length(w);
