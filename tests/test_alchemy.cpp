@@ -190,8 +190,9 @@ TEST_F(AlchemyTest, MonotoneInIntensityContrastAndEpsilon) {
 }
 
 TEST_F(AlchemyTest, EpsilonKeepsZeroDistanceOccludersFinite) {
-  // The crease at a millimetre scale with epsilon at its minimum (1e-8): taps at distances of
-  // 1e-5..1e-4 from the crease and taps landing on their own pixel (v = 0: 0 / epsilon).
+  // The crease at a millimetre scale with epsilon at its minimum (1e-8 r^2 = 2.5e-15): taps at
+  // distances of 1e-5..1e-4 from the crease and taps landing on their own pixel (v = 0:
+  // 0 / epsilon).
   for (const char* eps : {"alchemy.epsilon=1e-8", "alchemy.epsilon=1e-4"}) {
     Result r = render(cornerScene(1e-3f), {"alchemy.radius=5e-4", eps, "alchemy.blur_radius=0"});
     ASSERT_TRUE(finite(r.ao)) << eps;

@@ -208,10 +208,10 @@ TEST(BenchQuantity, PluginsDeclareWhatTheyEstimate) {
     EXPECT_EQ(a.quantity, ref::Quantity::AlchemyDisk);  // the screen-disk integral
     EXPECT_EQ(a.alchemy.sigma, 2.0f);
     EXPECT_EQ(a.alchemy.contrast, 1.5f);
-    EXPECT_EQ(a.alchemy.epsilon, 0.001f);
+    EXPECT_EQ(a.alchemy.epsilon, float(0.001 * 0.5 * 0.5));  // the setting is relative to r^2
     EXPECT_EQ(a.alchemy.u, 0.0f);
     EXPECT_EQ(a.alchemy.bias, 0.002f);
-    EXPECT_EQ(label(a), "alchemy-disk r=0.5 sigma=2 u=0 eps=0.001 k=1.5 bias=0.002");
+    EXPECT_EQ(label(a), "alchemy-disk r=0.5 sigma=2 u=0 eps=0.00025 k=1.5 bias=0.002");
     EXPECT_NE(
         keyText(a),
         keyText(spec("alchemy", {"intensity=2", "contrast=1.5", "epsilon=0.001", "bias=0.003"})));

@@ -68,7 +68,7 @@ class AlchemyEffect : public gi::Effect {
     q.radius = s.number("radius");
     q.sigma = s.number("intensity");
     q.u = 0.0;
-    q.epsilon = s.number("epsilon");
+    q.epsilon = gi::alchemy::absoluteEpsilon(s.number("epsilon"), q.radius);
     q.contrast = s.number("contrast");
     q.bias = s.number("bias");
     return q;
@@ -78,11 +78,12 @@ class AlchemyEffect : public gi::Effect {
     using gi::alchemy::kMaxBlurRadius, gi::alchemy::kMaxGuardBand, gi::alchemy::kMaxSamples;
     gi::SettingDesc epsilon{"epsilon",
                             SettingType::Float,
-                            1e-4,
+                            gi::alchemy::kDefaultRelativeEpsilon,
                             1e-8,
-                            1.0,
-                            "epsilon, the guard of the denominator v.v + epsilon (world units "
-                            "squared): larger values lighten corners (light leaks)",
+                            4.0,
+                            "epsilon relative to r^2: the denominator is v.v + epsilon r^2 (so "
+                            "it follows a scaled scene); larger values lighten corners (light "
+                            "leaks)",
                             false};
     epsilon.logScale = true;
     return {
@@ -96,10 +97,10 @@ class AlchemyEffect : public gi::Effect {
          "bias beta: the numerator is max(0, v.n - beta z), z the view distance (the paper's "
          "z_C beta); removes self-occlusion from depth precision",
          false},
-        {"intensity", SettingType::Float, 1.0, 0.0, 10.0,
-         "intensity sigma (world units, like u in eq. 8): A = max(0, 1 - (2 sigma / s) sum)^k; "
-         "higher is darker",
-         false},
+        gi::SettingDesc::length("intensity", 1.0, 0.0, 1e9,
+                                "intensity sigma, a world length (like u in eq. 8; a model "
+                                "loaded without a scene file scales it with r): A = max(0, 1 - "
+                                "(2 sigma / s) sum)^k; higher is darker"),
         {"contrast", SettingType::Float, 1.0, 0.1, 8.0,
          "contrast k, the exponent of eq. 10: higher darkens the occluded parts more", false},
         epsilon,
@@ -256,9 +257,13 @@ class AlchemyEffect : public gi::Effect {
   // Host-visible and written while recording: the renderer waits for each frame before it
   // records the next, so the GPU is not reading it. Rewritten only when a setting changed.
   void upload(const gi::SettingValues& s) {
-    const std::array<double, 6> key = {s.number("radius"),    s.number("bias"),
-                                       s.number("intensity"), s.number("contrast"),
-                                       s.number("epsilon"),   double(s.integer("samples"))};
+    const double radius = s.number("radius");
+    const std::array<double, 6> key = {radius,
+                                       s.number("bias"),
+                                       s.number("intensity"),
+                                       s.number("contrast"),
+                                       gi::alchemy::absoluteEpsilon(s.number("epsilon"), radius),
+                                       double(s.integer("samples"))};
     if (key == uploaded_) return;
     const gi::alchemy::Uniforms u =
         gi::alchemy::makeUniforms(key[0], key[1], key[2], key[3], key[4], int(key[5]));

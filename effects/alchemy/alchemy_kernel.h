@@ -78,6 +78,14 @@ inline glm::vec2 tapOffset(int i, int s) {
   return unpackTap(packTap(exactTapOffset(i, s)));
 }
 
+// The `epsilon` setting is relative to r^2: the guard of v.v scales with the squared distances
+// it guards, so a scene scaled by L (r and sigma scaled by L) gives the same image. The
+// default 4e-4 is the paper's 1e-4 at r = 0.5.
+constexpr double kDefaultRelativeEpsilon = 4e-4;
+inline double absoluteEpsilon(double relative, double radius) {
+  return relative * radius * radius;
+}
+
 inline Uniforms makeUniforms(double radius, double bias, double intensity, double contrast,
                              double epsilon, int samples) {
   const int s = std::clamp(samples, 1, kMaxSamples);
