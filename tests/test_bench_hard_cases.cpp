@@ -82,6 +82,19 @@ TEST_F(HardCasesTest, IsmEnvironmentVplsStayFiniteAndInRangeOnEveryHardCase) {
   sweep(o);
 }
 
+// SSDO's optional passes (off by default) on every hard case, 8 static frames each: two depth
+// layers, two additional cameras and contact shadows, with the bounce (contact shadows applied
+// to the published direct light) and without it (published as `contact_shadow`).
+TEST_F(HardCasesTest, SsdoPeelingCamerasAndContactShadowsStayFiniteOnEveryHardCase) {
+  for (const char* bounce : {"ssdo.bounce=true", "ssdo.bounce=false"}) {
+    bench::HardCaseOptions o;
+    o.effects = {"ssdo"};
+    o.sets = {"ssdo.layers=2", "ssdo.cameras=2", "ssdo.contact_shadows=true", bounce};
+    o.flickerFrames = 8;
+    sweep(o);
+  }
+}
+
 // Every effect joins: the sweep covers the registry, not a list.
 TEST_F(HardCasesTest, SweepCoversEveryRegisteredEffect) {
   bench::HardCaseOptions o;
