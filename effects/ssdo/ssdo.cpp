@@ -36,6 +36,7 @@
 #include "ssdo_blur_x.comp.h"           // const uint32_t ssdo_blur_x_comp[]
 #include "ssdo_contact.comp.h"          // const uint32_t ssdo_contact_comp[]
 #include "ssdo_depth.comp.h"            // const uint32_t ssdo_depth_comp[]
+#include "ssdo_env_samples.comp.h"      // const uint32_t ssdo_env_samples_comp[]
 #include "ssdo_layers.comp.h"           // const uint32_t ssdo_layers_comp[]
 #include "ssdo_resolve.comp.h"          // const uint32_t ssdo_resolve_comp[]
 #include "ssdo_resolve_ambient.comp.h"  // const uint32_t ssdo_resolve_ambient_comp[]
@@ -76,8 +77,11 @@ class SsdoEffect : public gi::Effect {
         "screen-space directional occlusion of the environment with one indirect bounce "
         "(Ritschel et al. 2009; 16 interleaved sample sets, geometry-aware blur)";
     i.stage = gi::EffectStage::BeforeLighting;
-    i.reads = {res::kDepth,    res::kNormal, res::kAlbedo,      res::kMaterial,
-               res::kEmission, res::kLights, res::kShadowViews, res::kShadowMaps};
+    i.reads = {res::kDepth,          res::kNormal,
+               res::kAlbedo,         res::kMaterial,
+               res::kEmission,       res::kLights,
+               res::kShadowViews,    res::kShadowMaps,
+               res::kEnvironmentMap, res::kEnvironmentSampling};
     i.writes = {res::kAmbient, res::kIndirect, res::kContactShadow, res::kDirectLight};
     i.debugView = res::kAmbient;
     i.estimates = gi::GroundTruth::IndirectLight;
@@ -126,6 +130,13 @@ class SsdoEffect : public gi::Effect {
          "distance of the additional cameras from the viewer, in radii of the scene's bounding "
          "sphere",
          false},
+        gi::SettingDesc::enumeration(
+            "environment_sampling", {"sh9", "map", "mis"}, 0,
+            "an equirect map's radiance per sample direction: its SH9 (smooth, cheapest), the "
+            "map itself over the cosine samples, or the map with half the samples drawn from the "
+            "engine's importance sampling of it (multiple importance sampling: sharp, bright "
+            "features such as a sun)",
+            true),
         {"contact_shadows", SettingType::Bool, 0, 0, 1,
          "screen-space contact shadows for the first four shadow-casting lights: restores the "
          "shadow the shadow-map bias removes next to contacts (pass ssdo_contact; applied to "
@@ -149,6 +160,7 @@ class SsdoEffect : public gi::Effect {
     samples_ = uint32_t(std::clamp(settings.integer("samples"), 1, gi::ssdo::kMaxSamples));
     layers_ = uint32_t(std::clamp(settings.integer("layers"), 1, gi::ssdo::kMaxLayers));
     cameras_ = uint32_t(std::clamp(settings.integer("cameras"), 0, gi::ssdo::kMaxCameras));
+    environmentSampling_ = uint32_t(std::clamp(settings.integer("environment_sampling"), 0, 2));
     contact_ = settings.flag("contact_shadows");
     contactSamples_ =
         uint32_t(std::clamp(settings.integer("contact_samples"), 1, kMaxContactSamples));
@@ -179,6 +191,18 @@ class SsdoEffect : public gi::Effect {
     if (!uniforms_)
       uniforms_ =
           gi::vk::Buffer(vk, sizeof(gi::ssdo::Uniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true);
+    // The importance samples of environment_sampling=mis: two vec4 per sample slot (bound, but
+    // not read, in the other modes).
+    if (!environmentSamples_)
+      environmentSamples_ = gi::vk::Buffer(vk, kEnvironmentSlots * 2 * sizeof(float[4]),
+                                           VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false);
+    if (environmentSampling_ == 2)
+      environmentSamplesPipeline_ = gi::vk::Pipeline::compute(
+          vk, {std::begin(ssdo_env_samples_comp), std::end(ssdo_env_samples_comp)},
+          {{0, tex},
+           {1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+           {2, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}},
+          0, {});
   }
 
   // The additional cameras (seed 000 §4): displaced from the viewer by camera_displacement x
@@ -222,6 +246,9 @@ class SsdoEffect : public gi::Effect {
     struct Io {
       gi::TextureHandle depth, normal, albedo, material, emission, shadowMaps;
       gi::BufferHandle lights, shadowViews;
+      gi::TextureHandle envMap;  // the environment (its map and importance-sampling tables)
+      gi::BufferHandle envSampling;
+      gi::BufferHandle envSamples;  // environment_sampling=mis: ssdo_env_samples' table
       gi::TextureHandle surface, raw, half, ambient, indirect;
       // The peeled depth layers 1..layers-1 (peeled[0] is layer 1), and layers 2 and 3 packed.
       std::vector<gi::TextureHandle> peeled;
@@ -445,6 +472,32 @@ class SsdoEffect : public gi::Effect {
             }
           });
 
+    if (environmentSampling_ == 2) {
+      // environment_sampling=mis: the environment's importance samples, one per sample slot
+      // (dispatched only while the environment is an equirect map).
+      io->envSamples = graph.importBuffer("ssdo_env_samples", environmentSamples_.handle(),
+                                          environmentSamples_.size());
+      graph.addPass(
+          "ssdo_env_samples",
+          [&](gi::PassBuilder& b) {
+            io->envMap = b.read(bb.texture(res::kEnvironmentMap));
+            io->envSampling =
+                b.read(bb.buffer(res::kEnvironmentSampling), gi::BufferUsage::StorageRead);
+            io->envSamples = b.write(io->envSamples, gi::BufferUsage::StorageWrite);
+          },
+          [this, io, nearest, c = &ctx](gi::PassContext& pc) {
+            // Only an equirect map is read per direction (the kind may change at run time
+            // without a graph rebuild, as in the ssdo pass).
+            if (environmentKind(c->frame()) != 2) return;
+            const auto ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+            gi::vk::DescriptorWriter w;
+            w.sampled(0, pc.view(io->envMap), nearest)
+                .buffer(1, ssbo, pc.buffer(io->envSampling))
+                .buffer(2, ssbo, pc.buffer(io->envSamples));
+            pc.dispatch(environmentSamplesPipeline_, w, {uint32_t(kEnvironmentSlots), 1}, 64, 1);
+          });
+    }
+
     graph.addPass(
         "ssdo",
         [&](gi::PassBuilder& b) {
@@ -456,6 +509,11 @@ class SsdoEffect : public gi::Effect {
           }
           for (gi::TextureHandle& t : io->camSurface) t = b.read(t);
           if (layers_ > 2) io->layers23 = b.read(io->layers23);
+          io->envMap = b.read(bb.texture(res::kEnvironmentMap));
+          io->envSampling =
+              b.read(bb.buffer(res::kEnvironmentSampling), gi::BufferUsage::StorageRead);
+          if (environmentSampling_ == 2)
+            io->envSamples = b.read(io->envSamples, gi::BufferUsage::StorageRead);
           io->raw = b.write(b.create("ssdo_raw", gi::TextureDesc{kPackedFormat}),
                             gi::TextureUsage::StorageWrite);
         },
@@ -470,6 +528,7 @@ class SsdoEffect : public gi::Effect {
                 .storageImage(3, pc.view(io->raw))
                 .sampled(9, pc.view(io->depth), nearest)
                 .sampled(10, pc.view(io->normal), nearest);
+            bindEnvironment(w, pc, *io, nearest);
             pc.dispatch(ssdo_, w, pc.extent(io->raw), kGroupX, kGroupY);
             return;
           }
@@ -484,6 +543,7 @@ class SsdoEffect : public gi::Effect {
                       nearest);
           // Layers 2 and 3 (unused with up to 2 layers: the surface stands in).
           w.sampled(8, pc.view(layers_ > 2 ? io->layers23 : io->surface), nearest);
+          bindEnvironment(w, pc, *io, nearest);
           pc.dispatch(ssdo_, w, pc.extent(io->raw), kGroupX, kGroupY);
         });
 
@@ -546,6 +606,18 @@ class SsdoEffect : public gi::Effect {
   // Directional occlusion alone (no bounce, one layer, no cameras): the taps need only depth.
   bool depthInput() const { return !bounce_ && layers_ == 1 && cameras_ == 0; }
 
+  // The environment map and its importance-sampling tables (ssdo.glsl's bindings 11 and 12).
+  template <class Io>
+  void bindEnvironment(gi::vk::DescriptorWriter& w, gi::PassContext& pc, const Io& io,
+                       VkSampler sampler) const {
+    const auto ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    w.sampled(11, pc.view(io.envMap), sampler)
+        .buffer(12, ssbo, pc.buffer(io.envSampling))
+        .buffer(
+            13, ssbo,
+            environmentSampling_ == 2 ? pc.buffer(io.envSamples) : environmentSamples_.handle());
+  }
+
   static uint32_t environmentKind(const gi::FrameUniforms& f) {
     return uint32_t(std::clamp(int(std::lround(f.skyHorizon.w)), 0, 2));
   }
@@ -554,12 +626,22 @@ class SsdoEffect : public gi::Effect {
     const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
                tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
                img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-    const std::vector<uint32_t> constants = {samples_, bounce_ ? 1u : 0u, kind, layers_, cameras_};
+    const auto ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    const std::vector<uint32_t> constants = {samples_, bounce_ ? 1u : 0u, kind,
+                                             layers_,  cameras_,          environmentSampling_};
     ssdo_ =
         depthInput()
-            ? gi::vk::Pipeline::compute(
-                  ctx.vulkan(), {std::begin(ssdo_depth_comp), std::end(ssdo_depth_comp)},
-                  {{0, ubo}, {1, ubo}, {3, img}, {9, tex}, {10, tex}}, 0, constants)
+            ? gi::vk::Pipeline::compute(ctx.vulkan(),
+                                        {std::begin(ssdo_depth_comp), std::end(ssdo_depth_comp)},
+                                        {{0, ubo},
+                                         {1, ubo},
+                                         {3, img},
+                                         {9, tex},
+                                         {10, tex},
+                                         {11, tex},
+                                         {12, ssbo},
+                                         {13, ssbo}},
+                                        0, constants)
             : gi::vk::Pipeline::compute(ctx.vulkan(), {std::begin(ssdo_comp), std::end(ssdo_comp)},
                                         {{0, ubo},
                                          {1, ubo},
@@ -569,7 +651,10 @@ class SsdoEffect : public gi::Effect {
                                          {5, tex},
                                          {6, tex},
                                          {7, tex},
-                                         {8, tex}},
+                                         {8, tex},
+                                         {11, tex},
+                                         {12, ssbo},
+                                         {13, ssbo}},
                                         0, constants);
     environmentKind_ = kind;
   }
@@ -670,6 +755,11 @@ class SsdoEffect : public gi::Effect {
   std::vector<std::shared_ptr<gi::ViewUniforms>> views_;  // the additional cameras
   bool bounce_ = true;
   uint32_t samples_ = 12, environmentKind_ = 0, layers_ = 1, cameras_ = 0, pcf_ = 1;
+  uint32_t environmentSampling_ = 0;  // 0 SH9, 1 map, 2 map with MIS (ssdo.glsl)
+  // Sample slots (gi::ssdo::kPhases x kMaxSamples; ssdo_env.glsl's kEnvironmentSlots).
+  static constexpr int kEnvironmentSlots = gi::ssdo::kPhases * gi::ssdo::kMaxSamples;
+  gi::vk::Buffer environmentSamples_;
+  gi::vk::Pipeline environmentSamplesPipeline_;
   std::array<uint32_t, 2> surfaceMasks_{7, 7};
   bool contact_ = false;
   uint32_t contactSamples_ = 4;

@@ -31,10 +31,28 @@ layout(constant_id = 3) const int kLayers = 1;
 // Additional cameras (0..4): a sample is also blocked when it is behind a surface one of them
 // sees (same test, their own images), and that surface is then its sender.
 layout(constant_id = 4) const int kCameras = 0;
+// An equirect map's radiance per sample direction (kEnvironmentKind 2; setting
+// `environment_sampling`): 0, its SH9 (the sum over the open samples' moments); 1, the map
+// per direction (its texel: environmentTexelRadiance) over the cosine-distributed samples;
+// 2, the map with multiple importance sampling: the odd samples take their directions from the
+// engine's importance sampling of the map (ssdo_env_samples.comp), the even ones stay cosine-
+// distributed, and each is weighted by the balance heuristic, 2 L V (cos / pi) /
+// (cos / pi + pdf_env) (guard: a zero denominator, or a direction below the horizon, adds 0).
+// The bounce uses the cosine samples only (their patch area doubled in mode 2).
+layout(constant_id = 5) const int kEnvironmentSampling = 0;
 
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 #include "ssdo_common.glsl"
 layout(set = 0, binding = 3, rgba32ui) uniform writeonly uimage2D outRaw;
+#define GI_ENVIRONMENT_SET 0
+#define GI_ENVIRONMENT_BINDING_MAP 11
+#define GI_ENVIRONMENT_BINDING_SAMPLING 12
+#include "environment.glsl"
+#include "ssdo_env.glsl"
+// The importance samples of `environment_sampling=mis`, one per sample slot (ssdo_env_samples).
+layout(set = 0, binding = 13, std430) readonly buffer EnvironmentSamples {
+  vec4 environmentSamples[];
+};
 #ifdef SSDO_DEPTH_INPUT
 // Directional occlusion alone (no bounce, one layer, no cameras; ssdo_depth.comp): a tap needs
 // only the 1 / view distance, which is affine in the G-buffer's reverse-Z depth, so the taps
@@ -214,6 +232,25 @@ void main() {
     float ky = float((code >> 12) & 4095u) * (2.0 / 4095.0) - 1.0;
     float kz = sqrt(max(0.0, 1.0 - kx * kx - ky * ky));
     float s = float((code >> 24) + 1u) * (1.0 / 256.0);
+    // Per-direction map radiance (kEnvironmentSampling > 0): the sample's L and, with MIS, the
+    // pdf of the other strategy. The branch on i folds: the loop unrolls.
+    bool mapLookup = kEnvironmentKind == 2 && kEnvironmentSampling > 0;
+    bool fromEnvironment = mapLookup && kEnvironmentSampling == 2 && (i & 1) == 1;
+    vec3 envL = vec3(0.0);
+    float envPdf = 0.0;
+    if (fromEnvironment) {
+      // Slot f's sample (R2 points over the slots of all 16 phases; ssdo_env_samples.comp).
+      vec4 dirPdf = environmentSamples[2 * f];
+      envL = environmentSamples[2 * f + 1].rgb;
+      envPdf = dirPdf.w;
+      kx = dot(dirPdf.xyz, Tw);
+      ky = dot(dirPdf.xyz, Bw);
+      kz = dot(dirPdf.xyz, Nw);  // <= 0: below the horizon, weighted 0 below
+    } else if (mapLookup) {
+      vec3 wd = Tw * kx + Bw * ky + Nw * kz;
+      envL = environmentTexelRadiance(wd);
+      if (kEnvironmentSampling == 2) envPdf = environmentPdf(wd);
+    }
     vec3 c = clipP + (clipT * kx + clipB * ky + clipN * kz) * s;
     float K = NP + R * s * kz;
     float Kc = min(K, minK), w = max(c.z, kMinClipW);
@@ -302,6 +339,11 @@ void main() {
 
     if (kEnvironmentKind == 1) {
       direct.x += blocked ? 0.0 : 1.0;  // constant: count the open directions
+    } else if (mapLookup) {
+      float cosPdf = max(kz, 0.0) * (1.0 / 3.14159265358979);
+      float weight = kEnvironmentSampling == 1 ? 1.0
+                                               : 2.0 * cosPdf / max(cosPdf + envPdf, 1e-30);
+      direct += blocked ? vec3(0.0) : envL * weight;
     } else if (kEnvironmentKind == 2) {
       // SH9 (a quadratic polynomial of the direction): the open directions' moments suffice.
       vec3 k = vec3(kx, ky, kz);
@@ -315,10 +357,13 @@ void main() {
       vec3 sky = mix(skyHorizon, y >= 0.0 ? skyZenith : skyGround, sqrt(abs(y)));
       direct += blocked ? vec3(0.0) : sky;
     }
+    // With MIS only the cosine samples send, each standing for twice the patch area.
+    if (kEnvironmentSampling == 2 && kEnvironmentKind == 2)
+      send = fromEnvironment ? vec3(0.0) : 2.0 * send;
     bounce += send;
   }
   if (kEnvironmentKind == 1) direct = direct.x * frame.skyGround.rgb * frame.skyZenith.w;
-  if (kEnvironmentKind == 2) direct = shFromMoments(direct.x, m1, m2, m2x, mat3(Tw, Bw, Nw));
+  if (kEnvironmentKind == 2 && kEnvironmentSampling == 0) direct = shFromMoments(direct.x, m1, m2, m2x, mat3(Tw, Bw, Nw));
   direct *= 1.0 / float(kSamples);
   bounce *= ssdo.params.z;
   imageStore(outRaw, p,
