@@ -494,6 +494,40 @@ TEST_F(IsmTest, CornellBoxBouncesIncreaseMonotonicallyAndConverge) {
   EXPECT_LT(mean[3] - mean[2], mean[2] - mean[1]);
 }
 
+// The VPL singularity guard on the GPU: 1 / max(d^2, d_min^2) with d_min = distance_clamp x
+// the scene's diagonal (17.09 here). With d_min = 3.42 (clamp 0.2) the floor under the panel's
+// VPL (d ~ 2) gets (d / d_min)^2 of its unclamped light; pixels farther than d_min keep theirs
+// exactly; no pixel gets brighter. (The CPU mirror: IsmFormulas.SingularityGuardKeepsTheVplFinite.)
+TEST_F(IsmTest, SingularityClampCapsTheLightNearTheVpl) {
+  const Scene s = panelScene();
+  const Result base = render(s, kOneVpl);
+  const Result clamped = render(s, with(kOneVpl, {"ism.distance_clamp=0.2"}));
+  const glm::vec3 vpl(-2, 2, 0);  // the panel's centre: the VPL lies on it, within 0.25
+  const float dMin = 0.2f * std::sqrt(12.0f * 12.0f * 2.0f + 2.0f * 2.0f);
+  int nearPixels = 0, farPixels = 0;
+  for (int y = 0; y < int(kH); ++y)
+    for (int x = 0; x < int(kW); ++x) {
+      if (base.sky(x, y)) continue;
+      const float e0 = luminance(base.px(base.indirect, x, y)),
+                  e1 = luminance(clamped.px(clamped.indirect, x, y));
+      ASSERT_TRUE(std::isfinite(e1));
+      ASSERT_LE(e1, e0 * 1.001f + 1e-6f) << x << "," << y;
+      const float d = glm::length(base.worldAt(x, y) - vpl);
+      if (d > dMin + 0.4f) {
+        ++farPixels;
+        ASSERT_NEAR(e1, e0, 1e-3f * e0 + 1e-6f) << "beyond d_min, pixel " << x << "," << y;
+      } else if (d < dMin - 0.4f && e0 > 1e-4f) {
+        ++nearPixels;
+        const float lo = (d - 0.3f) / dMin, hi = (d + 0.3f) / dMin;
+        ASSERT_GE(e1 / e0, lo * lo) << "pixel " << x << "," << y << " at " << d;
+        ASSERT_LE(e1 / e0, hi * hi) << "pixel " << x << "," << y << " at " << d;
+      }
+    }
+  std::printf("%d lit pixels within d_min, %d beyond\n", nearPixels, farPixels);
+  EXPECT_GT(nearPixels, 50);
+  EXPECT_GT(farPixels, 50);
+}
+
 // The geometry-aware blur removes the k x k interleaving pattern: with 4 x 4 blocks (each pixel
 // gathers 16 of the 256 VPLs) the blurred indirect light of the Cornell box matches the image
 // whose every pixel gathers all 256 (block 1) within 10% on average (measured 7.7%: the residue

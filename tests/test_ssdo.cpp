@@ -348,6 +348,60 @@ TEST_F(SsdoTest, ShadowNextToABoxTakesTheColourOfTheUnblockedSky) {
   EXPECT_LT(redness(pNear), redness(dNear) - 0.02);  // measured -0.041
 }
 
+// The issue's two-colour case, the colours split left / right: an equirect map red toward -x,
+// blue toward +x, over a floor with a box. Beside the box's -x face the box hides the blue
+// half: SSDO's shadow there is red; beside its +x face it hides the red half: the shadow is
+// blue; SSAO darkens both sides with the open floor's hue (r / (r + b) 0.5000 everywhere).
+// Read through the map's SH9 (its first-order band keeps the split: 0.599 left, 0.407 right,
+// 0.500 open) and through multiple importance sampling (0.692, 0.325, 0.496: the sharp split).
+TEST_F(SsdoTest, ShadowsOnEachSideOfABoxTakeTheColourOfTheOtherSide) {
+  const std::string dir = ::testing::TempDir();
+  {
+    std::ofstream out(dir + "/ssdo_red_blue.hdr", std::ios::binary);
+    out << "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 16 +X 32\n";
+    // Column x: u = (x + 0.5) / 32 = atan(z, x) / 2 pi: x < 0 (red) for u in (0.25, 0.75).
+    const unsigned char red[4] = {128, 0, 0, 129}, blue[4] = {0, 0, 128, 129};
+    for (int y = 0; y < 16; ++y)
+      for (int x = 0; x < 32; ++x)
+        out.write(reinterpret_cast<const char*>(x >= 8 && x < 24 ? red : blue), 4);
+  }
+  const Scene s = jsonScene("red_blue", R"({
+      "models": [
+        { "primitive": "plane", "size": 40, "material": { "base_color": [0.8, 0.8, 0.8] } },
+        { "primitive": "box", "size": 1, "translation": [0, 0.5, 0],
+          "material": { "base_color": [0.8, 0.8, 0.8] } } ],
+      "lights": [ { "type": "directional", "intensity": 0, "casts_shadows": false } ],
+      "camera": { "position": [0, 4, 2.5], "target": [0, 0, 0] },
+      "environment": { "type": "map", "file": ")" +
+                                            dir + R"(/ssdo_red_blue.hdr" } })");
+  auto floor = [](glm::vec3 p) { return std::abs(p.y) < 1e-3f && std::abs(p.z) < 0.45f; };
+  auto left = [&](glm::vec3 p) { return floor(p) && p.x > -0.65f && p.x < -0.51f; };
+  auto right = [&](glm::vec3 p) { return floor(p) && p.x > 0.51f && p.x < 0.65f; };
+  auto open = [](glm::vec3 p) {
+    return std::abs(p.y) < 1e-3f && std::abs(p.x) < 0.3f && p.z > 1.6f && p.z < 2.0f;
+  };
+  auto redness = [](glm::dvec3 c) { return c.r / (c.r + c.b); };
+  const Result ssao = render(s, {"ssao.radius=1"}, "ssao");
+  const double aOpen = redness(mean(ssao, ssao.lit, open));
+  std::printf("ssao redness: left %.4f, right %.4f, open %.4f\n",
+              redness(mean(ssao, ssao.lit, left)), redness(mean(ssao, ssao.lit, right)), aOpen);
+  EXPECT_NEAR(redness(mean(ssao, ssao.lit, left)), aOpen, 0.005);
+  EXPECT_NEAR(redness(mean(ssao, ssao.lit, right)), aOpen, 0.005);
+  for (const char* mode : {"sh9", "mis"}) {
+    const Result r = render(s, {"ssdo.bounce=false", "ssdo.radius=1",
+                                std::string("ssdo.environment_sampling=") + mode});
+    int nLeft = 0, nRight = 0, nOpen = 0;
+    const double l = redness(mean(r, r.lit, left, &nLeft)),
+                 rr = redness(mean(r, r.lit, right, &nRight)),
+                 o = redness(mean(r, r.lit, open, &nOpen));
+    std::printf("ssdo %s redness: left %.4f, right %.4f, open %.4f\n", mode, l, rr, o);
+    ASSERT_GT(std::min({nLeft, nRight, nOpen}), 20) << mode;
+    EXPECT_NEAR(o, 0.5, 0.05) << mode << ": the open floor sees both halves alike";
+    EXPECT_GT(l, o + 0.05) << mode << ": the shadow left of the box is red";
+    EXPECT_LT(rr, o - 0.05) << mode << ": the shadow right of the box is blue";
+  }
+}
+
 // A white floor and a yellow emissive wall (x = 0) under a black environment: the floor's
 // indirect light is yellow, strongest next to the wall, fading with distance and 0 beyond the
 // radius. Back-facing senders are rejected: the G-buffer turns every normal toward the camera,
