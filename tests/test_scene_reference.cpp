@@ -13,6 +13,7 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "gi/environment.h"
 #include "gi/errors.h"
 #include "gi/image_io.h"
 #include "gi/reference/ray_scene.h"
@@ -507,6 +508,56 @@ TEST(ReferenceDirect, AnalyticLightsAndEnvironmentsOnAPlane) {
     }
     EXPECT_GT(checked, 50);
   }
+}
+
+// A map that is dim (0.05) but for a small sun (1000, 2x2 texels of 64 x 32: 0.027 sr, 97% of
+// the map's power) over an open plane: the environment is sampled by cosine and by the map's
+// importance, combined by multiple importance sampling (Shading::environmentLight). The mean
+// matches (rho / pi) int L cos (midpoint rule on a fine grid) within 2%, and the pixels'
+// spread at 64 spp is below 0.6 of the mean (measured 0.41; 1.3 with cosine samples alone,
+// which find the sun in 0.6% of the samples).
+TEST(ReferenceDirect, SmallSunInAMapIsFoundByImportanceSampling) {
+  const glm::vec3 albedo(0.5f);
+  SceneBuilder b;
+  b.add(parallelogram({-50, 0, 50}, {100, 0, 0}, {0, 0, -100}), b.material(albedo));
+  b.camera({0, 2, 3}, {0, 0, 0});
+  Scene scene = b.done();
+  Environment& e = scene.environment;
+  e.kind = Environment::Kind::Map;
+  e.intensity = 1.0f;
+  e.mapWidth = 64;
+  e.mapHeight = 32;
+  e.mapRGB.assign(64 * 32 * 3, 0.05f);
+  for (int y : {7, 8})
+    for (int x : {63, 0})
+      for (int c = 0; c < 3; ++c) e.mapRGB[(size_t(y) * 64 + x) * 3 + c] = 1000.0f;
+  double exact = 0.0;
+  const int nu = 1024, nv = 512;
+  for (int j = 0; j < nv / 2; ++j)
+    for (int i = 0; i < nu; ++i) {
+      const double theta = (j + 0.5) * kPi / nv, phi = (i + 0.5) * 2.0 * kPi / nu;
+      const glm::vec3 d(float(std::sin(theta) * std::cos(phi)), float(std::cos(theta)),
+                        float(std::sin(theta) * std::sin(phi)));
+      exact += environmentLookup(e, d).x * std::cos(theta) * std::sin(theta) * (kPi / nv) *
+               (2.0 * kPi / nu);
+    }
+  exact *= 0.5 / kPi;
+  const ref::Result r = ref::render(scene, smallSettings(ref::Quantity::Direct, 64));
+  double sum = 0.0, sum2 = 0.0;
+  int n = 0;
+  for (size_t i = 0; i < size_t(r.value.width) * r.value.height; ++i) {
+    const PixelView p = pixel(r, i);
+    if (!p.geometry) continue;
+    ASSERT_TRUE(std::isfinite(p.value.x));
+    sum += p.value.x;
+    sum2 += double(p.value.x) * p.value.x;
+    ++n;
+  }
+  ASSERT_GT(n, 500);
+  const double mean = sum / n, spread = std::sqrt(std::max(0.0, sum2 / n - mean * mean));
+  std::printf("mean %.4f (exact %.4f), spread of the pixels %.4f\n", mean, exact, spread);
+  EXPECT_NEAR(mean, exact, 0.02 * exact);
+  EXPECT_LT(spread, 0.6 * mean);
 }
 
 TEST(ReferenceDirect, SpotConeAndRangeFollowTheRasteriser) {

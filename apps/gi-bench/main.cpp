@@ -360,7 +360,7 @@ struct LoadedScene {
 
 std::string cacheStem(const Options& o, const LoadedScene& s, const ReferenceKey& k) {
   std::ostringstream key;
-  key << "gi-bench-reference-v2|" << s.contents.size() << '|';
+  key << "gi-bench-reference-v3|" << s.contents.size() << '|';
   const gi::CameraView cam = gi::activeCamera(s.scene, float(o.width) / float(o.height));
   const float* v = &cam.view[0][0];
   const float* p = &cam.proj[0][0];

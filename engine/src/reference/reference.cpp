@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <thread>
 #include <vector>
 
@@ -107,6 +108,7 @@ struct SurfaceMaterial {
 class Shading {
  public:
   Shading(const Scene& scene, const RayScene& rays) : rays_(rays), env_(scene.environment) {
+    if (env_.kind == Environment::Kind::Map) envSampler_.emplace(env_);
     materials_ = scene.materials;
     if (materials_.empty()) materials_.emplace_back();
     for (const Texture& t : scene.textures) textures_.emplace_back(t);
@@ -161,6 +163,35 @@ class Shading {
   }
 
   glm::vec3 environment(const glm::vec3& dir) const { return environmentRadiance(env_, dir); }
+
+  // The environment light a diffuse point reflects, per unit diffuse albedo. A map is sampled
+  // twice and the two combined by multiple importance sampling (balance heuristic): along the
+  // cosine-sampled direction `dir` the caller traces anyway (`escaped`: it reached the sky),
+  // weighted p_cos / (p_cos + p_env), and along one direction drawn from the map's importance
+  // (EnvironmentSampler, its own shadow ray), L cos / pi / (p_cos + p_env): a small bright
+  // source (a sun in an HDR map) that cosine samples alone would rarely find. Sky and constant
+  // environments keep the cosine sample alone (their references unchanged).
+  glm::vec3 environmentLight(const SurfaceHit& x, const glm::vec3& dir, bool escaped,
+                             Rng& rng) const {
+    const glm::vec3 n = x.shadingNormal;
+    if (!envSampler_) return escaped ? environment(dir) : glm::vec3(0.0f);
+    const float cosPdf = std::max(glm::dot(n, dir), 0.0f) * float(1.0 / M_PI);
+    glm::vec3 sum(0.0f);
+    if (escaped) {
+      const float envPdf = envSampler_->pdf(dir);
+      // Guard: a zero denominator (a grazing direction of a black texel) adds nothing.
+      if (cosPdf + envPdf > 0.0f) sum += environment(dir) * (cosPdf / (cosPdf + envPdf));
+    }
+    const float u1 = rng.uniform(), u2 = rng.uniform();
+    const EnvironmentSampler::Sample e = envSampler_->sample(u1, u2);
+    const float cosE = glm::dot(n, e.direction);
+    if (cosE > 0.0f && e.pdf > 0.0f &&
+        !rays_.occluded(RayScene::spawnOrigin(x), e.direction, 0.0f, kInf)) {
+      const float cosPdfE = cosE * float(1.0 / M_PI);
+      sum += environment(e.direction) * (cosPdfE / (cosPdfE + e.pdf));
+    }
+    return finiteOrZero(sum);
+  }
 
   // Reflected radiance from the point, spot and directional lights with shadow rays:
   // sum (diffuse / pi) E_l cos(theta_l) V_l, with the rasteriser's units and falloffs.
@@ -249,6 +280,7 @@ class Shading {
  private:
   const RayScene& rays_;
   Environment env_;
+  std::optional<EnvironmentSampler> envSampler_;  // a map's importance sampling (MIS)
   std::vector<Material> materials_;
   std::vector<LinearTexture> textures_;
   std::vector<WorldLight> lights_;
@@ -283,11 +315,13 @@ glm::vec3 reflected(const Shading& shading, const SurfaceHit& y, const SurfaceMa
   const glm::vec3 dir = cosineDirection(y.shadingNormal, rng);
   const glm::vec3 origin = RayScene::spawnOrigin(y);
   if (more == 0) {
-    if (!rays.occluded(origin, dir, 0.0f, kInf)) l += my.diffuse * shading.environment(dir);
-    return l;
+    const bool escaped = !rays.occluded(origin, dir, 0.0f, kInf);
+    return l + my.diffuse * shading.environmentLight(y, dir, escaped, rng);
   }
   SurfaceHit z;
-  if (!rays.intersect(origin, dir, 0.0f, kInf, z)) return l + my.diffuse * shading.environment(dir);
+  if (!rays.intersect(origin, dir, 0.0f, kInf, z))
+    return l + my.diffuse * shading.environmentLight(y, dir, true, rng);
+  l += my.diffuse * shading.environmentLight(y, dir, false, rng);
   const SurfaceMaterial mz = shading.material(z);
   glm::vec3 lz = emitterLight ? mz.emission : glm::vec3(0.0f);
   if (mz.diffuse != glm::vec3(0.0f)) lz += reflected(shading, z, mz, more - 1, emitterLight, rng);
@@ -313,9 +347,10 @@ glm::vec3 sampleQuantity(const Settings& s, const Shading& shading, const Primar
       if (!rays.intersect(origin, dir, 0.0f, s.radius, h)) return glm::vec3(0.0f);
       return glm::vec3(alchemyFalloff(s.alchemy, h.t));
     }
-    case Quantity::Direct:
-      if (rays.occluded(origin, dir, 0.0f, kInf)) return p.base;
-      return p.base + p.material.diffuse * shading.environment(dir);
+    case Quantity::Direct: {
+      const bool escaped = !rays.occluded(origin, dir, 0.0f, kInf);
+      return p.base + p.material.diffuse * shading.environmentLight(p.hit, dir, escaped, rng);
+    }
     case Quantity::DirectIndirect: {
       // Light from emissive surfaces: sampled on the emitters and, below, by the cosine-
       // sampled bounce, combined by multiple importance sampling (balance heuristic).
@@ -324,7 +359,9 @@ glm::vec3 sampleQuantity(const Settings& s, const Shading& shading, const Primar
                                     : p.material.diffuse * shading.sampleEmitters(p.hit, rng);
       SurfaceHit y;
       if (!rays.intersect(origin, dir, 0.0f, kInf, y))
-        return p.base + emitted + p.material.diffuse * shading.environment(dir);
+        return p.base + emitted +
+               p.material.diffuse * shading.environmentLight(p.hit, dir, true, rng);
+      const glm::vec3 sky = p.material.diffuse * shading.environmentLight(p.hit, dir, false, rng);
       // The radiance leaving y towards the pixel's point: its emission (MIS-weighted) plus
       // what it reflects: its direct light (lights with shadow rays, environment by one cosine
       // sample) and, with more bounces, the light of the further path (reflected()).
@@ -334,7 +371,7 @@ glm::vec3 sampleQuantity(const Settings& s, const Shading& shading, const Primar
         ly += my.emission * shading.bsdfWeight(p.hit, dir, y, my.emission);
       if (my.diffuse != glm::vec3(0.0f))
         ly += reflected(shading, y, my, s.bounces - 1, s.emitterLight, rng);
-      return p.base + emitted + p.material.diffuse * ly;
+      return p.base + emitted + sky + p.material.diffuse * ly;
     }
     case Quantity::Depth:
     case Quantity::Normal:
