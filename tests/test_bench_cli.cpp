@@ -166,7 +166,8 @@ TEST(BenchCli, DeclaredQuantityFollowsTheSweptRadius) {
 }
 
 // Several effects on one scene against the same target: one chart with every effect as a
-// series (the methods side by side), before the per-effect charts.
+// series (the methods side by side), before the per-effect charts, and one of each against
+// the quantity it declares.
 TEST(BenchCli, SeveralEffectsShareOneChartPerScene) {
   const bool hasGtao = fs::exists(test::binPath("plugins/gi_effect_gtao.so"));
   if (!hasSsao() || !hasGtao) GTEST_SKIP() << "the ssao and gtao plugins are not built";
@@ -183,6 +184,12 @@ TEST(BenchCli, SeveralEffectsShareOneChartPerScene) {
   EXPECT_NE(svg.find("ssao"), std::string::npos);
   EXPECT_NE(svg.find("gtao"), std::string::npos);
   EXPECT_GT(fs::file_size(out + "/plots/default_all.png"), 1000u);
+  // SSAO declares linear obscurance, not the AO target: a second chart scores each effect
+  // against its own quantity.
+  EXPECT_NE(report.find("plots/default_all_declared.png"), std::string::npos) << report;
+  const std::string declared = readAll(out + "/plots/default_all_declared.svg");
+  EXPECT_NE(declared.find("declared quantity"), std::string::npos);
+  EXPECT_NE(declared.find("ssao"), std::string::npos);
 }
 
 // repetitions.csv keeps every round of every configuration (median and fastest frame, and with

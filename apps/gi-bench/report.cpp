@@ -235,21 +235,26 @@ std::string xmlEscape(const std::string& s) {
 
 // Rows of one scene and effect as a plot: series by `Row::series`, points in swept-value
 // order, labelled by the swept setting ("ssao.samples=16"), error bars from the intervals.
+// `declared`: each row's error against the quantity its effect declares instead of the
+// target (no Pareto front: the rows' quantities may differ).
 Plot buildPlot(const std::string& title, const std::vector<const Row*>& rows,
-               bool seriesByEffect = false) {
+               bool seriesByEffect = false, bool declared = false) {
   Plot p;
   p.title = title;
   const bool effectTime = !rows.empty() && rows.front()->effectMs > 0.0;
   p.xLabel = std::string(effectTime ? "effect" : "frame") + " GPU time, ms (median; bars: " +
              (rows.empty() ? std::string("-") : percent(rows.front()->totalCi.coverage)) +
              " interval)";
-  p.yLabel = "NRMSE vs " + (rows.empty() ? std::string("reference") : rows.front()->reference);
-  const std::vector<size_t> front = paretoFront(rows);
+  p.yLabel = "NRMSE vs " + (rows.empty() ? std::string("reference")
+                            : declared   ? std::string("each effect's declared quantity")
+                                         : rows.front()->reference);
+  const std::vector<size_t> front = declared ? std::vector<size_t>{} : paretoFront(rows);
   std::set<const Row*> onFront;
   for (size_t i : front) onFront.insert(rows[i]);
   auto point = [&](const Row* r) {
     const Interval t = plotInterval(*r);
-    PlotPoint pt{t.median, t.lo, t.hi, r->nrmse, "", onFront.count(r) > 0};
+    PlotPoint pt{
+        t.median, t.lo, t.hi, declared ? r->declaredNrmse : r->nrmse, "", onFront.count(r) > 0};
     pt.label = r->gridKey.empty() ? (r->params.empty() ? r->preset : r->params)
                                   : r->gridKey + "=" + fmt(r->gridValue);
     return pt;
@@ -643,6 +648,11 @@ void writeResults(const std::string& dir, const std::vector<Row>& rows, const Ru
           buildPlot(
               stem + ": every effect (" + g.front()->compared + " vs " + g.front()->reference + ")",
               g, true));
+    // The same rows, each against the quantity its effect declares (where any differs from
+    // the target): how well each estimates what it claims to.
+    if (std::any_of(g.begin(), g.end(), [](const Row* r) { return r->declared != r->reference; }))
+      write("plots/" + fileSafe(stem) + "_all_declared",
+            buildPlot(stem + ": every effect, each against its declared quantity", g, true, true));
   }
   for (const auto& key : order) {
     const std::string stem = fs::path(key.first).stem().string();
