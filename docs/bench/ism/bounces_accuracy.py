@@ -14,17 +14,8 @@ and its NRMSE.
 """
 import os, re, statistics, subprocess, sys, tempfile
 
-def read_pfm(path):
-    with open(path, "rb") as f:
-        kind = f.readline().strip()
-        w, h = map(int, f.readline().split())
-        scale = float(f.readline())
-        import struct
-        n = 3 if kind == b"PF" else 1
-        data = f.read()
-        fmt = ("<" if scale < 0 else ">") + "f" * (w * h * n)
-        vals = struct.unpack(fmt, data[: 4 * w * h * n])
-        return w, h, n, vals
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from pfm import read_pfm  # noqa: E402
 
 out, reps, scene, size, spp = sys.argv[1], int(sys.argv[2]), sys.argv[3], sys.argv[4], sys.argv[5]
 w, h = size.split("x")

@@ -10,17 +10,11 @@ usage: fig4_classic.py OUT.md SCENE WxH VPLS BIN_DIR [RES,RES,...] [POINTS,POINT
 REFERENCE_RES: the classic maps' resolution for every row, instead of each row's own)
 NRMSE = RMS(ism - classic) / mean(classic) over the geometry pixels (gi-render --view depth).
 """
-import os, struct, subprocess, sys, tempfile, time
+import os, subprocess, sys, tempfile, time
 
 
-def read_pfm(path):
-    with open(path, "rb") as f:
-        kind = f.readline().strip()
-        w, h = map(int, f.readline().split())
-        scale = float(f.readline())
-        n = 3 if kind == b"PF" else 1
-        fmt = ("<" if scale < 0 else ">") + "f" * (w * h * n)
-        return n, struct.unpack(fmt, f.read()[: 4 * w * h * n])
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from pfm import read_pfm  # noqa: E402
 
 
 out, scene, size, vpls, bindir = sys.argv[1:6]
@@ -41,7 +35,8 @@ def run(name, sets, view="indirect"):
         argv += ["--set", s]
     start = time.time()
     subprocess.run(argv, check=True, capture_output=True)
-    return read_pfm(path), time.time() - start
+    _, _, n, values = read_pfm(path)
+    return (n, values), time.time() - start
 
 
 (n_depth, depth), _ = run("depth", [], "depth")
