@@ -7,13 +7,11 @@
 
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <ostream>
 #include <string>
 #include <vector>
 
 #include "effect_fixture.h"
-#include "gi/scene_io.h"
 #include "quad_scene.h"
 #include "test_support.h"
 
@@ -97,17 +95,7 @@ TEST_P(AoFamilyTest, NoDarkPixelsOnTheOutlineOfACurvedObject) {
   // plugin's unfiltered spread; and with the effect's filter on every pixel of the object must
   // stay open (> 0.97).
   for (const char* scale : {"1", "[0.1, 2, 0.1]"}) {
-    const std::string path = ::testing::TempDir() + "/ao_family_outline.json";
-    {
-      std::ofstream f(path);
-      f << R"({
-      "models": [
-        { "primitive": "plane", "size": 40, "rotation": [90, 0, 0], "translation": [0, 0, -4] },
-        { "primitive": "sphere", "radius": 0.4, "segments": 48, "rings": 24, "scale": )"
-        << scale << R"( } ],
-      "camera": { "position": [0, 0, 3], "target": [0, 0, 0], "yfov_deg": 45 } })";
-    }
-    const Scene s = loadSceneJson(path);
+    const Scene s = test::outlineScene(scale, ::testing::TempDir() + "/ao_family_outline.json");
     for (const auto& sets : {GetParam().blurOff, GetParam().blurOn}) {
       const bool filtered = sets == GetParam().blurOn;
       const std::string blur = sets[0];

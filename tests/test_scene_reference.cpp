@@ -531,17 +531,7 @@ TEST(ReferenceDirect, SmallSunInAMapIsFoundByImportanceSampling) {
   for (int y : {7, 8})
     for (int x : {63, 0})
       for (int c = 0; c < 3; ++c) e.mapRGB[(size_t(y) * 64 + x) * 3 + c] = 1000.0f;
-  double exact = 0.0;
-  const int nu = 1024, nv = 512;
-  for (int j = 0; j < nv / 2; ++j)
-    for (int i = 0; i < nu; ++i) {
-      const double theta = (j + 0.5) * kPi / nv, phi = (i + 0.5) * 2.0 * kPi / nu;
-      const glm::vec3 d(float(std::sin(theta) * std::cos(phi)), float(std::cos(theta)),
-                        float(std::sin(theta) * std::sin(phi)));
-      exact += environmentLookup(e, d).x * std::cos(theta) * std::sin(theta) * (kPi / nv) *
-               (2.0 * kPi / nu);
-    }
-  exact *= 0.5 / kPi;
+  const double exact = 0.5 * test::upperHemisphereIrradianceOverPi(e, false);
   const ref::Result r = ref::render(scene, smallSettings(ref::Quantity::Direct, 64));
   double sum = 0.0, sum2 = 0.0;
   int n = 0;

@@ -6,7 +6,6 @@
 
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <functional>
 #include <limits>
 
@@ -15,7 +14,6 @@
 #include "../effects/ssao/ssao_kernel.h"
 #include "gi/effect_config.h"
 #include "gi/renderer.h"
-#include "gi/scene_io.h"
 #include "quad_scene.h"
 #include "test_support.h"
 #include "vulkan_fixture.h"
@@ -351,17 +349,7 @@ TEST_F(SsaoTest, NoDarkPixelsOnTheOutlineOfACurvedObject) {
   // pointed into the object, whose pixels then read AO ~0.1 (isolated dots the blur keeps, as it
   // does not average across the outline). Every pixel of the object must stay open.
   for (const char* scale : {"1", "[0.1, 2, 0.1]"}) {
-    const std::string path = ::testing::TempDir() + "/ssao_outline.json";
-    {
-      std::ofstream f(path);
-      f << R"({
-      "models": [
-        { "primitive": "plane", "size": 40, "rotation": [90, 0, 0], "translation": [0, 0, -4] },
-        { "primitive": "sphere", "radius": 0.4, "segments": 48, "rings": 24, "scale": )"
-        << scale << R"( } ],
-      "camera": { "position": [0, 0, 3], "target": [0, 0, 0], "yfov_deg": 45 } })";
-    }
-    const Scene s = loadSceneJson(path);
+    const Scene s = test::outlineScene(scale, ::testing::TempDir() + "/ssao_outline.json");
     for (const char* blur : {"ssao.blur_radius=0", "ssao.blur_radius=2"}) {
       Result r = render(s, {"ssao.radius=0.5", "ssao.samples=16", blur}, 320, 240);
       auto onSphere = [&](int x, int y) { return r.worldAt(x, y).z > -1.0f; };

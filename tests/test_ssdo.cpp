@@ -10,6 +10,7 @@
 #include <array>
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <string>
 
 #include "../effects/ssdo/ssdo_samples.h"
@@ -25,6 +26,19 @@
 
 namespace gi {
 namespace {
+
+// A w x h Radiance .hdr (flat RGBE texels, rows top to bottom: row 0 looks up) of texel(x, y).
+using Rgbe = std::array<unsigned char, 4>;
+void writeRgbeMap(const std::string& path, int w, int h,
+                  const std::function<Rgbe(int, int)>& texel) {
+  std::ofstream out(path, std::ios::binary);
+  out << "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y " << h << " +X " << w << "\n";
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const Rgbe t = texel(x, y);
+      out.write(reinterpret_cast<const char*>(t.data()), 4);
+    }
+}
 
 constexpr uint32_t kW = 160, kH = 120;
 
@@ -151,12 +165,9 @@ TEST_F(SsdoTest, OpenPlaneUnderAConstantEnvironmentIsAlbedoTimesRadiance) {
 // L again. Tolerance 2%: the map's RGBE quantization and the SH projection's quadrature.
 TEST_F(SsdoTest, OpenPlaneUnderAConstantMapIsAlbedoTimesRadiance) {
   const std::string dir = ::testing::TempDir();
-  {
-    std::ofstream out(dir + "/ssdo_flat.hdr", std::ios::binary);
-    out << "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 8 +X 16\n";
-    const unsigned char px[4] = {128, 96, 64, 128};  // (0.5, 0.375, 0.25)
-    for (int i = 0; i < 16 * 8; ++i) out.write(reinterpret_cast<const char*>(px), 4);
-  }
+  writeRgbeMap(dir + "/ssdo_flat.hdr", 16, 8, [](int, int) {
+    return Rgbe{128, 96, 64, 128};  // (0.5, 0.375, 0.25)
+  });
   const Scene s = jsonScene("map", R"({
       "models": [ { "primitive": "plane", "size": 40, "material": { "base_color": [0.5, 0.5, 0.5] } } ],
       "lights": [ { "type": "directional", "intensity": 0, "casts_shadows": false } ],
@@ -193,20 +204,13 @@ TEST_F(SsdoTest, OpenPlaneUnderAConstantMapIsAlbedoTimesRadiance) {
 // sun too often or not at all (+27% here; +156% / +28% / -36% at 8 / 16 / 32 samples).
 TEST_F(SsdoTest, SunInAMapCastsItsShadowWhenTheMapIsReadPerDirection) {
   const std::string dir = ::testing::TempDir();
-  {
-    // RGBE: 0.05 = 205 x 2^(124 - 128 - 8 + ...); written as mantissa 205, exponent 124 - 0
-    // (0.05 ~ 205 / 256 x 2^-4); the sun 1000 ~ 250 / 256 x 2^10.
-    std::ofstream out(dir + "/ssdo_sun.hdr", std::ios::binary);
-    out << "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 32 +X 64\n";
-    const unsigned char dim[4] = {205, 205, 205, 124}, sun[4] = {250, 250, 250, 138};
-    for (int y = 0; y < 32; ++y)
-      for (int x = 0; x < 64; ++x) {
-        // Direction (1, 1, 0) / sqrt 2: v = acos(y) / pi = 0.25 (rows 7-8), u = 0 (columns
-        // 63 and 0).
-        const bool isSun = (y == 7 || y == 8) && (x == 63 || x == 0);
-        out.write(reinterpret_cast<const char*>(isSun ? sun : dim), 4);
-      }
-  }
+  // RGBE (mantissa + 0.5) / 256 x 2^(exponent - 128): 0.05 ~ 205.5 / 256 x 2^-4, the sun
+  // 1000 ~ 250.5 / 256 x 2^10, in direction (1, 1, 0) / sqrt 2: v = acos(y) / pi = 0.25 (rows
+  // 7-8), u = 0 (columns 63 and 0).
+  writeRgbeMap(dir + "/ssdo_sun.hdr", 64, 32, [](int x, int y) {
+    const bool sun = (y == 7 || y == 8) && (x == 63 || x == 0);
+    return sun ? Rgbe{250, 250, 250, 138} : Rgbe{205, 205, 205, 124};
+  });
   const Scene s = jsonScene("sun", R"({
       "models": [ { "primitive": "plane", "size": 40, "material": { "base_color": [0.5, 0.5, 0.5] } },
                   { "primitive": "box", "size": [1, 1, 1], "translation": [0, 0.5, 0],
@@ -233,20 +237,7 @@ TEST_F(SsdoTest, SunInAMapCastsItsShadowWhenTheMapIsReadPerDirection) {
   };
   // The open floor's exact value: albedo x (1 / pi) int L cos over the upper hemisphere (of the
   // bilinear map, whose integral is the texels'), midpoint rule on a fine grid.
-  double exact = 0.0;
-  {
-    const int nu = 1024, nv = 512;
-    for (int j = 0; j < nv / 2; ++j)
-      for (int i = 0; i < nu; ++i) {
-        const double theta = (j + 0.5) * M_PI / nv, phi = (i + 0.5) * 2.0 * M_PI / nu;
-        const glm::vec3 d(float(std::sin(theta) * std::cos(phi)), float(std::cos(theta)),
-                          float(std::sin(theta) * std::sin(phi)));
-        const glm::vec3 L = environmentLookup(s.environment, d);
-        const double lum = 0.2126 * L.x + 0.7152 * L.y + 0.0722 * L.z;
-        exact += lum * std::cos(theta) * std::sin(theta) * (M_PI / nv) * (2.0 * M_PI / nu);
-      }
-    exact *= 0.5 / M_PI;
-  }
+  const double exact = 0.5 * test::upperHemisphereIrradianceOverPi(s.environment);
   double ratio[3], open[3];
   const char* modes[3] = {"sh9", "map", "mis"};
   for (int m = 0; m < 3; ++m) {
@@ -356,15 +347,10 @@ TEST_F(SsdoTest, ShadowNextToABoxTakesTheColourOfTheUnblockedSky) {
 // 0.500 open) and through multiple importance sampling (0.692, 0.325, 0.496: the sharp split).
 TEST_F(SsdoTest, ShadowsOnEachSideOfABoxTakeTheColourOfTheOtherSide) {
   const std::string dir = ::testing::TempDir();
-  {
-    std::ofstream out(dir + "/ssdo_red_blue.hdr", std::ios::binary);
-    out << "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 16 +X 32\n";
-    // Column x: u = (x + 0.5) / 32 = atan(z, x) / 2 pi: x < 0 (red) for u in (0.25, 0.75).
-    const unsigned char red[4] = {128, 0, 0, 129}, blue[4] = {0, 0, 128, 129};
-    for (int y = 0; y < 16; ++y)
-      for (int x = 0; x < 32; ++x)
-        out.write(reinterpret_cast<const char*>(x >= 8 && x < 24 ? red : blue), 4);
-  }
+  // Column x: u = (x + 0.5) / 32 = atan(z, x) / 2 pi: x < 0 (red) for u in (0.25, 0.75).
+  writeRgbeMap(dir + "/ssdo_red_blue.hdr", 32, 16, [](int x, int) {
+    return x >= 8 && x < 24 ? Rgbe{128, 0, 0, 129} : Rgbe{0, 0, 128, 129};
+  });
   const Scene s = jsonScene("red_blue", R"({
       "models": [
         { "primitive": "plane", "size": 40, "material": { "base_color": [0.8, 0.8, 0.8] } },

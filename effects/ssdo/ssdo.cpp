@@ -194,8 +194,9 @@ class SsdoEffect : public gi::Effect {
     // The importance samples of environment_sampling=mis: two vec4 per sample slot (bound, but
     // not read, in the other modes).
     if (!environmentSamples_)
-      environmentSamples_ = gi::vk::Buffer(vk, kEnvironmentSlots * 2 * sizeof(float[4]),
-                                           VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false);
+      environmentSamples_ =
+          gi::vk::Buffer(vk, VkDeviceSize(kEnvironmentSlots) * 2 * sizeof(float[4]),
+                         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false);
     if (environmentSampling_ == 2)
       environmentSamplesPipeline_ = gi::vk::Pipeline::compute(
           vk, {std::begin(ssdo_env_samples_comp), std::end(ssdo_env_samples_comp)},

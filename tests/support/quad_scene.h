@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -12,6 +14,7 @@
 
 #include "gi/image_io.h"
 #include "gi/scene.h"
+#include "gi/scene_io.h"
 
 namespace gi::test {
 
@@ -81,6 +84,23 @@ inline std::vector<HardCornerView> hardCornerViews() {
   return {{{6, 1e-3f, 0.5f}, {0, 0, 0.5f}, 0.05f, 100.0f},
           {{2.5f, 1.6f, 0}, {0, 0, 0}, 1e-4f, 1e5f},
           {{2.5f, 0.3f, 0}, {0, 3, 0}, 1e-4f, 1e5f}};
+}
+
+// The outline case: a tessellated sphere of radius 0.4 (48 x 24), scaled by `scale` (JSON: "1",
+// or "[0.1, 2, 0.1]" for a thin vertical "cylinder"), 4 units (8 radii of 0.5) in front of a
+// wall, the camera at z = 3: convex objects, AO 1 everywhere on them. Written as a scene file
+// to `path` (primitives are a scene file's) and loaded.
+inline Scene outlineScene(const std::string& scale, const std::string& path) {
+  {
+    std::ofstream f(path);
+    f << R"({
+      "models": [
+        { "primitive": "plane", "size": 40, "rotation": [90, 0, 0], "translation": [0, 0, -4] },
+        { "primitive": "sphere", "radius": 0.4, "segments": 48, "rings": 24, "scale": )"
+      << scale << R"( } ],
+      "camera": { "position": [0, 0, 3], "target": [0, 0, 0], "yfov_deg": 45 } })";
+  }
+  return loadSceneJson(path);
 }
 
 // The depth-discontinuity case: a wall at z = 0 and, 3 units in front of it, an open book (two

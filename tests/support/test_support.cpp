@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -58,6 +59,21 @@ void expectError(const std::function<void()>& f, ErrorKind kind,
       EXPECT_NE(std::string(e.what()).find(frag), std::string::npos)
           << "'" << frag << "' missing from: " << e.what();
   }
+}
+
+double upperHemisphereIrradianceOverPi(const Environment& env, bool luminance) {
+  const int nu = 1024, nv = 512;  // v over the whole sphere; the upper half's rows summed
+  double sum = 0.0;
+  for (int j = 0; j < nv / 2; ++j)
+    for (int i = 0; i < nu; ++i) {
+      const double theta = (j + 0.5) * M_PI / nv, phi = (i + 0.5) * 2.0 * M_PI / nu;
+      const glm::vec3 d(float(std::sin(theta) * std::cos(phi)), float(std::cos(theta)),
+                        float(std::sin(theta) * std::sin(phi)));
+      const glm::vec3 l = environmentLookup(env, d);
+      const double value = luminance ? 0.2126 * l.x + 0.7152 * l.y + 0.0722 * l.z : l.x;
+      sum += value * std::cos(theta) * std::sin(theta) * (M_PI / nv) * (2.0 * M_PI / nu);
+    }
+  return sum / M_PI;
 }
 
 }  // namespace gi::test

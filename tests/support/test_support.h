@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include "gi/environment.h"
 #include "gi/errors.h"
 
 namespace gi::test {
@@ -17,6 +18,12 @@ std::string sharedAsset(const std::string& relative);
 std::string assimpModel(const std::string& relative);
 // Path to a built executable in build/bin.
 std::string binPath(const std::string& name);
+
+// (1 / pi) int L cos over the upper hemisphere (+y) of environment `env` as
+// gi::environmentLookup reads it, per channel (luminance weights 0.2126, 0.7152, 0.0722 when
+// `luminance`): the exact environment term of an open floor per unit albedo, by the midpoint
+// rule on a 1024 x 256 grid of (phi, theta).
+double upperHemisphereIrradianceOverPi(const Environment& env, bool luminance = true);
 
 // `f` must throw a gi::Error of `kind` whose message contains every fragment.
 void expectError(const std::function<void()>& f, ErrorKind kind,
