@@ -33,7 +33,8 @@ layout(constant_id = 3) const int kLayers = 1;
 layout(constant_id = 4) const int kCameras = 0;
 // An equirect map's radiance per sample direction (kEnvironmentKind 2; setting
 // `environment_sampling`): 0, its SH9 (the sum over the open samples' moments); 1, the map
-// per direction (its texel: environmentTexelRadiance) over the cosine-distributed samples;
+// per direction (its texel: environment.glsl's environmentTexelRadiance) over the cosine-
+// distributed samples;
 // 2, the map with multiple importance sampling: the odd samples take their directions from the
 // engine's importance sampling of the map (ssdo_env_samples.comp), the even ones stay cosine-
 // distributed, and each is weighted by the balance heuristic, 2 L V (cos / pi) /
@@ -363,7 +364,8 @@ void main() {
     bounce += send;
   }
   if (kEnvironmentKind == 1) direct = direct.x * frame.skyGround.rgb * frame.skyZenith.w;
-  if (kEnvironmentKind == 2 && kEnvironmentSampling == 0) direct = shFromMoments(direct.x, m1, m2, m2x, mat3(Tw, Bw, Nw));
+  if (kEnvironmentKind == 2 && kEnvironmentSampling == 0)
+    direct = shFromMoments(direct.x, m1, m2, m2x, mat3(Tw, Bw, Nw));
   direct *= 1.0 / float(kSamples);
   bounce *= ssdo.params.z;
   imageStore(outRaw, p,
