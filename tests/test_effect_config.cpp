@@ -118,7 +118,9 @@ TEST(EffectConfig, PrecedenceDefaultsPresetSceneCommandLine) {
 TEST(EffectConfig, WorldLengthDefaultsFollowABareModelsSize) {
   // The real plugins' radii are world lengths: a model loaded without a scene file (the
   // 2CylinderEngine glTF, hundreds of units across) scales their defaults by its size; the
-  // built-in room and scene files keep them; preset, scene and --set values are not scaled.
+  // built-in room and scene files keep them. A preset's lengths are for the reference size too
+  // (presets are written for no scene in particular) and scale with them; scene-file and --set
+  // values are in the scene's own units and are not scaled.
   EffectRegistry reg;
   reg.scanDirectory(test::binPath("plugins"));
   EffectOverrides cli;
@@ -136,8 +138,16 @@ TEST(EffectConfig, WorldLengthDefaultsFollowABareModelsSize) {
   ASSERT_GT(scale, 10.0f) << "the engine model is hundreds of units across";
   EXPECT_NEAR(resolveEffects(model, nullptr, cli, reg)[0].settings.number("radius"), 0.5 * scale,
               1e-6 * scale);
+  const std::string dir = test::makeTempDir("preset-lengths");
+  const Preset preset = loadPreset(
+      writeFile(dir, "p.json", R"({"effects": {"ssao": {"radius": 0.3, "samples": 8}}})"));
+  EXPECT_DOUBLE_EQ(resolveEffects(room, &preset, cli, reg)[0].settings.number("radius"), 0.3);
+  EXPECT_NEAR(resolveEffects(model, &preset, cli, reg)[0].settings.number("radius"), 0.3 * scale,
+              1e-6 * scale);
+  EXPECT_EQ(resolveEffects(model, &preset, cli, reg)[0].settings.integer("samples"), 8);
   cli.sets = {"ssao.radius=0.25"};
   EXPECT_DOUBLE_EQ(resolveEffects(model, nullptr, cli, reg)[0].settings.number("radius"), 0.25);
+  EXPECT_DOUBLE_EQ(resolveEffects(model, &preset, cli, reg)[0].settings.number("radius"), 0.25);
   // Only Float settings marked as lengths scale: the tap count does not.
   EXPECT_EQ(resolveEffects(model, nullptr, cli, reg)[0].settings.integer("samples"),
             reg.defaultSettings("ssao").integer("samples"));

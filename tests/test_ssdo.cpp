@@ -511,9 +511,10 @@ TEST_F(SsdoTest, PassListFollowsBounceAndBlurAndBounceOffKeepsTheDirectionalTerm
     }
     return f;
   };
-  const auto on = passes({"ssdo.bounce=true"});
-  const auto off = passes({"ssdo.bounce=false"});
-  const auto resolveOnly = passes({"ssdo.blur_radius=0"});
+  // One layer: the second layer's pass is PeelingAndCameraPassesOnlyWhenAsked's subject.
+  const auto on = passes({"ssdo.bounce=true", "ssdo.layers=1"});
+  const auto off = passes({"ssdo.bounce=false", "ssdo.layers=1"});
+  const auto resolveOnly = passes({"ssdo.blur_radius=0", "ssdo.layers=1"});
   const std::vector<std::string> blurred = {"gbuffer",   "ssdo_surface", "ssdo",
                                             "ssdo_blur", "lighting",     "tonemap"};
   EXPECT_EQ(on.passes, blurred);
@@ -795,7 +796,7 @@ TEST_F(SsdoTest, ContactShadowsRestoreTheShadowTheBiasRemoves) {
 
 TEST_F(SsdoTest, PeelingAndCameraPassesOnlyWhenAsked) {
   const Scene scene = test::cornerScene();  // no lights: no shadow pass
-  auto passes = [&](const std::vector<std::string>& sets) {
+  auto passes = [&](std::vector<std::string> sets) {
     Renderer r(ctx(), scene, settingsFor(scene, "ssdo", sets), &registry);
     r.renderFrame();
     EXPECT_TRUE(finite(r.readTarget("ambient")));
@@ -803,21 +804,24 @@ TEST_F(SsdoTest, PeelingAndCameraPassesOnlyWhenAsked) {
     return r.passNames();
   };
   using V = std::vector<std::string>;
-  EXPECT_EQ(passes({}), (V{"gbuffer", "ssdo_surface", "ssdo", "ssdo_blur", "lighting", "tonemap"}));
-  EXPECT_EQ(passes({"ssdo.layers=2"}), (V{"gbuffer", "ssdo_peel", "ssdo_surface", "ssdo",
-                                          "ssdo_blur", "lighting", "tonemap"}));
-  EXPECT_EQ(passes({"ssdo.cameras=2"}),
+  // Two layers by default (one peel pass); `layers` 1 turns peeling off.
+  EXPECT_EQ(passes({}), (V{"gbuffer", "ssdo_peel", "ssdo_surface", "ssdo", "ssdo_blur", "lighting",
+                           "tonemap"}));
+  EXPECT_EQ(passes({"ssdo.layers=1"}),
+            (V{"gbuffer", "ssdo_surface", "ssdo", "ssdo_blur", "lighting", "tonemap"}));
+  EXPECT_EQ(passes({"ssdo.layers=1", "ssdo.cameras=2"}),
             (V{"gbuffer", "ssdo_cameras", "ssdo_camera_surface", "ssdo_surface", "ssdo",
                "ssdo_blur", "lighting", "tonemap"}));
-  EXPECT_EQ(passes({"ssdo.contact_shadows=true"}), (V{"gbuffer", "ssdo_contact", "ssdo_surface",
-                                                      "ssdo", "ssdo_blur", "lighting", "tonemap"}));
-  EXPECT_EQ(passes({"ssdo.layers=2", "ssdo.cameras=4"}),
+  EXPECT_EQ(
+      passes({"ssdo.layers=1", "ssdo.contact_shadows=true"}),
+      (V{"gbuffer", "ssdo_contact", "ssdo_surface", "ssdo", "ssdo_blur", "lighting", "tonemap"}));
+  EXPECT_EQ(passes({"ssdo.cameras=4"}),
             (V{"gbuffer", "ssdo_peel", "ssdo_cameras", "ssdo_camera_surface", "ssdo_surface",
                "ssdo", "ssdo_blur", "lighting", "tonemap"}));
   // The environment's importance samples only for environment_sampling=mis.
-  EXPECT_EQ(passes({"ssdo.environment_sampling=map"}),
+  EXPECT_EQ(passes({"ssdo.layers=1", "ssdo.environment_sampling=map"}),
             (V{"gbuffer", "ssdo_surface", "ssdo", "ssdo_blur", "lighting", "tonemap"}));
-  EXPECT_EQ(passes({"ssdo.environment_sampling=mis"}),
+  EXPECT_EQ(passes({"ssdo.layers=1", "ssdo.environment_sampling=mis"}),
             (V{"gbuffer", "ssdo_surface", "ssdo_env_samples", "ssdo", "ssdo_blur", "lighting",
                "tonemap"}));
 }

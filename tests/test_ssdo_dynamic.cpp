@@ -80,108 +80,119 @@ TEST_F(SsdoDynamicTest, ShadowAndBounceFollowTheWalkingFoxFrameByFrame) {
     stack.insert(stack.end(), n.children.begin(), n.children.end());
   }
   const float R = 0.5f;
-  const std::vector<std::string> sets = {"ssdo.radius=0.5"};
-  Renderer a(ctx(), withFox, settingsFor(withFox, sets), &registry);
-  Renderer b(ctx(), noFox, settingsFor(noFox, sets), &registry);
+  // One layer (the bounds above were measured with it) and the default two: with the Fox's
+  // back faces as a second layer, samples behind its body are no longer blocked, so about half
+  // as many floor pixels darken (the contact shadow under it) and their centroid is noisier:
+  // 8 / 6 pixels off the footprint / its motion there (measured 1.2..5.6 / 0..4.4), still
+  // below the ~9 of a one-frame lag.
+  for (const int layers : {1, 2}) {
+    SCOPED_TRACE("layers " + std::to_string(layers));
+    const std::vector<std::string> sets = {"ssdo.radius=0.5",
+                                           "ssdo.layers=" + std::to_string(layers)};
+    Renderer a(ctx(), withFox, settingsFor(withFox, sets), &registry);
+    Renderer b(ctx(), noFox, settingsFor(noFox, sets), &registry);
 
-  const int frames = 6;  // at 3 s the Fox walks behind the morphing cube
-  const double dt = 0.5;
-  std::vector<bool> darkenedBefore(size_t(kW * kH), false);
-  glm::vec2 firstDark(0.0f), firstFoot(0.0f);
-  int returned = 0;
-  for (int k = 0; k < frames; ++k) {
-    SCOPED_TRACE("frame " + std::to_string(k));
-    a.setTime(k * dt);
-    b.setTime(k * dt);
-    const test::SsdoFrame fa = grab(a), fb = grab(b);
-    ASSERT_TRUE(test::finite(fa.ambient) && test::finite(fa.indirect));
-    // The Fox's visible surface: depth in front of the Fox-less one (reverse-Z: larger).
-    std::vector<glm::vec3> foxPoints;
-    glm::vec3 foxMean(0.0f);
-    for (int y = 0; y < fa.h; ++y)
-      for (int x = 0; x < fa.w; ++x)
-        if (fa.depthAt(x, y) > fb.depthAt(x, y) * (1.0f + 1e-4f) + 1e-7f) {
-          foxPoints.push_back(fa.worldAt(x, y));
-          foxMean += foxPoints.back();
-        }
-    ASSERT_GT(foxPoints.size(), 100u) << "the Fox must be in view";
-    foxMean /= float(foxPoints.size());
-    const glm::vec2 foot = fa.project({foxMean.x, 0.0f, foxMean.z});
+    const int frames = 6;  // at 3 s the Fox walks behind the morphing cube
+    const double dt = 0.5;
+    std::vector<bool> darkenedBefore(size_t(kW * kH), false);
+    glm::vec2 firstDark(0.0f), firstFoot(0.0f);
+    int returned = 0;
+    for (int k = 0; k < frames; ++k) {
+      SCOPED_TRACE("frame " + std::to_string(k));
+      a.setTime(k * dt);
+      b.setTime(k * dt);
+      const test::SsdoFrame fa = grab(a), fb = grab(b);
+      ASSERT_TRUE(test::finite(fa.ambient) && test::finite(fa.indirect));
+      // The Fox's visible surface: depth in front of the Fox-less one (reverse-Z: larger).
+      std::vector<glm::vec3> foxPoints;
+      glm::vec3 foxMean(0.0f);
+      for (int y = 0; y < fa.h; ++y)
+        for (int x = 0; x < fa.w; ++x)
+          if (fa.depthAt(x, y) > fb.depthAt(x, y) * (1.0f + 1e-4f) + 1e-7f) {
+            foxPoints.push_back(fa.worldAt(x, y));
+            foxMean += foxPoints.back();
+          }
+      ASSERT_GT(foxPoints.size(), 100u) << "the Fox must be in view";
+      foxMean /= float(foxPoints.size());
+      const glm::vec2 foot = fa.project({foxMean.x, 0.0f, foxMean.z});
 
-    // Per pixel, the distance of its surface to the nearest visible Fox point (0 on the Fox).
-    std::vector<float> nearest(size_t(kW * kH), 0.0f);
-    for (int y = 0; y < fa.h; ++y)
-      for (int x = 0; x < fa.w; ++x) {
-        if (fa.sky(x, y)) {
-          nearest[size_t(y) * kW + size_t(x)] = 1e9f;
-          continue;
+      // Per pixel, the distance of its surface to the nearest visible Fox point (0 on the Fox).
+      std::vector<float> nearest(size_t(kW * kH), 0.0f);
+      for (int y = 0; y < fa.h; ++y)
+        for (int x = 0; x < fa.w; ++x) {
+          if (fa.sky(x, y)) {
+            nearest[size_t(y) * kW + size_t(x)] = 1e9f;
+            continue;
+          }
+          const glm::vec3 p = fa.worldAt(x, y);
+          float d = 1e9f;
+          for (const glm::vec3& q : foxPoints) d = std::min(d, glm::length(q - p));
+          nearest[size_t(y) * kW + size_t(x)] = d;
         }
-        const glm::vec3 p = fa.worldAt(x, y);
-        float d = 1e9f;
-        for (const glm::vec3& q : foxPoints) d = std::min(d, glm::length(q - p));
-        nearest[size_t(y) * kW + size_t(x)] = d;
+      // Far: every pixel of the 5x5 block the blur (radius 2, x then y) gathers is more than
+      // 2.2 R from the Fox (a sample reaches R; an occluder counts within R of it in view depth,
+      // up to 1.1 R along an oblique ray).
+      auto far = [&](int x, int y) {
+        for (int j = std::max(0, y - 2); j <= std::min(fa.h - 1, y + 2); ++j)
+          for (int i = std::max(0, x - 2); i <= std::min(fa.w - 1, x + 2); ++i)
+            if (nearest[size_t(j) * kW + size_t(i)] <= 2.2f * R) return false;
+        return true;
+      };
+
+      glm::dvec3 dark(0.0), bounce(0.0);  // (sum w x, sum w y, sum w)
+      int nDark = 0, nBounce = 0, farFloor = 0, farUnlit = 0;
+      for (int y = 0; y < fa.h; ++y)
+        for (int x = 0; x < fa.w; ++x) {
+          if (fa.sky(x, y) || fa.depthAt(x, y) != fb.depthAt(x, y)) continue;
+          const glm::vec3 p = fa.worldAt(x, y);
+          if (std::abs(p.y) > 1e-2f) continue;  // the floor only
+          const size_t i = size_t(y) * kW + size_t(x);
+          const float open = fb.sum(fb.ambient, x, y), dDark = open - fa.sum(fa.ambient, x, y);
+          const float dBounce = fa.sum(fa.indirect, x, y) - fb.sum(fb.indirect, x, y);
+          if (dDark > 0.02f * open) {
+            dark += glm::dvec3(x * dDark, y * dDark, dDark);
+            ++nDark;
+            darkenedBefore[i] = true;
+          }
+          if (dBounce > 1e-4f) {
+            bounce += glm::dvec3(x * dBounce, y * dBounce, dBounce);
+            ++nBounce;
+          }
+          if (!far(x, y)) continue;
+          ++farFloor;
+          ASSERT_EQ(fa.sum(fa.ambient, x, y), open) << x << "," << y << " far from the Fox";
+          if (fb.sum(fb.indirect, x, y) == 0.0f) {
+            ++farUnlit;
+            ASSERT_EQ(fa.sum(fa.indirect, x, y), 0.0f) << x << "," << y << " far from the Fox";
+          }
+          if (darkenedBefore[i] && !(dDark > 0.02f * open)) ++returned;
+        }
+      ASSERT_GE(nDark, 20);
+      ASSERT_GE(nBounce, 20);
+      ASSERT_GT(farFloor, 1000);
+      ASSERT_GT(farUnlit, 1000);
+      const glm::vec2 cDark(dark.x / dark.z, dark.y / dark.z),
+          cBounce(bounce.x / bounce.z, bounce.y / bounce.z);
+      if (k == 0) {
+        firstDark = cDark;
+        firstFoot = foot;
       }
-    // Far: every pixel of the 5x5 block the blur (radius 2, x then y) gathers is more than
-    // 2.2 R from the Fox (a sample reaches R; an occluder counts within R of it in view depth,
-    // up to 1.1 R along an oblique ray).
-    auto far = [&](int x, int y) {
-      for (int j = std::max(0, y - 2); j <= std::min(fa.h - 1, y + 2); ++j)
-        for (int i = std::max(0, x - 2); i <= std::min(fa.w - 1, x + 2); ++i)
-          if (nearest[size_t(j) * kW + size_t(i)] <= 2.2f * R) return false;
-      return true;
-    };
-
-    glm::dvec3 dark(0.0), bounce(0.0);  // (sum w x, sum w y, sum w)
-    int nDark = 0, nBounce = 0, farFloor = 0, farUnlit = 0;
-    for (int y = 0; y < fa.h; ++y)
-      for (int x = 0; x < fa.w; ++x) {
-        if (fa.sky(x, y) || fa.depthAt(x, y) != fb.depthAt(x, y)) continue;
-        const glm::vec3 p = fa.worldAt(x, y);
-        if (std::abs(p.y) > 1e-2f) continue;  // the floor only
-        const size_t i = size_t(y) * kW + size_t(x);
-        const float open = fb.sum(fb.ambient, x, y), dDark = open - fa.sum(fa.ambient, x, y);
-        const float dBounce = fa.sum(fa.indirect, x, y) - fb.sum(fb.indirect, x, y);
-        if (dDark > 0.02f * open) {
-          dark += glm::dvec3(x * dDark, y * dDark, dDark);
-          ++nDark;
-          darkenedBefore[i] = true;
-        }
-        if (dBounce > 1e-4f) {
-          bounce += glm::dvec3(x * dBounce, y * dBounce, dBounce);
-          ++nBounce;
-        }
-        if (!far(x, y)) continue;
-        ++farFloor;
-        ASSERT_EQ(fa.sum(fa.ambient, x, y), open) << x << "," << y << " far from the Fox";
-        if (fb.sum(fb.indirect, x, y) == 0.0f) {
-          ++farUnlit;
-          ASSERT_EQ(fa.sum(fa.indirect, x, y), 0.0f) << x << "," << y << " far from the Fox";
-        }
-        if (darkenedBefore[i] && !(dDark > 0.02f * open)) ++returned;
-      }
-    ASSERT_GE(nDark, 20);
-    ASSERT_GE(nBounce, 20);
-    ASSERT_GT(farFloor, 1000);
-    ASSERT_GT(farUnlit, 1000);
-    const glm::vec2 cDark(dark.x / dark.z, dark.y / dark.z),
-        cBounce(bounce.x / bounce.z, bounce.y / bounce.z);
-    if (k == 0) {
-      firstDark = cDark;
-      firstFoot = foot;
+      const float moved = glm::length((cDark - firstDark) - (foot - firstFoot));
+      std::printf(
+          "t %.1f: footprint (%.1f, %.1f); darkened %d px at (%.1f, %.1f), off by %.1f px, moved "
+          "off by %.1f px; bounce %d px at (%.1f, %.1f), off by %.1f px\n",
+          k * dt, foot.x, foot.y, nDark, cDark.x, cDark.y, glm::length(cDark - foot), moved,
+          nBounce, cBounce.x, cBounce.y, glm::length(cBounce - foot));
+      EXPECT_LT(glm::length(cDark - foot), layers == 1 ? 6.0f : 8.0f);
+      EXPECT_LT(moved, layers == 1 ? 4.0f : 6.0f);
+      EXPECT_LT(glm::length(cBounce - foot), 8.0f);
     }
-    const float moved = glm::length((cDark - firstDark) - (foot - firstFoot));
     std::printf(
-        "t %.1f: footprint (%.1f, %.1f); darkened %d px at (%.1f, %.1f), off by %.1f px, moved "
-        "off by %.1f px; bounce %d px at (%.1f, %.1f), off by %.1f px\n",
-        k * dt, foot.x, foot.y, nDark, cDark.x, cDark.y, glm::length(cDark - foot), moved, nBounce,
-        cBounce.x, cBounce.y, glm::length(cBounce - foot));
-    EXPECT_LT(glm::length(cDark - foot), 6.0f);
-    EXPECT_LT(moved, 4.0f);
-    EXPECT_LT(glm::length(cBounce - foot), 8.0f);
+        "layers %d: floor pixels darkened earlier and back at the unoccluded value: %d "
+        "(pixel-frames)\n",
+        layers, returned);
+    EXPECT_GT(returned, 20);
   }
-  std::printf("floor pixels darkened earlier and back at the unoccluded value: %d (pixel-frames)\n",
-              returned);
-  EXPECT_GT(returned, 20);
 }
 
 // ---- flicker on a camera path -----------------------------------------------------------------
@@ -207,12 +218,12 @@ std::vector<CameraView> cameraPath(const CameraView& start, int moving, int stop
 // change of the ambient term after reprojection, relative to its mean. For a term that belongs
 // to the surface the reprojected change is only resampling (bilinear) and the slow change of
 // what the screen shows; a screen-fixed pattern sliding over the surfaces, or samples that
-// change every frame, make it jump. Bound test::kFlickerBound = 1.5%: measured 0.83% (worst pair
-// 1.10%) with the blur, which averages every 4x4 pattern phase, so a surface point's value
-// barely depends on where it falls in the pattern; 5.6% without the blur (the next test: a
-// point changes sample set whenever it changes pixel). Where the camera stops the frames are
-// identical: SSDO keeps no temporal state and draws no per-frame random numbers (per-frame
-// sample sets give 1.24% at a still camera: the next test).
+// change every frame, make it jump. Bound test::kFlickerBound = 1.5%: measured 0.71% (worst pair
+// 1.04%; one layer: 0.83%) with the blur, which averages every 4x4 pattern phase, so a surface
+// point's value barely depends on where it falls in the pattern; 5.4% without the blur (the next
+// test: a point changes sample set whenever it changes pixel). Where the camera stops the frames
+// are identical: SSDO keeps no temporal state and draws no per-frame random numbers (per-frame
+// sample sets give 1.15% at a still camera: the next test).
 // The bounce term's own flicker bound: its screen-space senders change as the pattern slides
 // over the surfaces (measured 0.193; it is 4% of the ambient term, so ~0.8% of the sum).
 constexpr double kBounceFlickerBound = 0.25;
@@ -271,10 +282,10 @@ TEST_F(SsdoDynamicTest, CameraPathOverAStaticSceneDoesNotFlicker) {
 }
 
 // The criteria can fail: without the blur the screen-fixed pattern slides over the surfaces
-// (16 frames of the path: > 2x the bound, measured 5.6%); with the sample sets changed every
+// (16 frames of the path: > 2x the bound, measured 5.4%); with the sample sets changed every
 // frame (pattern_sets cycling 16, 15, 13, 11: other Hammersley sets each frame, as a per-frame
 // random rotation would give) a still camera sees a different image each frame (8 frames:
-// > 0.5x the bound, measured 1.24%, where SSDO's own still frames are identical).
+// > 0.5x the bound, measured 1.15%, where SSDO's own still frames are identical).
 TEST_F(SsdoDynamicTest, FlickerMetricCatchesASlidingPatternAndPerFrameSampleSets) {
   const Scene scene = makeDefaultScene();
   const int n = 16;

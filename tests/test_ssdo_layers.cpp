@@ -65,6 +65,7 @@ TEST_F(SsdoLayersTest, TheGraphRunsLayersMinusOnePeelPasses) {
     EXPECT_EQ(passes, expected) << "layers " << k;
   }
   const SettingDesc d = registry.defaultSettings("ssdo").desc("layers");
+  EXPECT_EQ(d.defaultValue, 2.0) << "seed 000 §4 and issue 12: two depth layers by default";
   EXPECT_EQ(d.minValue, 1.0);
   EXPECT_EQ(d.maxValue, 4.0);
   test::expectError([&] { settingsFor(scene, {"ssdo.layers=5"}); }, ErrorKind::InvalidData,

@@ -4,9 +4,10 @@
 // y half writes the outputs (ssdo_blur_x.comp, ssdo_resolve.comp; ssdo_resolve_ambient.comp
 // without the bounce). Publishes "ambient" (alpha 2: per unit diffuse albedo, replaces the
 // engine's environment x AO term) and "indirect" (x the diffuse albedo, added).
-// Optional (seed 000 §4), only built when asked: up to three more depth layers peeled through
-// the engine's layered-depth draw (`layers` 2..4, passes ssdo_peel, ssdo_peel2, ssdo_peel3;
-// layers 2 and 3 packed by ssdo_layers.comp), and `cameras` low-resolution
+// Depth peeling (seed 000 §4): `layers` - 1 more depth layers (2 by default, as the issue and
+// the paper's Fig. 5 ask; 1 turns it off) peeled through the engine's layered-depth draw
+// (passes ssdo_peel, ssdo_peel2, ssdo_peel3; layers 2 and 3 packed by ssdo_layers.comp).
+// Optional, only built when asked: `cameras` low-resolution
 // views whose G-buffers add occluders and senders (passes ssdo_cameras, ssdo_camera_surface).
 // Optional (seed 000 §5, `contact_shadows`): the contact shadows the shadow-map bias removes
 // (pass ssdo_contact, ssdo_contact.comp), applied to the lights SSDO publishes with the bounce,
@@ -115,9 +116,10 @@ class SsdoEffect : public gi::Effect {
          "the blur also rejects neighbours whose normal differs by more than acos(0.8) "
          "(off: the tangent-plane depth test alone, which lets creases blend over the radius)",
          true},
-        {"layers", SettingType::Int, 1, 1, gi::ssdo::kMaxLayers,
-         "depth layers (2..4: depth peeling, layers - 1 peel passes; a sample is blocked only "
-         "inside the solid intervals [layer 0, layer 1] and [layer 2, layer 3]: thin objects "
+        {"layers", SettingType::Int, 2, 1, gi::ssdo::kMaxLayers,
+         "depth layers (1: the G-buffer's alone; 2..4: depth peeling, layers - 1 peel passes; a "
+         "sample is blocked only inside the solid intervals [layer 0, layer 1] and [layer 2, layer "
+         "3]: thin objects "
          "stop shadowing what is behind them, and 3..4 see an occluder behind another one)",
          true},
         {"cameras", SettingType::Int, 0, 0, gi::ssdo::kMaxCameras,

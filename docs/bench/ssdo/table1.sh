@@ -4,7 +4,7 @@
 #   docs/bench/ssdo/table1.sh [--reps R] [--frames F] [--scene S] [--sizes WxH,WxH]
 #                             [--out DIR] [BUILD]
 # One gi-bench run per size; in it the six configurations (SSAO, SSDO, SSDO + bounce at N = 8
-# and 16; every other setting at its default) are interleaved repetition by repetition, so a
+# and 16; `layers` 1 as in the paper's table, every other setting at its default) are interleaved repetition by repetition, so a
 # repetition's ratio to SSAO compares measurements taken back to back. Scores are not used
 # here (the reference is 1 sample per pixel: only the times count), so of gi-bench's output
 # only results.json is kept, as DIR/<size>.json (every repetition's pass times); DIR/table1.csv
@@ -34,7 +34,7 @@ for size in "${size_list[@]}"; do
   [[ $size =~ ^([0-9]+)x([0-9]+)$ ]] || { echo "table1.sh: bad size $size" >&2; exit 2; }
   echo "== $size: $(uptime)" >&2
   "$bench" --scenes "$scene" --effects ssao,ssdo --presets none \
-    --grid ssao.samples=8,16 --grid ssdo.samples=8,16 --grid ssdo.bounce=false,true \
+    --grid ssao.samples=8,16 --grid ssdo.samples=8,16 --grid ssdo.bounce=false,true --grid ssdo.layers=1 \
     --width "${BASH_REMATCH[1]}" --height "${BASH_REMATCH[2]}" --frames "$frames" --reps "$reps" \
     --ref-spp 1 --cache "$tmp/cache" --no-progress --out "$tmp/$size" >&2
   mkdir -p "$out"

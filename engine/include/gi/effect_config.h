@@ -3,7 +3,9 @@
 // against the effects' declared settings; errors name the file (or flag), the key and the range.
 // The engine's own settings (gi/engine_settings.h) travel the same way under the name "engine"
 // (preset: "effects": {"engine": {...}}; scene: "effects": [{"name": "engine", "settings":
-// {...}}]; --set engine.key=value); "engine" is never an effect.
+// {...}}]; --set engine.key=value); "engine" is never an effect. World lengths
+// (SettingDesc::worldLength) in a preset are for the reference scene size, like the defaults:
+// a model loaded without a scene file scales both by Scene::lengthScale.
 #pragma once
 
 #include <map>

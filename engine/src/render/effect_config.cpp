@@ -20,6 +20,18 @@ void applyJson(SettingValues& s, const json& values, const std::string& origin) 
   for (auto it = values.begin(); it != values.end(); ++it) s.set(it.key(), it.value(), origin);
 }
 
+// A preset is written for no scene in particular: its world lengths, like the defaults, are
+// for the reference scene size and follow Scene::lengthScale (clamped to their range). Scene
+// files and --set give lengths in the scene's own units and are taken as they are.
+void applyPresetJson(SettingValues& s, const json& values, const std::string& origin,
+                     float lengthScale) {
+  applyJson(s, values, origin);
+  if (lengthScale == 1.0f) return;
+  for (const SettingDesc& d : s.descs())
+    if (d.worldLength && d.type == SettingType::Float && values.contains(d.name))
+      s.set(d.name, std::clamp(s.number(d.name) * lengthScale, d.minValue, d.maxValue), origin);
+}
+
 struct SetArg {
   std::string owner, key, value;
 };
@@ -36,7 +48,7 @@ SetArg parseSet(const std::string& s) {
 void layerEngineSettings(SettingValues& v, const Scene& scene, const Preset* preset,
                          const EffectOverrides& cli) {
   if (preset && preset->effects.count(kEngineSettingsOwner))
-    applyJson(v, preset->effects.at(kEngineSettingsOwner), preset->path);
+    applyPresetJson(v, preset->effects.at(kEngineSettingsOwner), preset->path, scene.lengthScale);
   for (const EffectRequest& r : scene.effects)
     if (isEngine(r.name)) applyJson(v, r.settings, scene.sourcePath);
   for (const std::string& s : cli.sets) {
@@ -119,7 +131,7 @@ std::vector<EffectConfig> resolveEffects(const Scene& scene, const Preset* prese
   layerEngineSettings(engine, scene, preset, cli);
   for (EffectConfig& c : configs) {
     if (preset && preset->effects.count(c.name))
-      applyJson(c.settings, preset->effects.at(c.name), preset->path);
+      applyPresetJson(c.settings, preset->effects.at(c.name), preset->path, scene.lengthScale);
     for (const EffectRequest& r : scene.effects)
       if (r.name == c.name) applyJson(c.settings, r.settings, scene.sourcePath);
   }
