@@ -3,12 +3,14 @@
 // (closed forms); the ambient transfer W is 1 in a closed white box, equals O for black
 // occluders, stays finite and in [0, 1] for every albedo (the guard); far foreground objects
 // cast no silhouette shadow; the 4x4 filter removes the interleave pattern without crossing
-// depth edges; no NaN at grazing angles, extreme clip planes or on the sky. The sample set and
-// the SPIR-V specialization are checked on the CPU.
+// depth edges; no NaN at grazing angles, extreme clip planes or on the sky; the radiance
+// transfer is the albedo transfer times the environment without lights and takes the colour of
+// a lit wall with them. The sample set and the SPIR-V specialization are checked on the CPU.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <limits>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -372,6 +374,136 @@ TEST_F(ObscuranceTest, TransferIsFiniteAndOrderedForEveryAlbedo) {
   EXPECT_GT(e.mean(), sweep[2].mean() + 0.01);
 }
 
+// transfer = radiance without lights or emission: the occluders send only their share of the
+// ambient light, so the published ambient is L^a x the albedo transfer W (the same sums; the
+// guard's phantom sample sees L^a in both) and the lit images agree. Tolerance: the sums'
+// half floats and the filter averaging L^a over its window (constant on each face here).
+TEST_F(ObscuranceTest, RadianceTransferWithoutLightsIsTheAlbedoTransferTimesTheAmbient) {
+  const Scene crevice = creviceScene(0.7f);  // no lights: the environment alone
+  auto lit = [&](const char* transfer, ImageRGBA32F* ambient) {
+    Renderer r(ctx(), crevice,
+               settingsFor(crevice, {transfer, "obscurance.radius=1", "obscurance.samples=16"}),
+               &registry);
+    r.renderFrame();
+    if (ambient) *ambient = r.readTarget("ambient");
+    return r.readTarget("lit");
+  };
+  ImageRGBA32F ambient;
+  const ImageRGBA32F a = lit("obscurance.transfer=albedo", nullptr);
+  const ImageRGBA32F b = lit("obscurance.transfer=radiance", &ambient);
+  const Result o = render(crevice, {"obscurance.transfer=off", "obscurance.radius=1"});
+  ASSERT_TRUE(finite(b));
+  ASSERT_TRUE(finite(ambient));
+  // Within 2 pixels of a crease the filter's window holds two faces and their different L^a:
+  // the worst there is measured, not bounded; elsewhere (0.1 from the creases) it is.
+  double worst = 0.0, worstAway = 0.0, sum = 0.0;
+  int n = 0;
+  for (int y = 0; y < o.h; ++y)
+    for (int x = 0; x < o.w; ++x) {
+      const size_t i = (size_t(y) * o.w + x) * 4;
+      if (o.sky(x, y)) {
+        EXPECT_EQ(ambient.pixels[i + 3], 0.0f) << "sky: the lighting pass's own term";
+        continue;
+      }
+      ASSERT_EQ(ambient.pixels[i + 3], 2.0f) << "per unit albedo, at " << x << "," << y;
+      // On a face one coordinate is 0; away from its creases both others exceed 0.1.
+      const glm::vec3 w = glm::abs(o.worldAt(x, y));
+      const bool away =
+          w.x + w.y + w.z - std::min({w.x, w.y, w.z}) - std::max({w.x, w.y, w.z}) > 0.1f;
+      for (int c = 0; c < 3; ++c) {
+        const double rel = std::abs(double(b.pixels[i + c]) - a.pixels[i + c]) /
+                           std::max(double(a.pixels[i + c]), 1e-3);
+        worst = std::max(worst, rel), sum += rel, ++n;
+        if (away) worstAway = std::max(worstAway, rel);
+      }
+    }
+  std::printf(
+      "no lights: lit radiance vs albedo transfer: mean relative difference %.5f, worst "
+      "%.5f away from the creases, %.5f next to them, over %d channels\n",
+      sum / n, worstAway, worst, n);
+  ASSERT_GT(n, 10000);
+  EXPECT_LT(sum / n, 2e-3);
+  EXPECT_LT(worstAway, 5e-3);  // measured 0.0013
+}
+
+// A white floor next to a red wall lit by a sun that grazes the floor: with transfer = radiance
+// the floor's ambient light near the wall turns red and rises above the open sky's (the wall
+// sends its direct light: W above 1), fading with the distance; the albedo transfer's stays
+// grey and below the open floor's.
+TEST_F(ObscuranceTest, RadianceTransferBleedsTheColourOfALitWall) {
+  const std::string path = ::testing::TempDir() + "/obscurance_red_wall.json";
+  {
+    std::ofstream f(path);
+    f << R"({
+      "models": [
+        { "primitive": "plane", "size": 20, "material": { "base_color": [0.8, 0.8, 0.8] } },
+        { "primitive": "plane", "size": 20, "rotation": [0, 0, -90],
+          "material": { "base_color": [0.9, 0.05, 0.05] } } ],
+      "lights": [ { "type": "directional", "direction": [-1, -0.02, 0], "intensity": 4 } ],
+      "camera": { "position": [2.5, 1.6, 0], "target": [0, 0, 0] } })";
+  }
+  const Scene scene = loadSceneJson(path);
+  struct Out {
+    ImageRGBA32F ambient, lit;
+  };
+  auto run = [&](const char* transfer) {
+    Renderer r(ctx(), scene, settingsFor(scene, {transfer, "obscurance.radius=0.5"}), &registry);
+    r.renderFrame();
+    Out out{{}, r.readTarget("lit")};
+    if (std::string(transfer).find("radiance") != std::string::npos) {
+      out.ambient = r.readTarget("ambient");
+      // The occluders' direct radiance first, after the shadow map it reads.
+      EXPECT_EQ(r.passNames(), (std::vector<std::string>{
+                                   "gbuffer", "shadow_0", "obscurance_radiance", "obscurance",
+                                   "obscurance_filter", "lighting", "tonemap"}));
+    }
+    return out;
+  };
+  const Out radiance = run("obscurance.transfer=radiance");
+  const Out albedo = run("obscurance.transfer=albedo");
+  const Result o = render(scene, {"obscurance.transfer=off", "obscurance.radius=0.5"});
+  ASSERT_TRUE(finite(radiance.ambient));
+  ASSERT_TRUE(finite(radiance.lit));
+  // Mean ambient (radiance) and lit colour (both) over floor pixels in a band of x.
+  auto band = [&](const ImageRGBA32F& img, float x0, float x1, int* count) {
+    glm::dvec3 sum(0.0);
+    *count = 0;
+    for (int y = 0; y < o.h; ++y)
+      for (int x = 0; x < o.w; ++x) {
+        if (o.sky(x, y)) continue;
+        const glm::vec3 w = o.worldAt(x, y);
+        if (std::abs(w.y) > 1e-3f || w.x < x0 || w.x >= x1 || std::abs(w.z) > 1.0f) continue;
+        const float* p = &img.pixels[(size_t(y) * o.w + x) * 4];
+        sum += glm::dvec3(p[0], p[1], p[2]), ++*count;
+      }
+    return *count > 0 ? sum / double(*count) : sum;
+  };
+  int nNear = 0, nMid = 0, nFar = 0;
+  const glm::dvec3 near = band(radiance.ambient, 0.02f, 0.1f, &nNear);
+  const glm::dvec3 mid = band(radiance.ambient, 0.25f, 0.4f, &nMid);
+  const glm::dvec3 far = band(radiance.ambient, 0.8f, 1.5f, &nFar);  // beyond R: open
+  ASSERT_GT(nNear, 20);
+  ASSERT_GT(nMid, 20);
+  ASSERT_GT(nFar, 20);
+  auto redness = [](glm::dvec3 c) { return c.r / std::max(c.g, 1e-9); };
+  std::printf(
+      "floor ambient (per unit albedo) near / mid / far from the red wall: "
+      "(%.3f %.3f %.3f) / (%.3f %.3f %.3f) / (%.3f %.3f %.3f); r/g %.2f / %.2f / %.2f\n",
+      near.r, near.g, near.b, mid.r, mid.g, mid.b, far.r, far.g, far.b, redness(near), redness(mid),
+      redness(far));
+  EXPECT_GT(redness(near), 1.5 * redness(far)) << "the lit red wall tints the floor near it";
+  EXPECT_GT(redness(near), redness(mid)) << "the tint fades with the distance";
+  EXPECT_GT(redness(mid), redness(far));
+  EXPECT_GT(near.r, far.r) << "the lit wall sends more red than the open sky: W above 1";
+  // The albedo transfer's lit floor: grey (the floor's own colour), darker near the wall.
+  int a0 = 0, a1 = 0;
+  const glm::dvec3 litNear = band(albedo.lit, 0.02f, 0.1f, &a0);
+  const glm::dvec3 litFar = band(albedo.lit, 0.8f, 1.5f, &a1);
+  std::printf("albedo transfer, lit floor near / far: r/g %.3f / %.3f\n", redness(litNear),
+              redness(litFar));
+  EXPECT_NEAR(redness(litNear), redness(litFar), 0.05 * redness(litFar));
+}
+
 TEST_F(ObscuranceTest, NoFalseSilhouetteShadowAndNoFilterAcrossDepthEdges) {
   // A wall at z = 0 and, 3 units (6 R) in front of it, an open book of two small quads at 90
   // degrees opening towards the camera: dark inside, up to its silhouettes. Wall pixels around
@@ -456,6 +588,21 @@ TEST_F(ObscuranceTest, NoNaNAtGrazingAnglesExtremeClipPlanesOrSky) {
       std::printf("grazing floor, %s, %s: mean %.4f\n", radius, t, sum / floorPixels);
       EXPECT_GT(sum / floorPixels, 0.98)
           << radius << " " << t << ": a plane does not occlude itself";
+    }
+  }  // transfer = radiance publishes "ambient": finite and non-negative there too, sky untouched.
+  for (const char* radius : {"obscurance.radius=1e-4", "obscurance.radius=1e4"}) {
+    Renderer r(ctx(), grazing, settingsFor(grazing, {radius, "obscurance.transfer=radiance"}),
+               &registry);
+    r.renderFrame();
+    const ImageRGBA32F ambient = r.readTarget("ambient"), depth = r.readTarget("depth");
+    ASSERT_TRUE(finite(ambient)) << radius;
+    ASSERT_TRUE(finite(r.readTarget("lit"))) << radius;
+    for (size_t i = 0; i < ambient.pixels.size(); i += 4) {
+      ASSERT_GE(std::min({ambient.pixels[i], ambient.pixels[i + 1], ambient.pixels[i + 2]}), 0.0f)
+          << radius;
+      if (depth.pixels[i] <= 0.0f) {
+        ASSERT_EQ(ambient.pixels[i + 3], 0.0f) << radius << " sky";
+      }
     }
   }
 }

@@ -9,13 +9,18 @@
 // filter needs of the G-buffer (1 / view distance and its tangent-plane slopes), packed in one
 // RGBA32UI texel so that the filter fetches each neighbour once (notes/llvmpipe.md: ~1 ms per
 // full-screen fetch at 640x480); the filter averages the sums over 4x4 pixels and divides.
+// MODE 3 (transfer = radiance) sums colours instead: the ambient radiance per unit albedo,
+// A = (L^a O + (1/pi) Int (1 - mu) L_d(y) cos) / (1 - (1/pi) Int (1 - mu) a(y) cos), with
+// L_d the occluders' direct radiance (obscurance_radiance.comp) and L^a the environment's
+// E(n) / pi at the pixel, RGB: colour bleeding from lit neighbours, and A may exceed L^a.
 // Settings that change code are specialization constants (notes/llvmpipe.md: a runtime `if`
 // runs both sides on llvmpipe; constant loops unroll, so the UBO taps are scalar loads).
 layout(local_size_x = 32, local_size_y = 16) in;
 
 layout(constant_id = 0) const int SAMPLES = 16;  // rays per pixel, 1..64
 layout(constant_id = 1) const int POINTS = 1;    // test points per ray (1 or 2)
-layout(constant_id = 2) const int MODE = 0;      // 0 obscurance, 1 W with albedo, 2 W with emission
+// 0 obscurance, 1 W with albedo, 2 W with emission, 3 ambient radiance A (RGB, see above)
+layout(constant_id = 2) const int MODE = 0;
 
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 // Keep in sync with gi::obscurance::Uniforms (obscurance_kernel.h).
@@ -27,7 +32,7 @@ layout(set = 0, binding = 1) uniform ObscuranceParams {
 layout(set = 0, binding = 2) uniform sampler2D gDepth;
 layout(set = 0, binding = 3) uniform sampler2D gNormal;
 layout(set = 0, binding = 4) uniform sampler2D gAlbedo;
-layout(set = 0, binding = 5) uniform sampler2D gEmission;
+layout(set = 0, binding = 5) uniform sampler2D gEmission;  // MODE 3: the occluders' L_d
 layout(set = 0, binding = 6, rgba32ui) uniform writeonly uimage2D outSums;
 
 // Guard: test points at or behind the camera plane (clip.w below this) are untestable: open.
@@ -39,6 +44,8 @@ const float kSlideMinK = 1e-4;
 // 16-bit sums finite when the environment is black; the output is clamped to 1 anyway).
 const float kMaxEmissionRatio = 64.0;
 const vec3 kLuma = vec3(0.2126, 0.7152, 0.0722);  // grey value of a colour (Rec. 709)
+// MODE 3: the colour sums' ceiling (half floats overflow to inf above 65504).
+const float kMaxHalfSum = 65000.0;
 
 vec3 clipToPixels(vec3 v, float p00, float p11, float p20, float p21, vec2 halfSize) {
   float w = -v.z;
@@ -95,14 +102,16 @@ void main() {
   float minK = -kSlideMinK * max(-P.z, 1e-20);
 
   float invAmbient = 0.0;
-  if (MODE == 2) {  // folded away unless specialized to 2
-    vec3 la = environmentIrradianceOverPi(frame, mat3(frame.invView) * N);
+  vec3 la = vec3(0.0);
+  if (MODE >= 2) {  // folded away below 2
+    la = environmentIrradianceOverPi(frame, mat3(frame.invView) * N);
     invAmbient = 1.0 / max(dot(la, kLuma), 1e-6);  // guard: black environment
   }
 
   vec2 sizeF = vec2(size);
   float bias = obs.params.y;
   float nSum = 0.0, dSum = 0.0;
+  vec3 sent = vec3(0.0);  // MODE 3: sum of (1 - J) L_d(y)
   for (int i = 0; i < SAMPLES; ++i) {
     uint code = obs.kernel[i >> 2][i & 3];
     vec3 k = vec3(float(code & 2047u) * (2.0 / 2047.0) - 1.0,
@@ -141,10 +150,20 @@ void main() {
         float e = max(dot(texelFetch(gEmission, hit, 0).rgb, kLuma), 0.0) * invAmbient;
         nSum += (1.0 - J) * min(e, kMaxEmissionRatio);
       }
+      if (MODE == 3) sent += (1.0 - J) * max(texelFetch(gEmission, hit, 0).rgb, vec3(0.0));
     }
   }
   float invN = 1.0 / float(SAMPLES);
   vec2 sums = vec2(nSum * invN, MODE == 0 ? 1.0 : dSum * invN);
+  // MODE 3: the numerator in colour, with the transfer guard's phantom open sample (eta of it,
+  // seeing L^a) added here, where L^a is known: the resolve divides (N + eta L^a) / (D + eta),
+  // averaged over the filter's window. Guard: the sums stay below the half-float maximum.
+  vec3 rgb = vec3(0.0);
+  if (MODE == 3) {
+    float eta = obs.params.w;
+    rgb = min(la * (sums.x + eta) + sent * invN, vec3(kMaxHalfSum));
+    sums = vec2(rgb.r, sums.y + eta);
+  }
 
   // For the filter: on the tangent plane N.X = N.P, 1/z along the pixel's view ray D (z = -1)
   // is (N.D) / (N.P), so its slope per pixel is (1/z) (N.x dDx, N.y dDy) / (N.D).
@@ -156,5 +175,7 @@ void main() {
   // centre's own distance are averaged.
   vec2 slope = nd < -1e-4 * length(D) ? ic * N.xy * dD / nd : vec2(0.0);
   slope = clamp(slope, vec2(-60000.0), vec2(60000.0));  // finite in 16 bits
-  imageStore(outSums, p, uvec4(packHalf2x16(sums), floatBitsToUint(ic), packHalf2x16(slope), 0u));
+  imageStore(outSums, p,
+             uvec4(packHalf2x16(sums), floatBitsToUint(ic), packHalf2x16(slope),
+                   MODE == 3 ? packHalf2x16(rgb.gb) : 0u));
 }

@@ -2,8 +2,10 @@
 // containment tests of Lloyd-relaxed, cos x mu' importance-sampled points against the depth
 // buffer, the silhouette test, 4x4 interleaving and a depth-aware 4x4 box filter. Publishes
 // "ao": obscurance O (transfer off) or the ambient transfer W (eq. 6/9), which the lighting pass
-// multiplies into its environment term, i.e. L' = a W L^a (eq. 2). Estimator, guard and sample
-// set: obscurance_kernel.h; measurements: README.md.
+// multiplies into its environment term, i.e. L' = a W L^a (eq. 2). transfer = radiance
+// publishes "ambient" instead: the ambient radiance with the occluders' direct radiance in
+// colour (a pass `obscurance_radiance` sums the lights for them first). Estimator, guard and
+// sample set: obscurance_kernel.h; measurements: README.md.
 #include <algorithm>
 #include <array>
 #include <memory>
@@ -17,7 +19,9 @@
 #include "obscurance.comp.h"         // const uint32_t obscurance_comp[]
 #include "obscurance_filter.comp.h"  // const uint32_t obscurance_filter_comp[]
 #include "obscurance_kernel.h"
-#include "obscurance_resolve.comp.h"  // const uint32_t obscurance_resolve_comp[]
+#include "obscurance_radiance.comp.h"         // const uint32_t obscurance_radiance_comp[]
+#include "obscurance_resolve.comp.h"          // const uint32_t obscurance_resolve_comp[]
+#include "obscurance_resolve_ambient.comp.h"  // const uint32_t obscurance_resolve_ambient_comp[]
 
 namespace {
 
@@ -26,6 +30,7 @@ namespace obs = gi::obscurance;
 using gi::SettingType;
 
 constexpr VkFormat kAOFormat = VK_FORMAT_R16_SFLOAT;
+constexpr VkFormat kRadianceFormat = VK_FORMAT_R16G16B16A16_SFLOAT;  // and "ambient"
 // half2(N / n, D / n), 1 / distance, half2 slopes: what the filter reads, one fetch per tap.
 constexpr VkFormat kSumsFormat = VK_FORMAT_R32G32B32A32_UINT;
 constexpr uint32_t kGroupX = 32, kGroupY = 16;  // 32x16: llvmpipe's fastest
@@ -45,8 +50,10 @@ class ObscuranceEffect : public gi::Effect {
         "obscurance with a fuzzy membership and the ambient transfer function with "
         "interreflections (seed 001)";
     i.stage = gi::EffectStage::BeforeLighting;
-    i.reads = {res::kDepth, res::kNormal, res::kAlbedo, res::kEmission};
-    i.writes = {res::kAO};
+    i.reads = {res::kDepth,    res::kNormal, res::kAlbedo,      res::kMaterial,
+               res::kEmission, res::kLights, res::kShadowViews, res::kShadowMaps};
+    // "ambient" only with transfer = radiance, "ao" otherwise.
+    i.writes = {res::kAO, res::kAmbient};
     i.debugView = res::kAO;
     // Its physical target is AO (equal to obscurance for membership step); what it estimates
     // exactly is estimatedQuantity().
@@ -55,15 +62,19 @@ class ObscuranceEffect : public gi::Effect {
   }
 
   // transfer off: obscurance with the membership setting (gi-reference --quantity obscurance
-  // --membership <membership>). The transfer modes output W (interreflections with the
-  // occluders' albedo or radiance), which no reference computes: they declare AO of R, their
-  // physical target, so both of gi-bench's columns are against AO.
+  // --membership <membership>). The W modes output W (interreflections with the occluders'
+  // albedo or emission), which no reference computes: they declare AO of R, their physical
+  // target, so both of gi-bench's columns are against AO. radiance replaces the ambient term
+  // with light (the environment's and the lit neighbours' one bounce): the lit image against
+  // direct + one diffuse bounce, as SSDO.
   gi::EstimatedQuantity estimatedQuantity(const gi::SettingValues& s) const override {
     gi::EstimatedQuantity q;
     q.radius = s.number("radius");
     if (s.option("transfer") == "off") {
       q.kind = gi::EstimatedQuantity::Kind::Obscurance;
       q.membership = s.option("membership");
+    } else if (s.option("transfer") == "radiance") {
+      q.kind = gi::EstimatedQuantity::Kind::DirectIndirect;
     } else {
       q.kind = gi::EstimatedQuantity::Kind::AmbientOcclusion;
     }
@@ -87,8 +98,10 @@ class ObscuranceEffect : public gi::Effect {
         gi::SettingDesc::enumeration(
             "transfer", obs::transferNames(), int(obs::Transfer::Off),
             "output: off = obscurance O; albedo = ambient transfer W (interreflections with the "
-            "occluders' albedo, eq. 9); emission = W with the occluders' radiance (emission + "
-            "albedo x ambient), clamped to 1",
+            "occluders' albedo, eq. 9); emission = W with the occluders' emission (+ albedo x "
+            "ambient), clamped to 1; radiance = the ambient radiance in colour (\"ambient\") "
+            "with the occluders' direct radiance (emission + albedo x the lights): colour "
+            "bleeding, W above 1",
             true),
         {"bias", SettingType::Float, 0.02, 0.0, 0.5,
          "a test point must be this far behind the depth buffer's surface to count as inside, "
@@ -110,6 +123,20 @@ class ObscuranceEffect : public gi::Effect {
                img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
     const int mode = s.integer("transfer");
     filter_ = s.flag("filter");
+    radiance_ = mode == int(obs::Transfer::Radiance);
+    if (radiance_)
+      radiancePipeline_ = gi::vk::Pipeline::compute(
+          vk, words(std::begin(obscurance_radiance_comp), std::end(obscurance_radiance_comp)),
+          {{0, ubo},
+           {1, tex},
+           {2, tex},
+           {3, tex},
+           {4, tex},
+           {5, tex},
+           {6, ubo},
+           {7, ubo},
+           {8, tex},
+           {9, img}});
     main_ = gi::vk::Pipeline::compute(
         vk, words(std::begin(obscurance_comp), std::end(obscurance_comp)),
         {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, tex}, {5, tex}, {6, img}}, 0,
@@ -120,9 +147,15 @@ class ObscuranceEffect : public gi::Effect {
     filterX_ = gi::vk::Pipeline::compute(
         vk, words(std::begin(obscurance_filter_comp), std::end(obscurance_filter_comp)),
         filterBindings, 0, filterSpec);
-    resolve_ = gi::vk::Pipeline::compute(
-        vk, words(std::begin(obscurance_resolve_comp), std::end(obscurance_resolve_comp)),
-        filterBindings, 0, filterSpec);
+    resolve_ =
+        radiance_
+            ? gi::vk::Pipeline::compute(vk,
+                                        words(std::begin(obscurance_resolve_ambient_comp),
+                                              std::end(obscurance_resolve_ambient_comp)),
+                                        filterBindings, 0, filterSpec)
+            : gi::vk::Pipeline::compute(
+                  vk, words(std::begin(obscurance_resolve_comp), std::end(obscurance_resolve_comp)),
+                  filterBindings, 0, filterSpec);
     if (!uniforms_)
       uniforms_ =
           gi::vk::Buffer(vk, sizeof(obs::Uniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true);
@@ -132,12 +165,50 @@ class ObscuranceEffect : public gi::Effect {
   void addPasses(gi::FrameGraph& graph, gi::EffectContext& ctx,
                  const gi::SettingValues& settings) override {
     struct Io {
-      gi::TextureHandle depth, normal, albedo, emission, sums, half, ao;
+      // `sent`: what the taps read of an occluder (the emission, or obscurance_radiance).
+      gi::TextureHandle depth, normal, albedo, material, emission, shadowMaps, radiance, sent, sums,
+          half, out;
+      gi::BufferHandle lights, shadowViews;
     };
     auto io = std::make_shared<Io>();
     gi::Blackboard& bb = graph.blackboard();
     const VkBuffer frame = ctx.frameUniforms();
     const VkSampler nearest = ctx.nearestSampler();
+    const VkDescriptorType ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
+    const bool radiance = radiance_;  // changesGraph: prepare() matched the transfer
+
+    // transfer = radiance: the occluders' direct radiance, once per pixel, read by the taps in
+    // place of the emission.
+    if (radiance)
+      graph.addPass(
+          "obscurance_radiance",
+          [&](gi::PassBuilder& b) {
+            io->depth = b.read(bb.texture(res::kDepth));
+            io->normal = b.read(bb.texture(res::kNormal));
+            io->albedo = b.read(bb.texture(res::kAlbedo));
+            io->material = b.read(bb.texture(res::kMaterial));
+            io->emission = b.read(bb.texture(res::kEmission));
+            io->lights = b.read(bb.buffer(res::kLights));
+            io->shadowViews = b.read(bb.buffer(res::kShadowViews));
+            io->shadowMaps = b.read(bb.texture(res::kShadowMaps));
+            io->radiance =
+                b.write(b.create("obscurance_radiance", gi::TextureDesc{kRadianceFormat}),
+                        gi::TextureUsage::StorageWrite);
+          },
+          [this, io, frame, nearest, ubo](gi::PassContext& pc) {
+            gi::vk::DescriptorWriter w;
+            w.buffer(0, ubo, frame)
+                .sampled(1, pc.view(io->depth), nearest)
+                .sampled(2, pc.view(io->normal), nearest)
+                .sampled(3, pc.view(io->albedo), nearest)
+                .sampled(4, pc.view(io->material), nearest)
+                .sampled(5, pc.view(io->emission), nearest)
+                .buffer(6, ubo, pc.buffer(io->lights))
+                .buffer(7, ubo, pc.buffer(io->shadowViews))
+                .sampled(8, pc.view(io->shadowMaps), nearest)
+                .storageImage(9, pc.view(io->radiance));
+            pc.dispatch(radiancePipeline_, w, pc.extent(io->radiance), kGroupX, kGroupY);
+          });
 
     graph.addPass(
         "obscurance",
@@ -145,7 +216,7 @@ class ObscuranceEffect : public gi::Effect {
           io->depth = b.read(bb.texture(res::kDepth));
           io->normal = b.read(bb.texture(res::kNormal));
           io->albedo = b.read(bb.texture(res::kAlbedo));
-          io->emission = b.read(bb.texture(res::kEmission));
+          io->sent = b.read(radiance ? io->radiance : bb.texture(res::kEmission));
           io->sums = b.write(b.create("obscurance_sums", gi::TextureDesc{kSumsFormat}),
                              gi::TextureUsage::StorageWrite);
         },
@@ -157,7 +228,7 @@ class ObscuranceEffect : public gi::Effect {
               .sampled(2, pc.view(io->depth), nearest)
               .sampled(3, pc.view(io->normal), nearest)
               .sampled(4, pc.view(io->albedo), nearest)
-              .sampled(5, pc.view(io->emission), nearest)
+              .sampled(5, pc.view(io->sent), nearest)
               .storageImage(6, pc.view(io->sums));
           const VkExtent2D e = pc.extent(io->sums);
           pc.dispatch(main_, w, e, kGroupX, kGroupY);
@@ -173,11 +244,12 @@ class ObscuranceEffect : public gi::Effect {
           if (filter)
             io->half = b.write(b.create("obscurance_filter_x", gi::TextureDesc{kSumsFormat}),
                                gi::TextureUsage::StorageWrite);
-          io->ao = b.write(b.create(res::kAO, gi::TextureDesc{kAOFormat}),
-                           gi::TextureUsage::StorageWrite);
+          io->out = b.write(b.create(radiance ? res::kAmbient : res::kAO,
+                                     gi::TextureDesc{radiance ? kRadianceFormat : kAOFormat}),
+                            gi::TextureUsage::StorageWrite);
         },
         [this, io, frame, nearest, filter](gi::PassContext& pc) {
-          const VkExtent2D e = pc.extent(io->ao);
+          const VkExtent2D e = pc.extent(io->out);
           auto axis = [&](const gi::vk::Pipeline& p, VkImageView in, VkImageLayout inLayout,
                           VkImageView out) {
             gi::vk::DescriptorWriter w;
@@ -189,7 +261,7 @@ class ObscuranceEffect : public gi::Effect {
           };
           if (!filter) {
             axis(resolve_, pc.view(io->sums), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                 pc.view(io->ao));
+                 pc.view(io->out));
             return;
           }
           axis(filterX_, pc.view(io->sums), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
@@ -197,9 +269,9 @@ class ObscuranceEffect : public gi::Effect {
           // The graph orders passes, not dispatches inside one: the y dispatch reads what the
           // x dispatch wrote (the image stays GENERAL, as storage images are).
           gi::vk::storageWriteToSampledRead(pc.cmd(), pc.image(io->half));
-          axis(resolve_, pc.view(io->half), VK_IMAGE_LAYOUT_GENERAL, pc.view(io->ao));
+          axis(resolve_, pc.view(io->half), VK_IMAGE_LAYOUT_GENERAL, pc.view(io->out));
         });
-    bb.put(res::kAO, io->ao);
+    bb.put(radiance ? res::kAmbient : res::kAO, io->out);
   }
 
  private:
@@ -216,8 +288,8 @@ class ObscuranceEffect : public gi::Effect {
     uploaded_ = key;
   }
 
-  gi::vk::Pipeline main_, filterX_, resolve_;
-  bool filter_ = true;
+  gi::vk::Pipeline main_, filterX_, resolve_, radiancePipeline_;
+  bool filter_ = true, radiance_ = false;
   gi::vk::Buffer uniforms_;
   std::optional<std::array<double, 5>> uploaded_;  // the settings uniforms_ holds
 };

@@ -4,4 +4,5 @@
 // Filter along x: sums -> sums (obscurance_filter.glsl).
 #define GI_AXIS ivec2(1, 0)
 #define GI_RESOLVE 0
+#define GI_AMBIENT 0
 #include "obscurance_filter.glsl"

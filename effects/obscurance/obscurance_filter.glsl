@@ -11,10 +11,13 @@
 //
 // Input and intermediate texel (RGBA32UI, written by obscurance.comp): x = half2(N / n, D / n),
 // y = float bits of 1 / view distance (0: sky, no geometry), z = half2 slopes of 1 / distance
-// along x and y per pixel. One fetch per tap, no G-buffer reads.
+// along x and y per pixel, w (MODE 3) = half2 of the colour numerator's g, b (x then holds
+// its r and D + eta). One fetch per tap, no G-buffer reads. MODE 3 resolves to the RGBA16F
+// "ambient" (GI_AMBIENT), the other modes to the R16F "ao".
 layout(local_size_x = 32, local_size_y = 16) in;
 
-layout(constant_id = 0) const int MODE = 0;    // 0 obscurance, 1 W (albedo), 2 W (emission)
+// 0 obscurance, 1 W (albedo), 2 W (emission), 3 ambient radiance (RGB)
+layout(constant_id = 0) const int MODE = 0;
 layout(constant_id = 1) const int RADIUS = 2;  // 2: the 4x4 box; 0: no filtering (resolve only)
 
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
@@ -24,14 +27,23 @@ layout(set = 0, binding = 1) uniform ObscuranceParams {
   uvec4 kernel[16];
 } obs;
 layout(set = 0, binding = 2) uniform usampler2D inSums;
-#if GI_RESOLVE
+#if GI_RESOLVE && GI_AMBIENT
+layout(set = 0, binding = 3, rgba16f) uniform writeonly image2D outImage;
+#elif GI_RESOLVE
 layout(set = 0, binding = 3, r16f) uniform writeonly image2D outImage;
 #else
 layout(set = 0, binding = 3, rgba32ui) uniform writeonly uimage2D outImage;
 #endif
 
-void store(ivec2 p, vec2 sums, uvec4 centre) {
-#if GI_RESOLVE
+void store(ivec2 p, vec4 sums, uvec4 centre) {
+#if GI_RESOLVE && GI_AMBIENT
+  // Ambient radiance per unit diffuse albedo (alpha 2: the lighting pass multiplies by it);
+  // D + eta >= eta > 0 per pixel, so the window's mean is too. Sky / no geometry (1 / distance
+  // 0): alpha 0, the lighting pass's own term. Guards: finite, below the half-float maximum.
+  vec3 a = max(vec3(sums.x, sums.zw) / max(sums.y, 1e-30), vec3(0.0));
+  a = mix(min(a, vec3(65000.0)), vec3(0.0), isnan(a));
+  imageStore(outImage, p, uintBitsToFloat(centre.y) > 0.0 ? vec4(a, 2.0) : vec4(0.0));
+#elif GI_RESOLVE
   float w = sums.x;
   if (MODE != 0) {
     // Guarded transfer ratio (obscurance_kernel.h: the phantom open sample): finite, in [0, 1]
@@ -42,7 +54,8 @@ void store(ivec2 p, vec2 sums, uvec4 centre) {
   }
   imageStore(outImage, p, vec4(w));
 #else
-  imageStore(outImage, p, uvec4(packHalf2x16(sums), centre.yzw));
+  imageStore(outImage, p,
+             uvec4(packHalf2x16(sums.xy), centre.yz, MODE == 3 ? packHalf2x16(sums.zw) : 0u));
 #endif
 }
 
@@ -53,7 +66,7 @@ void main() {
   const ivec2 axis = GI_AXIS;
 
   uvec4 c = texelFetch(inSums, p, 0);
-  vec2 sum = unpackHalf2x16(c.x);
+  vec4 sum = vec4(unpackHalf2x16(c.x), MODE == 3 ? unpackHalf2x16(c.w) : vec2(0.0));
   float ic = uintBitsToFloat(c.y);  // 1 / view distance; 0: sky
   if (RADIUS == 0 || !(ic > 0.0)) {  // no filter (folded at specialization), or sky: as is
     store(p, sum, c);
@@ -72,7 +85,7 @@ void main() {
     // |1/iq - 1/pred| < tol without a division (iq, pred > 0); sky (iq = 0) is rejected.
     bool sameSurface = inside && pred > 0.0 && abs(pred - iq) < tol * iq * pred;
     float w = sameSurface ? (abs(o) == RADIUS ? 0.5 : 1.0) : 0.0;
-    sum += w * unpackHalf2x16(t.x);
+    sum += w * vec4(unpackHalf2x16(t.x), MODE == 3 ? unpackHalf2x16(t.w) : vec2(0.0));
     weights += w;
   }
   store(p, sum / weights, c);  // weights >= 1: the centre always counts

@@ -48,11 +48,13 @@ inline const std::vector<std::string>& membershipNames() {
   static const std::vector<std::string> names = {"sqrt", "step", "linear", "smoothstep"};
   return names;
 }
-// What the transfer mode estimates and outputs through "ao": obscurance O, the transfer W with
-// the occluders' albedo, or W with their radiance (emission + albedo x ambient).
-enum class Transfer { Off = 0, Albedo = 1, Emission = 2 };
+// What the transfer mode estimates and outputs: through "ao" obscurance O, the transfer W with
+// the occluders' albedo, or W with their emission (emission + albedo x ambient, clamped to 1);
+// through "ambient" (RGB, per unit albedo) the ambient radiance with the occluders' direct
+// radiance (emission + albedo x the scene's lights): colour bleeding, not clamped.
+enum class Transfer { Off = 0, Albedo = 1, Emission = 2, Radiance = 3 };
 inline const std::vector<std::string>& transferNames() {
-  static const std::vector<std::string> names = {"off", "albedo", "emission"};
+  static const std::vector<std::string> names = {"off", "albedo", "emission", "radiance"};
   return names;
 }
 

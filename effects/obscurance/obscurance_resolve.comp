@@ -4,4 +4,5 @@
 // Filter along y and divide: sums -> "ao" (obscurance_filter.glsl).
 #define GI_AXIS ivec2(0, 1)
 #define GI_RESOLVE 1
+#define GI_AMBIENT 0
 #include "obscurance_filter.glsl"

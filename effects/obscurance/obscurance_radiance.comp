@@ -1,0 +1,55 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#include "common.glsl"
+
+// transfer = radiance: per pixel, once, the radiance an occluder at this pixel sends besides its
+// share of the ambient light (seed 001 §3: "the radiance stored in the pixel"): emission +
+// diffuse albedo x the scene's lights (irradiance / pi, summed by the engine's sumLights exactly
+// as the lighting pass sums them: shadow maps, PCF). Lambertian: no specular. This frame's lit
+// image does not exist yet (the effect runs before lighting) and the ambient part is the
+// transfer's own unknown (eq. 9's denominator), so it is left out here.
+layout(local_size_x = 32, local_size_y = 16) in;
+
+layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
+layout(set = 0, binding = 1) uniform sampler2D gDepth;
+layout(set = 0, binding = 2) uniform sampler2D gNormal;
+layout(set = 0, binding = 3) uniform sampler2D gAlbedo;
+layout(set = 0, binding = 4) uniform sampler2D gMaterial;
+layout(set = 0, binding = 5) uniform sampler2D gEmission;
+#define GI_LIGHTS_SET 0
+#define GI_LIGHTS_BINDING 6
+#define GI_SHADOW_VIEWS_BINDING 7
+#define GI_SHADOW_MAPS_BINDING 8
+#include "lights.glsl"
+layout(set = 0, binding = 9, rgba16f) uniform writeonly image2D outRadiance;
+
+// Guard: half floats overflow to inf above 65504.
+const float kMaxRadiance = 65000.0;
+
+void main() {
+  ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+  ivec2 size = ivec2(frame.viewport.xy);
+  if (p.x >= size.x || p.y >= size.y) return;
+
+  float depth = texelFetch(gDepth, p, 0).r;
+  vec4 normalTexel = texelFetch(gNormal, p, 0);
+  // Guard: sky / far-plane pixels and pixels without geometry send nothing (they are never
+  // inside a test anyway: their depth is behind every point).
+  if (isSky(depth) || !(normalTexel.w > 0.5)) {
+    imageStore(outRadiance, p, vec4(0.0));
+    return;
+  }
+  vec2 uv = (vec2(p) + 0.5) * frame.viewport.zw;
+  vec3 pos = viewPositionFromDepth(frame.invProj, uv, depth);
+  vec3 n = safeNormalize(normalTexel.xyz, safeNormalize(-pos, vec3(0.0, 0.0, 1.0)));
+  vec3 albedo = texelFetch(gAlbedo, p, 0).rgb;
+  vec2 rm = texelFetch(gMaterial, p, 0).rg;
+  LightSum lights = sumLights(pos, n, safeNormalize(-pos, vec3(0.0, 0.0, 1.0)),
+                              mix(vec3(0.04), albedo, rm.y), shininessOf(rm.x), vec4(1.0), false);
+  vec3 radiance = texelFetch(gEmission, p, 0).rgb +
+                  albedo * (1.0 - rm.y) * lights.irradiance * (1.0 / 3.14159265358979);
+  // Guards: finite, non-negative, below the half-float maximum; NaN inputs read 0.
+  radiance = clamp(radiance, vec3(0.0), vec3(kMaxRadiance));
+  radiance = mix(radiance, vec3(0.0), isnan(radiance));
+  imageStore(outRadiance, p, vec4(radiance, 1.0));
+}
