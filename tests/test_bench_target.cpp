@@ -81,6 +81,31 @@ TEST(BenchTarget, LitImagesOfEveryEffectAgainstOneQuantity) {
   EXPECT_NE(row(direct, "ssdo")["nrmse"], row(own, "ssdo")["nrmse"]);
 }
 
+// An AO effect whose settings make it output light (obscurance's radiance transfer publishes
+// "ambient", not "ao") declares a light quantity and is judged by its lit image, against direct
+// + indirect light; under its AO settings the same effect is still read at "ao".
+TEST(BenchTarget, AnAoEffectThatOutputsLightIsJudgedAsLight) {
+  if (!hasPlugin("obscurance")) GTEST_SKIP() << "the obscurance plugin is not built";
+  const std::string dir = test::makeTempDir("bench-ao-light");
+  const nlohmann::json j =
+      sweep(dir, "out", "--effects obscurance --grid obscurance.transfer=off,radiance");
+  int seen = 0;
+  for (const auto& r : j["results"]) {
+    const std::string params = r["params"];
+    if (params.find("transfer=radiance") != std::string::npos) {
+      EXPECT_EQ(r["compared"], "lit") << r.dump();
+      EXPECT_TRUE(startsWith(r["reference"], "direct+indirect spp=")) << r.dump();
+      EXPECT_TRUE(startsWith(r["declared"], "direct+indirect spp=")) << r.dump();
+      ++seen;
+    } else if (params.find("transfer=off") != std::string::npos) {
+      EXPECT_EQ(r["compared"], "ao") << r.dump();
+      EXPECT_TRUE(startsWith(r["declared"], "obscurance sqrt r=0.5")) << r.dump();
+      ++seen;
+    }
+  }
+  EXPECT_EQ(seen, 2) << j.dump();
+}
+
 // Each interval keeps its repetitions in measurement order: their median is the reported one,
 // and a pass's values sum, repetition by repetition, to the effect time.
 TEST(BenchTarget, RepetitionValuesAreKeptInOrder) {

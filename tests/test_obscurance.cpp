@@ -461,6 +461,37 @@ TEST_F(ObscuranceTest, RadianceTransferBleedsTheColourOfALitWall) {
   };
   const Out radiance = run("obscurance.transfer=radiance");
   const Out albedo = run("obscurance.transfer=albedo");
+  {
+    // Having summed the lights, the radiance pass publishes them as "direct_light", as SSDO's
+    // bounce does (whose direct_light is tested to be the lighting pass's own sum): the same
+    // values, within half-float rounding.
+    Renderer r(ctx(), scene,
+               settingsFor(scene, {"obscurance.transfer=radiance", "obscurance.radius=0.5"}),
+               &registry);
+    r.renderFrame();
+    const ImageRGBA32F mine = r.readTarget("direct_light");
+    ASSERT_TRUE(registry.has("ssdo"));
+    EffectOverrides cli;
+    cli.effects = std::vector<std::string>{"ssdo"};
+    RenderSettings rs;
+    rs.width = kW;
+    rs.height = kH;
+    rs.effects = resolveEffects(scene, nullptr, cli, registry);
+    Renderer s(ctx(), scene, rs, &registry);
+    s.renderFrame();
+    const ImageRGBA32F theirs = s.readTarget("direct_light");
+    double worst = 0.0, maxValue = 0.0;
+    for (size_t i = 0; i < mine.pixels.size(); ++i) {
+      if (i % 4 == 3) continue;
+      worst = std::max(worst, double(std::abs(mine.pixels[i] - theirs.pixels[i])) /
+                                  std::max(1.0, double(theirs.pixels[i])));
+      maxValue = std::max(maxValue, double(theirs.pixels[i]));
+    }
+    std::printf("direct_light against SSDO's: worst relative difference %.5f (max value %.3f)\n",
+                worst, maxValue);
+    EXPECT_GT(maxValue, 0.1) << "the wall must be lit for the test to bite";
+    EXPECT_LT(worst, 2e-3);
+  }
   const Result o = render(scene, {"obscurance.transfer=off", "obscurance.radius=0.5"});
   ASSERT_TRUE(finite(radiance.ambient));
   ASSERT_TRUE(finite(radiance.lit));

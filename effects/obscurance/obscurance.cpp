@@ -52,8 +52,8 @@ class ObscuranceEffect : public gi::Effect {
     i.stage = gi::EffectStage::BeforeLighting;
     i.reads = {res::kDepth,    res::kNormal, res::kAlbedo,      res::kMaterial,
                res::kEmission, res::kLights, res::kShadowViews, res::kShadowMaps};
-    // "ambient" only with transfer = radiance, "ao" otherwise.
-    i.writes = {res::kAO, res::kAmbient};
+    // "ambient" and "direct_light" only with transfer = radiance, "ao" otherwise.
+    i.writes = {res::kAO, res::kAmbient, res::kDirectLight};
     i.debugView = res::kAO;
     // Its physical target is AO (equal to obscurance for membership step); what it estimates
     // exactly is estimatedQuantity().
@@ -136,7 +136,8 @@ class ObscuranceEffect : public gi::Effect {
            {6, ubo},
            {7, ubo},
            {8, tex},
-           {9, img}});
+           {9, img},
+           {10, img}});
     main_ = gi::vk::Pipeline::compute(
         vk, words(std::begin(obscurance_comp), std::end(obscurance_comp)),
         {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, tex}, {5, tex}, {6, img}}, 0,
@@ -166,8 +167,8 @@ class ObscuranceEffect : public gi::Effect {
                  const gi::SettingValues& settings) override {
     struct Io {
       // `sent`: what the taps read of an occluder (the emission, or obscurance_radiance).
-      gi::TextureHandle depth, normal, albedo, material, emission, shadowMaps, radiance, sent, sums,
-          half, out;
+      gi::TextureHandle depth, normal, albedo, material, emission, shadowMaps, radiance, direct,
+          sent, sums, half, out;
       gi::BufferHandle lights, shadowViews;
     };
     auto io = std::make_shared<Io>();
@@ -178,7 +179,8 @@ class ObscuranceEffect : public gi::Effect {
     const bool radiance = radiance_;  // changesGraph: prepare() matched the transfer
 
     // transfer = radiance: the occluders' direct radiance, once per pixel, read by the taps in
-    // place of the emission.
+    // place of the emission; and the lights' radiance as "direct_light" (the lighting pass then
+    // does not sum them again).
     if (radiance)
       graph.addPass(
           "obscurance_radiance",
@@ -194,6 +196,8 @@ class ObscuranceEffect : public gi::Effect {
             io->radiance =
                 b.write(b.create("obscurance_radiance", gi::TextureDesc{kRadianceFormat}),
                         gi::TextureUsage::StorageWrite);
+            io->direct = b.write(b.create(res::kDirectLight, gi::TextureDesc{kRadianceFormat}),
+                                 gi::TextureUsage::StorageWrite);
           },
           [this, io, frame, nearest, ubo](gi::PassContext& pc) {
             gi::vk::DescriptorWriter w;
@@ -206,7 +210,8 @@ class ObscuranceEffect : public gi::Effect {
                 .buffer(6, ubo, pc.buffer(io->lights))
                 .buffer(7, ubo, pc.buffer(io->shadowViews))
                 .sampled(8, pc.view(io->shadowMaps), nearest)
-                .storageImage(9, pc.view(io->radiance));
+                .storageImage(9, pc.view(io->radiance))
+                .storageImage(10, pc.view(io->direct));
             pc.dispatch(radiancePipeline_, w, pc.extent(io->radiance), kGroupX, kGroupY);
           });
 
@@ -272,6 +277,7 @@ class ObscuranceEffect : public gi::Effect {
           axis(resolve_, pc.view(io->half), VK_IMAGE_LAYOUT_GENERAL, pc.view(io->out));
         });
     bb.put(radiance ? res::kAmbient : res::kAO, io->out);
+    if (radiance) bb.put(res::kDirectLight, io->direct);
   }
 
  private:

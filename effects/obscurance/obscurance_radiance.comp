@@ -7,7 +7,9 @@
 // diffuse albedo x the scene's lights (irradiance / pi, summed by the engine's sumLights exactly
 // as the lighting pass sums them: shadow maps, PCF). Lambertian: no specular. This frame's lit
 // image does not exist yet (the effect runs before lighting) and the ambient part is the
-// transfer's own unknown (eq. 9's denominator), so it is left out here.
+// transfer's own unknown (eq. 9's denominator), so it is left out here. Having summed the
+// lights, it also publishes their full radiance (specular included) as "direct_light", which
+// the lighting pass then uses instead of summing them a second time (as SSDO's bounce does).
 layout(local_size_x = 32, local_size_y = 16) in;
 
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
@@ -22,6 +24,7 @@ layout(set = 0, binding = 5) uniform sampler2D gEmission;
 #define GI_SHADOW_MAPS_BINDING 8
 #include "lights.glsl"
 layout(set = 0, binding = 9, rgba16f) uniform writeonly image2D outRadiance;
+layout(set = 0, binding = 10, rgba16f) uniform writeonly image2D outDirect;  // "direct_light"
 
 // Guard: half floats overflow to inf above 65504.
 const float kMaxRadiance = 65000.0;
@@ -37,6 +40,7 @@ void main() {
   // inside a test anyway: their depth is behind every point).
   if (isSky(depth) || !(normalTexel.w > 0.5)) {
     imageStore(outRadiance, p, vec4(0.0));
+    imageStore(outDirect, p, vec4(0.0, 0.0, 0.0, 1.0));  // the lighting pass draws the sky
     return;
   }
   vec2 uv = (vec2(p) + 0.5) * frame.viewport.zw;
@@ -46,10 +50,14 @@ void main() {
   vec2 rm = texelFetch(gMaterial, p, 0).rg;
   LightSum lights = sumLights(pos, n, safeNormalize(-pos, vec3(0.0, 0.0, 1.0)),
                               mix(vec3(0.04), albedo, rm.y), shininessOf(rm.x), vec4(1.0), false);
-  vec3 radiance = texelFetch(gEmission, p, 0).rgb +
-                  albedo * (1.0 - rm.y) * lights.irradiance * (1.0 / 3.14159265358979);
+  vec3 diffuseDirect = albedo * (1.0 - rm.y) * lights.irradiance * (1.0 / 3.14159265358979);
+  vec3 radiance = texelFetch(gEmission, p, 0).rgb + diffuseDirect;
+  vec3 direct = diffuseDirect + lights.specular;
   // Guards: finite, non-negative, below the half-float maximum; NaN inputs read 0.
   radiance = clamp(radiance, vec3(0.0), vec3(kMaxRadiance));
   radiance = mix(radiance, vec3(0.0), isnan(radiance));
+  direct = clamp(direct, vec3(0.0), vec3(kMaxRadiance));
+  direct = mix(direct, vec3(0.0), isnan(direct));
   imageStore(outRadiance, p, vec4(radiance, 1.0));
+  imageStore(outDirect, p, vec4(direct, 1.0));
 }

@@ -169,6 +169,8 @@ class Effect {
   // info().estimates: AO of the `radius` setting (0.5 without one), direct + indirect light,
   // or direct light. Override it when the effect computes another quantity (obscurance, the
   // Alchemy integral, ...): gi-bench then scores it against that too. See effects/README.md.
+  // An AO effect may declare a light kind for settings under which it outputs light itself
+  // (gi-bench then judges its lit image as light); a light effect may not declare AO.
   virtual EstimatedQuantity estimatedQuantity(const SettingValues& settings) const {
     EstimatedQuantity q;
     switch (info().estimates) {
