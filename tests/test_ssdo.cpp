@@ -198,10 +198,12 @@ TEST_F(SsdoTest, OpenPlaneUnderAConstantMapIsAlbedoTimesRadiance) {
 // texels of 64 x 32, 45 degrees up toward +x): the floor beside the box's -x face is in the
 // sun's shadow, the floor beside its +x face is not. With multiple importance sampling
 // (`environment_sampling=mis`) the open floor matches the exact (1 / pi) int L cos within 3%
-// (measured +0.5%) and the shadow side is dark (ratio 0.25: SSDO's point test lets the steps
-// that stop short of the box through); the map's SH9 spreads the sun over the sky (open floor
-// -28%, ratio 0.71), and the cosine samples alone, one fixed set per 4x4 block, hit the tiny
-// sun too often or not at all (+27% here; +156% / +28% / -36% at 8 / 16 / 32 samples).
+// (measured +0.5%) and the shadow side is dark (ratio 0.36 with the default two layers, 0.25
+// with one: SSDO's point test lets the steps that stop short of the box through, and with two
+// layers those beyond its back faces too); the map's SH9 spreads the sun over the sky (open
+// floor -28%, ratio 0.81; 0.71 with one layer), and the cosine samples alone, one fixed set per 4x4
+// block, hit the tiny sun too often or not at all (+27% here; +156% / +28% / -36% at 8 / 16 / 32
+// samples).
 TEST_F(SsdoTest, SunInAMapCastsItsShadowWhenTheMapIsReadPerDirection) {
   const std::string dir = ::testing::TempDir();
   // RGBE (mantissa + 0.5) / 256 x 2^(exponent - 128): 0.05 ~ 205.5 / 256 x 2^-4, the sun
@@ -343,8 +345,10 @@ TEST_F(SsdoTest, ShadowNextToABoxTakesTheColourOfTheUnblockedSky) {
 // blue toward +x, over a floor with a box. Beside the box's -x face the box hides the blue
 // half: SSDO's shadow there is red; beside its +x face it hides the red half: the shadow is
 // blue; SSAO darkens both sides with the open floor's hue (r / (r + b) 0.5000 everywhere).
-// Read through the map's SH9 (its first-order band keeps the split: 0.599 left, 0.407 right,
-// 0.500 open) and through multiple importance sampling (0.692, 0.325, 0.496: the sharp split).
+// Read through the map's SH9 (its first-order band keeps the split: 0.573 left, 0.427 right,
+// 0.500 open) and through multiple importance sampling (0.603, 0.347, 0.496: the sharp split),
+// with the default two layers (steps beyond the box's back faces count as open); with one
+// layer 0.599 / 0.407 / 0.500 and 0.692 / 0.325 / 0.496.
 TEST_F(SsdoTest, ShadowsOnEachSideOfABoxTakeTheColourOfTheOtherSide) {
   const std::string dir = ::testing::TempDir();
   // Column x: u = (x + 0.5) / 32 = atan(z, x) / 2 pi: x < 0 (red) for u in (0.25, 0.75).
