@@ -95,6 +95,19 @@ TEST_F(HardCasesTest, SsdoPeelingCamerasAndContactShadowsStayFiniteOnEveryHardCa
   }
 }
 
+// Obscurance's transfer modes (off by default) on every hard case, 8 static frames each: the
+// albedo transfer (albedo 1 under full occlusion: the guard) and the radiance transfer (its
+// "ambient" and "direct_light", lit neighbours in colour, W above 1), two points per ray.
+TEST_F(HardCasesTest, ObscuranceTransferModesStayFiniteOnEveryHardCase) {
+  for (const char* transfer : {"obscurance.transfer=albedo", "obscurance.transfer=radiance"}) {
+    bench::HardCaseOptions o;
+    o.effects = {"obscurance"};
+    o.sets = {transfer, "obscurance.points_per_ray=2"};
+    o.flickerFrames = 8;
+    sweep(o);
+  }
+}
+
 // Every effect joins: the sweep covers the registry, not a list.
 TEST_F(HardCasesTest, SweepCoversEveryRegisteredEffect) {
   bench::HardCaseOptions o;
