@@ -14,6 +14,7 @@
 
 #include "gi/effect.h"
 #include "gi/effect_registry.h"
+#include "gi/lit_surface.h"
 #include "gi/vk/pipeline.h"
 #include "gi/vk/resources.h"
 #include "obscurance.comp.h"         // const uint32_t obscurance_comp[]
@@ -124,20 +125,13 @@ class ObscuranceEffect : public gi::Effect {
     const int mode = s.integer("transfer");
     filter_ = s.flag("filter");
     radiance_ = mode == int(obs::Transfer::Radiance);
-    if (radiance_)
+    if (radiance_) {
+      std::vector<gi::vk::Binding> bindings = gi::LitSurfaceInputs::layout(1);
+      bindings.insert(bindings.end(), {{0, ubo}, {9, img}, {10, img}});
       radiancePipeline_ = gi::vk::Pipeline::compute(
           vk, words(std::begin(obscurance_radiance_comp), std::end(obscurance_radiance_comp)),
-          {{0, ubo},
-           {1, tex},
-           {2, tex},
-           {3, tex},
-           {4, tex},
-           {5, tex},
-           {6, ubo},
-           {7, ubo},
-           {8, tex},
-           {9, img},
-           {10, img}});
+          bindings);
+    }
     main_ = gi::vk::Pipeline::compute(
         vk, words(std::begin(obscurance_comp), std::end(obscurance_comp)),
         {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, tex}, {5, tex}, {6, img}}, 0,
@@ -166,10 +160,9 @@ class ObscuranceEffect : public gi::Effect {
   void addPasses(gi::FrameGraph& graph, gi::EffectContext& ctx,
                  const gi::SettingValues& settings) override {
     struct Io {
+      gi::LitSurfaceInputs surface;  // transfer = radiance: what obscurance_radiance reads
       // `sent`: what the taps read of an occluder (the emission, or obscurance_radiance).
-      gi::TextureHandle depth, normal, albedo, material, emission, shadowMaps, radiance, direct,
-          sent, sums, half, out;
-      gi::BufferHandle lights, shadowViews;
+      gi::TextureHandle depth, normal, albedo, radiance, direct, sent, sums, half, out;
     };
     auto io = std::make_shared<Io>();
     gi::Blackboard& bb = graph.blackboard();
@@ -185,14 +178,7 @@ class ObscuranceEffect : public gi::Effect {
       graph.addPass(
           "obscurance_radiance",
           [&](gi::PassBuilder& b) {
-            io->depth = b.read(bb.texture(res::kDepth));
-            io->normal = b.read(bb.texture(res::kNormal));
-            io->albedo = b.read(bb.texture(res::kAlbedo));
-            io->material = b.read(bb.texture(res::kMaterial));
-            io->emission = b.read(bb.texture(res::kEmission));
-            io->lights = b.read(bb.buffer(res::kLights));
-            io->shadowViews = b.read(bb.buffer(res::kShadowViews));
-            io->shadowMaps = b.read(bb.texture(res::kShadowMaps));
+            io->surface.read(b, bb);
             io->radiance =
                 b.write(b.create("obscurance_radiance", gi::TextureDesc{kRadianceFormat}),
                         gi::TextureUsage::StorageWrite);
@@ -201,17 +187,9 @@ class ObscuranceEffect : public gi::Effect {
           },
           [this, io, frame, nearest, ubo](gi::PassContext& pc) {
             gi::vk::DescriptorWriter w;
-            w.buffer(0, ubo, frame)
-                .sampled(1, pc.view(io->depth), nearest)
-                .sampled(2, pc.view(io->normal), nearest)
-                .sampled(3, pc.view(io->albedo), nearest)
-                .sampled(4, pc.view(io->material), nearest)
-                .sampled(5, pc.view(io->emission), nearest)
-                .buffer(6, ubo, pc.buffer(io->lights))
-                .buffer(7, ubo, pc.buffer(io->shadowViews))
-                .sampled(8, pc.view(io->shadowMaps), nearest)
-                .storageImage(9, pc.view(io->radiance))
-                .storageImage(10, pc.view(io->direct));
+            w.buffer(0, ubo, frame);
+            io->surface.bind(w, pc, 1, nearest);
+            w.storageImage(9, pc.view(io->radiance)).storageImage(10, pc.view(io->direct));
             pc.dispatch(radiancePipeline_, w, pc.extent(io->radiance), kGroupX, kGroupY);
           });
 

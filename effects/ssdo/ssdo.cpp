@@ -31,6 +31,7 @@
 #include "gi/effect.h"
 #include "gi/effect_registry.h"
 #include "gi/lights.h"
+#include "gi/lit_surface.h"
 #include "gi/vk/pipeline.h"
 #include "gi/vk/resources.h"
 #include "ssdo.comp.h"                  // const uint32_t ssdo_comp[]
@@ -247,9 +248,10 @@ class SsdoEffect : public gi::Effect {
   void addPasses(gi::FrameGraph& graph, gi::EffectContext& ctx,
                  const gi::SettingValues& settings) override {
     struct Io {
-      gi::TextureHandle depth, normal, albedo, material, emission, shadowMaps;
+      gi::TextureHandle depth, normal, albedo, material, shadowMaps;
       gi::BufferHandle lights, shadowViews;
-      gi::TextureHandle envMap;  // the environment (its map and importance-sampling tables)
+      gi::LitSurfaceInputs litInputs;  // what ssdo_surface reads to sum the lights
+      gi::TextureHandle envMap;        // the environment (its map and importance-sampling tables)
       gi::BufferHandle envSampling;
       gi::BufferHandle envSamples;  // environment_sampling=mis: ssdo_env_samples' table
       gi::TextureHandle surface, raw, half, ambient, indirect;
@@ -359,19 +361,14 @@ class SsdoEffect : public gi::Effect {
             const auto masks = lightMasks(c->lights());
             if (masks != surfaceMasks_ || pcfRadius(*c) != pcf_) buildSurface(*c, masks);
             for (uint32_t k = 0; k < n; ++k) {
-              const std::vector<gi::TextureHandle>& g = io->camG[k];
+              const std::vector<gi::TextureHandle>& g = io->camG[k];  // normal .. emission
+              const gi::LitSurfaceInputs camera{
+                  io->camDepth[k], g[0],       g[1],           g[2], g[3],
+                  io->shadowMaps,  io->lights, io->shadowViews};
               gi::vk::DescriptorWriter w;
-              w.buffer(0, ubo, views_[k]->buffer())
-                  .buffer(1, ubo, uniforms_.handle())
-                  .sampled(2, pc.view(io->camDepth[k]), nearest)
-                  .sampled(3, pc.view(g[0]), nearest)  // normal, albedo, material, emission
-                  .sampled(4, pc.view(g[1]), nearest)
-                  .sampled(5, pc.view(g[2]), nearest)
-                  .sampled(6, pc.view(g[3]), nearest)
-                  .buffer(7, ubo, pc.buffer(io->lights))
-                  .buffer(8, ubo, pc.buffer(io->shadowViews))
-                  .sampled(9, pc.view(io->shadowMaps), nearest)
-                  .storageImage(10, pc.view(io->camSurface[k]))
+              w.buffer(0, ubo, views_[k]->buffer()).buffer(1, ubo, uniforms_.handle());
+              camera.bind(w, pc, 2, nearest);
+              w.storageImage(10, pc.view(io->camSurface[k]))
                   .sampled(11, pc.view(io->camDepth[k]), nearest)   // unused: one layer
                   .storageImage(12, pc.view(io->camDirect))         // unused
                   .sampled(13, pc.view(io->camDepth[k]), nearest);  // unused: no contact
@@ -416,12 +413,7 @@ class SsdoEffect : public gi::Effect {
       graph.addPass(
           "ssdo_surface",
           [&](gi::PassBuilder& b) {
-            io->depth = b.read(bb.texture(res::kDepth));
-            io->normal = b.read(bb.texture(res::kNormal));
-            io->albedo = b.read(bb.texture(res::kAlbedo));
-            io->material = b.read(bb.texture(res::kMaterial));
-            io->emission = b.read(bb.texture(res::kEmission));
-            readLights(b);
+            io->litInputs.read(b, bb);
             if (layers_ > 1) io->peeled[0] = b.read(io->peeled[0]);
             io->surface = b.write(b.create("ssdo_surface", gi::TextureDesc{kPackedFormat}),
                                   gi::TextureUsage::StorageWrite);
@@ -444,24 +436,17 @@ class SsdoEffect : public gi::Effect {
             if (masks != surfaceMasks_ || pcfRadius(*c) != pcf_) buildSurface(*c, masks);
             const uint32_t kind = environmentKind(c->frame());
             if (kind != environmentKind_) buildSsdo(*c, kind);
+            const gi::TextureHandle depth = io->litInputs.depth;
             gi::vk::DescriptorWriter w;
-            w.buffer(0, ubo, frame)
-                .buffer(1, ubo, uniforms_.handle())
-                .sampled(2, pc.view(io->depth), nearest)
-                .sampled(3, pc.view(io->normal), nearest)
-                .sampled(4, pc.view(io->albedo), nearest)
-                .sampled(5, pc.view(io->material), nearest)
-                .sampled(6, pc.view(io->emission), nearest)
-                .buffer(7, ubo, pc.buffer(io->lights))
-                .buffer(8, ubo, pc.buffer(io->shadowViews))
-                .sampled(9, pc.view(io->shadowMaps), nearest)
-                .storageImage(10, pc.view(io->surface))
+            w.buffer(0, ubo, frame).buffer(1, ubo, uniforms_.handle());
+            io->litInputs.bind(w, pc, 2, nearest);
+            w.storageImage(10, pc.view(io->surface))
                 // The peeled layer (unused with one layer: the depth stands in).
-                .sampled(11, pc.view(layers_ > 1 ? io->peeled[0] : io->depth), nearest)
+                .sampled(11, pc.view(layers_ > 1 ? io->peeled[0] : depth), nearest)
                 // direct_light and the contact shadows (unused without the bounce and without
                 // contact shadows: the surface and the depth stand in).
                 .storageImage(12, pc.view(io->direct))
-                .sampled(13, pc.view(bounce_ && contact_ ? io->contact : io->depth), nearest);
+                .sampled(13, pc.view(bounce_ && contact_ ? io->contact : depth), nearest);
             const VkExtent2D e = pc.extent(io->surface);
             pc.dispatch(surface_, w, e, kGroupX, kGroupY);
             if (layers_ > 2) {
@@ -690,23 +675,11 @@ class SsdoEffect : public gi::Effect {
     pcf_ = pcfRadius(ctx);
     auto build = [&](uint32_t layers, bool mainView) {
       const bool direct = mainView && bounce_;
+      std::vector<gi::vk::Binding> bindings = gi::LitSurfaceInputs::layout(2);  // 2..9
+      bindings.insert(bindings.end(),
+                      {{0, ubo}, {1, ubo}, {10, img}, {11, tex}, {12, img}, {13, tex}});
       return gi::vk::Pipeline::compute(
-          ctx.vulkan(), {std::begin(ssdo_surface_comp), std::end(ssdo_surface_comp)},
-          {{0, ubo},
-           {1, ubo},
-           {2, tex},
-           {3, tex},
-           {4, tex},
-           {5, tex},
-           {6, tex},
-           {7, ubo},
-           {8, ubo},
-           {9, tex},
-           {10, img},
-           {11, tex},
-           {12, img},
-           {13, tex}},
-          0,
+          ctx.vulkan(), {std::begin(ssdo_surface_comp), std::end(ssdo_surface_comp)}, bindings, 0,
           {bounce_ ? 1u : 0u, masks[0], masks[1], layers, mainView ? pcf_ : 0u, direct ? 1u : 0u,
            direct && contact_ ? 1u : 0u});
     };

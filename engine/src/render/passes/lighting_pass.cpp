@@ -7,6 +7,7 @@
 #include <map>
 
 #include "gi/errors.h"
+#include "gi/lit_surface.h"
 #include "gi/vk/pipeline.h"
 #include "render/passes/builtin_passes.h"
 
@@ -34,24 +35,18 @@ class LightingPass final : public Effect {
   }
   void addPasses(FrameGraph& graph, EffectContext& ctx, const SettingValues&) override {
     struct Io {
-      TextureHandle gbuffer[5], shadowMaps, ao, ambient, indirect, contact, direct, environment,
-          lit;
-      BufferHandle lights, shadowViews;
+      LitSurfaceInputs surface;  // the G-buffer and the lights (gi/lit_surface.h)
+      TextureHandle ao, ambient, indirect, contact, direct, environment, lit;
       // ao, ambient, indirect, contact_shadow, direct_light: the neutral stand-in
       bool fallback[5] = {true, true, true, true, true};
     };
     auto io = std::make_shared<Io>();
 
     Blackboard& bb = graph.blackboard();
-    const char* gbuffer[5] = {res::kDepth, res::kNormal, res::kAlbedo, res::kMaterial,
-                              res::kEmission};
     graph.addPass(
         "lighting",
         [&](PassBuilder& b) {
-          for (int i = 0; i < 5; ++i) io->gbuffer[i] = b.read(bb.texture(gbuffer[i]));
-          io->lights = b.read(bb.buffer(res::kLights));
-          io->shadowViews = b.read(bb.buffer(res::kShadowViews));
-          io->shadowMaps = b.read(bb.texture(res::kShadowMaps));
+          io->surface.read(b, bb);
           io->ao = b.readOptional(res::kAO);
           io->ambient = b.readOptional(res::kAmbient);
           io->indirect = b.readOptional(res::kIndirect);
@@ -87,11 +82,8 @@ class LightingPass final : public Effect {
                inputMode(io->fallback[4], io->direct)});
           vk::DescriptorWriter w;
           w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame);
-          for (uint32_t i = 0; i < 5; ++i) w.sampled(1 + i, pc.view(io->gbuffer[i]), nearest);
-          w.buffer(6, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, pc.buffer(io->lights))
-              .buffer(7, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, pc.buffer(io->shadowViews))
-              .sampled(8, pc.view(io->shadowMaps), nearest)
-              .storageImage(9, pc.view(io->lit))
+          io->surface.bind(w, pc, 1, nearest);
+          w.storageImage(9, pc.view(io->lit))
               .sampled(10, pc.view(io->ao), linear)
               .sampled(11, pc.view(io->ambient), linear)
               .sampled(12, pc.view(io->indirect), linear)
@@ -131,25 +123,13 @@ class LightingPass final : public Effect {
     const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
                tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
                img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+    std::vector<vk::Binding> bindings = LitSurfaceInputs::layout(1);  // 1..8
+    bindings.insert(
+        bindings.end(),
+        {{0, ubo}, {9, img}, {10, tex}, {11, tex}, {12, tex}, {13, tex}, {14, tex}, {15, tex}});
     return pipelines_
-        .emplace(key, vk::Pipeline::compute(s_.ctx, vk::loadSpirv("lighting.comp"),
-                                            {{0, ubo},
-                                             {1, tex},
-                                             {2, tex},
-                                             {3, tex},
-                                             {4, tex},
-                                             {5, tex},
-                                             {6, ubo},
-                                             {7, ubo},
-                                             {8, tex},
-                                             {9, img},
-                                             {10, tex},
-                                             {11, tex},
-                                             {12, tex},
-                                             {13, tex},
-                                             {14, tex},
-                                             {15, tex}},
-                                            0, {key.begin(), key.end()}))
+        .emplace(key, vk::Pipeline::compute(s_.ctx, vk::loadSpirv("lighting.comp"), bindings, 0,
+                                            {key.begin(), key.end()}))
         .first->second;
   }
 
