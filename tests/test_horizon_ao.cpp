@@ -248,10 +248,14 @@ TEST_F(HorizonAoTest, PlaneIsOpen) {
   const Scene oblique =
       quadScene({{test::floorTransform(), 20.0f}}, glm::vec3(0, 1.5f, 3), glm::vec3(0, 0, -2));
   for (const Scene* s : {&headOn, &oblique})
-    for (const char* effect : {"hbao", "gtao"})
+    for (const char* effect : {"hbao", "gtao", "gtao half"})
       for (const char* blur : {"blur_radius=0", "blur_radius=2"}) {
-        const std::string b = std::string(effect) + "." + blur;
-        Result r = render(effect, *s, {std::string(effect) + ".radius=0.5", b});
+        // "gtao half": at half resolution, upsampled (downsample 2).
+        const bool half = std::string(effect) == "gtao half";
+        const std::string e = half ? "gtao" : effect, b = e + "." + blur;
+        std::vector<std::string> sets = {e + ".radius=0.5", b};
+        if (half) sets.push_back("gtao.downsample=2");
+        Result r = render(e, *s, sets);
         ASSERT_TRUE(finite(r.ao)) << b;
         int sky = 0, geometry = 0;
         float lowest = 1.0f;
@@ -265,8 +269,8 @@ TEST_F(HorizonAoTest, PlaneIsOpen) {
             ++geometry;
             lowest = std::min(lowest, r.at(x, y));
           }
-        std::printf("%s, %s: lowest AO on the plane %.4f\n", s == &headOn ? "head-on" : "oblique",
-                    b.c_str(), lowest);
+        std::printf("%s, %s%s: lowest AO on the plane %.4f\n", s == &headOn ? "head-on" : "oblique",
+                    b.c_str(), half ? " (half)" : "", lowest);
         EXPECT_GT(geometry, 1000) << b;
         EXPECT_GT(sky, 500) << b;
         EXPECT_GE(lowest, 0.99f) << b;
@@ -291,6 +295,46 @@ TEST_F(HorizonAoTest, GtaoCornerMatchesTheClosedForm) {
     EXPECT_LE(rendered - expected, 0.03) << "d = " << d;
   }
   EXPECT_LT(r.meanOnLine(0.05f), 0.65) << "near the crease AO tends to 1/2";
+}
+
+TEST_F(HorizonAoTest, GtaoAtHalfResolutionMatchesTheClosedFormAndTheFullResolution) {
+  // The corner test's setting at downsample 2 (a quarter of the pixels, each standing for a 2x2
+  // block; blurred there, upsampled by the engine's depth-aware upsample). Tolerance: within
+  // [-0.02, +0.06] of the closed form at every distance (measured -0.015 .. +0.053). Looser
+  // than at full resolution because the blur's radius 2 now spans 4 frame pixels each way:
+  // next to the crease the plane test cuts the window at the wall, so it averages pixels
+  // farther from the wall (brighter) more than nearer ones (+0.036 over full resolution at
+  // d = 0.1 R, 160x120). And the whole image within a mean 0.015 of the full-resolution one
+  // (measured 0.004), no pixel off by more than 0.15 (measured 0.078): a value carried across
+  // the crease from the wall (AO ~0.5 beside it) would exceed that.
+  const float R = 0.5f;
+  const std::vector<std::string> sets = {"gtao.radius=0.5", "gtao.falloff=0", "gtao.slices=4",
+                                         "gtao.steps=8"};
+  std::vector<std::string> halfSets = sets;
+  halfSets.push_back("gtao.downsample=2");
+  Result full = render("gtao", cornerScene(), sets), half = render("gtao", cornerScene(), halfSets);
+  ASSERT_TRUE(finite(half.ao));
+  for (float d : {0.05f, 0.1f, 0.2f, 0.3f, 0.4f, 0.7f}) {
+    const double rendered = half.meanOnLine(d), expected = half.closedFormOnLine(d, R);
+    std::printf(
+        "gtao half resolution, corner d = %.2f R: rendered %.4f (full resolution %.4f), "
+        "closed form %.4f\n",
+        d / R, rendered, full.meanOnLine(d), expected);
+    ASSERT_GE(rendered, 0.0) << "no floor pixels on the line x = " << d;
+    EXPECT_GE(rendered - expected, -0.02) << "d = " << d;
+    EXPECT_LE(rendered - expected, 0.06) << "d = " << d;
+  }
+  double sum = 0.0, worst = 0.0;
+  for (int y = 0; y < half.h; ++y)
+    for (int x = 0; x < half.w; ++x) {
+      const double diff = std::abs(double(half.at(x, y)) - full.at(x, y));
+      sum += diff;
+      worst = std::max(worst, diff);
+    }
+  const double mean = sum / (half.w * half.h);
+  std::printf("gtao half vs full resolution: mean |difference| %.4f, largest %.4f\n", mean, worst);
+  EXPECT_LT(mean, 0.015);
+  EXPECT_LT(worst, 0.15);
 }
 
 TEST_F(HorizonAoTest, GtaoBeatsSsaoAtEqualTapCount) {
@@ -425,14 +469,18 @@ TEST_F(HorizonAoTest, NoNaNAtGrazingAnglesExtremeClipPlanesOrSky) {
                                   glm::vec3(0, 0.01f, -10), 1.0f, 1e-4f, 1e5f);
   const Scene corner =
       quadScene(test::cornerQuads(), glm::vec3(2.5f, 1.6f, 0.0f), glm::vec3(0), 1.0f, 1e-4f, 1e5f);
-  for (const char* effect : {"hbao", "gtao"})
+  for (const char* effect : {"hbao", "gtao", "gtao half", "gtao quarter"})
     for (const char* radius : {"radius=0.5", "radius=1e-4", "radius=1e4"})
       for (const Scene* s : {&grazing, &corner}) {
-        const std::string e = effect, rs = e + "." + radius;
-        std::vector<std::string> sets = {rs};
+        const std::string name = effect, e = name.substr(0, 4), rs = name + "." + radius;
+        std::vector<std::string> sets = {e + "." + radius};
         if (e == "gtao")
           sets.insert(sets.end(),
                       {"gtao.bent_normals=true", "gtao.multi_bounce=true", "gtao.thickness=0.5"});
+        // Reduced resolution: the engine's upsample (1/2 blurred, 1/4 without the blur).
+        if (name == "gtao half") sets.push_back("gtao.downsample=2");
+        if (name == "gtao quarter")
+          sets.insert(sets.end(), {"gtao.downsample=4", "gtao.blur_radius=0"});
         Result r = render(e, *s, sets, e == "gtao" ? "gtao_bent_normal" : "");
         ASSERT_TRUE(finite(r.ao)) << rs;
         if (e == "gtao") {
@@ -476,6 +524,11 @@ TEST_F(HorizonAoTest, PassListsAndTheUnusedBentNormal) {
   EXPECT_EQ(passes("gtao", {}), (V{"gbuffer", "gtao", "gtao_blur"}));
   EXPECT_EQ(passes("gtao", {"gtao.blur_radius=0", "gtao.bent_normals=true"}),
             (V{"gbuffer", "gtao"}));
+  // At a reduced resolution the engine's blur upsamples; without the blur only that runs.
+  EXPECT_EQ(passes("gtao", {"gtao.downsample=2"}),
+            (V{"gbuffer", "gtao", "gtao_blur", "gtao_blur_upsample"}));
+  EXPECT_EQ(passes("gtao", {"gtao.downsample=2", "gtao.blur_radius=0"}),
+            (V{"gbuffer", "gtao", "gtao_blur_upsample"}));
   // Off, "gtao_bent_normal" is the G-buffer normal itself.
   Renderer r(ctx(), scene, settingsFor("gtao", scene, {}), &registry);
   r.renderFrame();

@@ -22,6 +22,9 @@ layout(constant_id = 0) const int kSlices = 3;
 layout(constant_id = 1) const int kSteps = 3;
 layout(constant_id = 2) const bool kBentNormals = false;
 layout(constant_id = 3) const bool kMultiBounce = false;
+// `resolution_divisor`: invocation q computes the frame pixel q x kScale, at 1 / kScale of the
+// frame's resolution in each axis; the engine's blur upsamples (gi/depth_aware_blur.h).
+layout(constant_id = 4) const int kScale = 1;
 
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 // Keep in sync with gi::gtao::Uniforms (gtao_params.h).
@@ -32,7 +35,7 @@ layout(set = 0, binding = 1) uniform GtaoParams {
 layout(set = 0, binding = 2) uniform sampler2D gDepth;
 layout(set = 0, binding = 3) uniform sampler2D gNormal;
 layout(set = 0, binding = 4) uniform sampler2D gAlbedo;  // the normal when multi_bounce is off
-layout(set = 0, binding = 5, rgba32f) uniform writeonly image2D outAO;  // depthAwareBlurPack
+layout(set = 0, binding = 5, rgba32f) uniform writeonly image2D outAO;  // depthAwareBlurPack(Scaled)
 layout(set = 0, binding = 6, rgba16f) uniform writeonly image2D outBent;  // 1x1 when off
 
 const float kPi = 3.14159265358979;
@@ -127,9 +130,11 @@ vec2 bentArc(vec2 cs, float cosN, float sinN) {
 }
 
 void main() {
-  ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+  ivec2 q = ivec2(gl_GlobalInvocationID.xy);  // the output texel; p: the frame pixel it stands for
+  ivec2 outSize = imageSize(outAO);
+  if (q.x >= outSize.x || q.y >= outSize.y) return;
+  ivec2 p = q * kScale;
   ivec2 size = ivec2(frame.viewport.xy);
-  if (p.x >= size.x || p.y >= size.y) return;
 
   float depth = texelFetch(gDepth, p, 0).r;
   vec4 normalTexel = texelFetch(gNormal, p, 0);
@@ -154,7 +159,8 @@ void main() {
   float R = gtao.params.x;
   // The radius in pixels at this depth (|P11| H / 2 pixels per unit at distance 1).
   float radiusPx = R * abs(p11) * 0.5 * frame.viewport.y / max(dist, 1e-30);
-  vec4 noise = gtao.noise[(p.y & 3) * 4 + (p.x & 3)];
+  // The phase of the output texel: the blur, which runs at the output's resolution, cancels it.
+  vec4 noise = gtao.noise[(q.y & 3) * 4 + (q.x & 3)];
   vec2 pixelCentre = vec2(p) + 0.5;
   vec2 sizeF = vec2(size);
   // View-space offset per pixel of screen motion at constant depth: the slice plane through
@@ -228,10 +234,17 @@ void main() {
     float fa = 2.0404 * a - 0.3324, fb = -4.7951 * a + 0.6417, fc = 2.7552 * a + 0.6903;
     ao = clamp(max(ao, ((fa * ao + fb) * ao + fc) * ao), 0.0, 1.0);
   }
-  imageStore(outAO, p, depthAwareBlurPack(frame, open ? 1.0 : ao, open ? vec3(0.0) : P, N));
+  imageStore(outAO, q,
+             depthAwareBlurPackScaled(frame, open ? 1.0 : ao, open ? vec3(0.0) : P, N, kScale));
   if (kBentNormals) {
     // Guard: no visible arc at all (fully occluded) or NaN falls back to the normal.
     vec3 bn = safeNormalize(bent, N);
-    imageStore(outBent, p, open ? normalTexel : vec4(bn, 1.0));
+    // At a reduced resolution, the frame pixel's bent normal for its whole block (nearest
+    // upsampling; the bent normal is not blurred either).
+    for (int y = 0; y < kScale; ++y)
+      for (int x = 0; x < kScale; ++x) {
+        ivec2 t = p + ivec2(x, y);
+        if (t.x < size.x && t.y < size.y) imageStore(outBent, t, open ? normalTexel : vec4(bn, 1.0));
+      }
   }
 }

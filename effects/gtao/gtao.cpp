@@ -82,6 +82,10 @@ class GtaoEffect : public gi::Effect {
         {"interleave", SettingType::Bool, 1, 0, 1,
          "rotate the slices and jitter the steps in a 4x4 pixel pattern for the blur to average",
          false},
+        {"downsample", SettingType::Int, 1, 1, gi::DepthAwareBlur::kMaxScale,
+         "compute at 1 / downsample of the resolution in each axis (Jimenez et al. 2016: half), "
+         "blur there and upsample depth-aware to full resolution (1: full resolution)",
+         true},
     };
   }
 
@@ -97,9 +101,12 @@ class GtaoEffect : public gi::Effect {
         vk, {std::begin(gtao_comp), std::end(gtao_comp)},
         {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, tex}, {5, img}, {6, img}}, 0,
         {uint32_t(s.integer("slices")), uint32_t(s.integer("steps")),
-         s.flag("bent_normals") ? 1u : 0u, s.flag("multi_bounce") ? 1u : 0u});
-    // The blur radius is compiled into the blur (changesGraph: prepare runs again).
-    if (s.integer("blur_radius") > 0) blur_.prepare(ctx, s.integer("blur_radius"));
+         s.flag("bent_normals") ? 1u : 0u, s.flag("multi_bounce") ? 1u : 0u,
+         uint32_t(s.integer("downsample"))});
+    // The blur radius and the downsampling are compiled into the blur (changesGraph: prepare
+    // runs again); at a reduced resolution the blur also upsamples, even with radius 0.
+    if (s.integer("blur_radius") > 0 || s.integer("downsample") > 1)
+      blur_.prepare(ctx, s.integer("blur_radius"), s.integer("downsample"));
     if (!uniforms_)
       uniforms_ =
           gi::vk::Buffer(vk, sizeof(gi::gtao::Uniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true);
@@ -119,7 +126,9 @@ class GtaoEffect : public gi::Effect {
     auto io = std::make_shared<Io>();
     gi::Blackboard& bb = graph.blackboard();
     // changesGraph settings: fixed for this graph.
-    const int blurRadius = settings.integer("blur_radius");
+    const int blurRadius = settings.integer("blur_radius"),
+              downsample = settings.integer("downsample");
+    const bool blurred = blurRadius > 0 || downsample > 1;
     const bool bentNormals = settings.flag("bent_normals"),
                multiBounce = settings.flag("multi_bounce");
     const VkBuffer frame = ctx.frameUniforms();
@@ -138,9 +147,11 @@ class GtaoEffect : public gi::Effect {
           io->depth = b.read(bb.texture(res::kDepth));
           io->normal = b.read(bb.texture(res::kNormal));
           if (multiBounce) io->albedo = b.read(bb.texture(res::kAlbedo));
-          io->raw = b.write(b.create(blurRadius > 0 ? "gtao_raw" : res::kAO,
-                                     gi::TextureDesc{gi::DepthAwareBlur::kPackedFormat}),
-                            gi::TextureUsage::StorageWrite);
+          io->raw = b.write(
+              b.create(blurred ? "gtao_raw" : res::kAO,
+                       gi::TextureDesc{gi::DepthAwareBlur::kPackedFormat,
+                                       gi::SizeClass::OutputRelative, 1.0f / float(downsample)}),
+              gi::TextureUsage::StorageWrite);
           if (bentNormals) io->bent = b.write(bentTexture, gi::TextureUsage::StorageWrite);
         },
         [this, io, values = &settings, frame, nearest, multiBounce,
@@ -160,7 +171,7 @@ class GtaoEffect : public gi::Effect {
         });
 
     io->ao = io->raw;
-    if (blurRadius > 0)
+    if (blurred)
       io->ao = blur_.addPass(graph, ctx, "gtao_blur", io->raw, res::kAO, [values = &settings] {
         return float(gi::gtao::kBlurDepthTolerance * values->number("radius"));
       });

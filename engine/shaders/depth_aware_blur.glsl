@@ -4,7 +4,8 @@
 // Producers (an effect's compute pass) write an RGBA32F texel per pixel:
 //   imageStore(out, p, depthAwareBlurPack(frame, value, P, N));
 // with P the view-space position and N the view-space unit normal (a sky pixel: P = vec3(0)).
-// The blur then reads one texel per tap. Include after common.glsl.
+// The blur then reads one texel per tap. A producer at a reduced resolution writes
+// depthAwareBlurPackScaled. Include after common.glsl.
 //
 // Blur weights: a box of width 2 radius with half-weight ends ([.5 1 1 1 .5] for radius 2), so
 // for even radii every phase of a 4x4 interleave pattern gets the same weight along each axis
@@ -31,6 +32,14 @@ vec4 depthAwareBlurPack(FrameUniforms f, float value, vec3 P, vec3 N) {
   vec2 dD = 2.0 * f.viewport.zw / p;
   vec2 slopes = nd < -1e-4 * length(D) ? iz * N.xy * dD / nd : vec2(0.0);
   return vec4(value, iz, slopes);
+}
+
+// The texel of a producer at 1 / scale of the frame's resolution (gi::DepthAwareBlur's
+// `scale`): P and N are those of the frame pixel it stands for, the slopes per low-resolution
+// pixel.
+vec4 depthAwareBlurPackScaled(FrameUniforms f, float value, vec3 P, vec3 N, int scale) {
+  vec4 t = depthAwareBlurPack(f, value, P, N);
+  return vec4(t.xy, t.zw * float(scale));
 }
 
 #endif

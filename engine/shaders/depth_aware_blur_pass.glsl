@@ -1,8 +1,10 @@
 // One axis of the engine's depth-aware blur (gi/depth_aware_blur.h, weights and edge stopping
 // in depth_aware_blur.glsl), included by depth_aware_blur_x.comp (keeps the packed texel for
-// the y pass) and depth_aware_blur_y.comp (writes the final value). One fetch per tap, no shared
+// the y pass), depth_aware_blur_y.comp (writes the final value) and
+// depth_aware_blur_y_packed.comp (keeps it for the upsample). One fetch per tap, no shared
 // memory: on llvmpipe every shared-memory access is gathered lane by lane and barriers are
-// costly. Include after defining GI_BLUR_AXIS (0: x, 1: y) and declaring `outValue` (binding 1).
+// costly. Include after defining GI_BLUR_AXIS (0: x, 1: y), GI_BLUR_KEEP_PACKED where the
+// packed texel is kept, and declaring `outValue` (binding 1).
 layout(local_size_x = 32, local_size_y = 16) in;
 
 layout(set = 0, binding = 0) uniform sampler2D inPacked;  // depthAwareBlurPack texels
@@ -35,5 +37,9 @@ void main() {
   }
   // weights >= 1: the centre always counts. Sky pixels (1/z = 0) keep their own value.
   float value = ic > 0.0 ? sum / weights : centre.x;
-  imageStore(outValue, p, GI_BLUR_AXIS == 0 ? vec4(value, centre.yzw) : vec4(value));
+#ifdef GI_BLUR_KEEP_PACKED
+  imageStore(outValue, p, vec4(value, centre.yzw));
+#else
+  imageStore(outValue, p, vec4(value));
+#endif
 }

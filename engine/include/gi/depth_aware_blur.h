@@ -1,11 +1,19 @@
 // A separable depth-aware (cross-bilateral) blur of one value per pixel, for effects whose raw
-// output is noisy or interleaved (screen-space ambient occlusion and the like).
+// output is noisy or interleaved (screen-space ambient occlusion and the like), optionally
+// computed at a reduced resolution and upsampled.
 //
 // The effect's own pass writes an RGBA32F texture (kPackedFormat) of
 // depthAwareBlurPack(frame, value, P, N) texels (depth_aware_blur.glsl: the value, 1 / view
 // distance and the tangent plane's slopes), so each blur tap is one fetch. The blur runs along x
 // then y (two dispatches in one pass) into an R16F texture of the packed input's size. Weights,
 // edge stopping and the 4x4-interleave cancellation: depth_aware_blur.glsl.
+//
+// Reduced resolution (`scale` > 1): the packed texture has 1 / scale of the frame's pixels in
+// each axis, its pixel q standing for the frame's pixel q x scale, with slopes per low-resolution
+// pixel (depthAwareBlurPackScaled). The blur runs there, and a second pass upsamples the result
+// to the frame's resolution: each pixel mixes its 4 nearest low-resolution values bilinearly,
+// keeping those whose tangent plane predicts its own depth within the tolerance (the blur's
+// test, so no value crosses a depth edge); when none does, the one whose plane comes nearest.
 #pragma once
 
 #include <functional>
@@ -21,18 +29,23 @@ class DepthAwareBlur {
   static constexpr VkFormat kPackedFormat = VK_FORMAT_R32G32B32A32_SFLOAT;
   static constexpr VkFormat kOutputFormat = VK_FORMAT_R16_SFLOAT;
   static constexpr int kMaxRadius = 8;
+  static constexpr int kMaxScale = 4;
 
-  // Builds the two pipelines; `radius` (clamped to 1..kMaxRadius) is compiled into them.
-  void prepare(EffectContext& ctx, int radius);
-  // Adds pass `name` blurring `packed` into a new texture `output` and returns it (publish it
-  // on the blackboard yourself). `tolerance()` is read each time the pass records: how far, in
-  // world units, a neighbour may lie from the centre's tangent plane and still be averaged.
+  // Builds the pipelines. `radius` (at most kMaxRadius; 0: no blur, only the upsample, which
+  // needs scale > 1) and `scale` (1..kMaxScale) are compiled into them.
+  void prepare(EffectContext& ctx, int radius, int scale = 1);
+  // Adds pass `name` blurring `packed` (and, with scale > 1, pass `name`_upsample, which reads
+  // the G-buffer depth) into a new texture `output` of the frame's resolution and returns it
+  // (publish it on the blackboard yourself). `tolerance()` is read each time a pass records: how
+  // far, in world units, a neighbour may lie from the centre's tangent plane and still be
+  // averaged.
   TextureHandle addPass(FrameGraph& graph, EffectContext& ctx, const std::string& name,
                         TextureHandle packed, const std::string& output,
                         std::function<float()> tolerance) const;
 
  private:
-  vk::Pipeline x_, y_;
+  vk::Pipeline x_, y_, upsample_;
+  int radius_ = 0, scale_ = 1;
 };
 
 }  // namespace gi

@@ -20,7 +20,8 @@
 // Bumped whenever this header, settings.h, frame_graph.h or the shader interface change in a
 // way that breaks compiled modules; the registry refuses modules built against another value.
 // 8: GpuScene::drawDepthFromBuffer (a new virtual: the vtable moved).
-#define GI_EFFECT_ABI_VERSION 8u
+// 9: DepthAwareBlur gained its reduced-resolution upsample (its layout grew).
+#define GI_EFFECT_ABI_VERSION 9u
 
 namespace gi {
 

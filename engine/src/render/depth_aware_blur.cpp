@@ -3,62 +3,110 @@
 #include <algorithm>
 #include <memory>
 
+#include "gi/errors.h"
 #include "gi/vk/resources.h"
 
 namespace gi {
 namespace {
 
-constexpr uint32_t kGroupX = 32, kGroupY = 16;  // depth_aware_blur_pass.glsl
+constexpr uint32_t kGroupX = 32, kGroupY = 16;  // depth_aware_blur_pass.glsl, _upsample.comp
 
 }  // namespace
 
-void DepthAwareBlur::prepare(EffectContext& ctx, int radius) {
+void DepthAwareBlur::prepare(EffectContext& ctx, int radius, int scale) {
   vk::Context& vk = ctx.vulkan();
   vk.requireWorkgroup(kGroupX, kGroupY, "depth-aware blur");
+  radius_ = std::clamp(radius, 0, kMaxRadius);
+  scale_ = std::clamp(scale, 1, kMaxScale);
+  if (radius_ == 0 && scale_ == 1)
+    throw Error(ErrorKind::Usage, {},
+                "depth-aware blur: radius 0 at full resolution has nothing to do");
   const std::vector<vk::Binding> bindings = {{0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER},
                                              {1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE}};
-  const std::vector<uint32_t> spec = {uint32_t(std::clamp(radius, 1, kMaxRadius))};
-  x_ = vk::Pipeline::compute(vk, vk::loadSpirv("depth_aware_blur_x.comp"), bindings, sizeof(float),
-                             spec);
-  y_ = vk::Pipeline::compute(vk, vk::loadSpirv("depth_aware_blur_y.comp"), bindings, sizeof(float),
-                             spec);
+  if (radius_ > 0) {
+    const std::vector<uint32_t> spec = {uint32_t(radius_)};
+    x_ = vk::Pipeline::compute(vk, vk::loadSpirv("depth_aware_blur_x.comp"), bindings,
+                               sizeof(float), spec);
+    // Upsampled later: the y pass keeps the packed texel (its 1/z and slopes) for the upsample.
+    y_ = vk::Pipeline::compute(
+        vk,
+        vk::loadSpirv(scale_ > 1 ? "depth_aware_blur_y_packed.comp" : "depth_aware_blur_y.comp"),
+        bindings, sizeof(float), spec);
+  }
+  if (scale_ > 1)
+    upsample_ = vk::Pipeline::compute(vk, vk::loadSpirv("depth_aware_upsample.comp"),
+                                      {{0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER},
+                                       {1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE},
+                                       {2, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER},
+                                       {3, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER}},
+                                      sizeof(float), {uint32_t(scale_)});
 }
 
 TextureHandle DepthAwareBlur::addPass(FrameGraph& graph, EffectContext& ctx,
                                       const std::string& name, TextureHandle packed,
                                       const std::string& output,
                                       std::function<float()> tolerance) const {
-  struct Io {
-    TextureHandle packed, half, out;
+  const VkSampler nearest = ctx.nearestSampler();
+  TextureHandle blurred = packed;
+  if (radius_ > 0) {
+    struct Io {
+      TextureHandle packed, half, out;
+    };
+    auto io = std::make_shared<Io>();
+    graph.addPass(
+        name,
+        [&](PassBuilder& b) {
+          io->packed = b.read(packed);
+          TextureDesc half{kPackedFormat, SizeClass::InputRelative};
+          half.relativeTo = packed;
+          io->half = b.write(b.create(name + "_x", half), TextureUsage::StorageWrite);
+          TextureDesc out{scale_ > 1 ? kPackedFormat : kOutputFormat, SizeClass::InputRelative};
+          out.relativeTo = packed;
+          io->out =
+              b.write(b.create(scale_ > 1 ? name + "_y" : output, out), TextureUsage::StorageWrite);
+        },
+        [this, io, tolerance, nearest](PassContext& pc) {
+          const VkExtent2D e = pc.extent(io->out);
+          const float tol = tolerance();
+          auto axis = [&](const vk::Pipeline& p, VkImageView in, VkImageLayout inLayout,
+                          VkImageView out) {
+            vk::DescriptorWriter w;
+            w.sampled(0, in, nearest, inLayout).storageImage(1, out);
+            vkCmdPushConstants(pc.cmd(), p.layout(), VK_SHADER_STAGE_ALL, 0, sizeof tol, &tol);
+            pc.dispatch(p, w, e, kGroupX, kGroupY);
+          };
+          axis(x_, pc.view(io->packed), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+               pc.view(io->half));
+          vk::storageWriteToSampledRead(pc.cmd(), pc.image(io->half));
+          axis(y_, pc.view(io->half), VK_IMAGE_LAYOUT_GENERAL, pc.view(io->out));
+        });
+    blurred = io->out;
+    if (scale_ == 1) return blurred;
+  }
+
+  struct Up {
+    TextureHandle packed, depth, out;
   };
-  auto io = std::make_shared<Io>();
+  auto up = std::make_shared<Up>();
   graph.addPass(
-      name,
+      name + "_upsample",
       [&](PassBuilder& b) {
-        io->packed = b.read(packed);
-        TextureDesc half{kPackedFormat, SizeClass::InputRelative};
-        half.relativeTo = packed;
-        io->half = b.write(b.create(name + "_x", half), TextureUsage::StorageWrite);
-        TextureDesc out{kOutputFormat, SizeClass::InputRelative};
-        out.relativeTo = packed;
-        io->out = b.write(b.create(output, out), TextureUsage::StorageWrite);
+        up->packed = b.read(blurred);
+        up->depth = b.read(graph.blackboard().texture(resources::kDepth));
+        up->out = b.write(b.create(output, TextureDesc{kOutputFormat}), TextureUsage::StorageWrite);
       },
-      [this, io, tolerance = std::move(tolerance),
-       nearest = ctx.nearestSampler()](PassContext& pc) {
-        const VkExtent2D e = pc.extent(io->out);
+      [this, up, tolerance = std::move(tolerance), nearest,
+       frame = ctx.frameUniforms()](PassContext& pc) {
         const float tol = tolerance();
-        auto axis = [&](const vk::Pipeline& p, VkImageView in, VkImageLayout inLayout,
-                        VkImageView out) {
-          vk::DescriptorWriter w;
-          w.sampled(0, in, nearest, inLayout).storageImage(1, out);
-          vkCmdPushConstants(pc.cmd(), p.layout(), VK_SHADER_STAGE_ALL, 0, sizeof tol, &tol);
-          pc.dispatch(p, w, e, kGroupX, kGroupY);
-        };
-        axis(x_, pc.view(io->packed), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, pc.view(io->half));
-        vk::storageWriteToSampledRead(pc.cmd(), pc.image(io->half));
-        axis(y_, pc.view(io->half), VK_IMAGE_LAYOUT_GENERAL, pc.view(io->out));
+        vk::DescriptorWriter w;
+        w.sampled(0, pc.view(up->packed), nearest)
+            .storageImage(1, pc.view(up->out))
+            .sampled(2, pc.view(up->depth), nearest)
+            .buffer(3, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame);
+        vkCmdPushConstants(pc.cmd(), upsample_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof tol, &tol);
+        pc.dispatch(upsample_, w, pc.extent(up->out), kGroupX, kGroupY);
       });
-  return io->out;
+  return up->out;
 }
 
 }  // namespace gi
