@@ -95,6 +95,24 @@ TEST_F(HardCasesTest, SsdoPeelingCamerasAndContactShadowsStayFiniteOnEveryHardCa
   }
 }
 
+// Under an equirect map with a small bright sun (assets/environments/small_sun.hdr) in place of
+// every case's environment: SSDO reading the map per direction (`map`) and by multiple
+// importance sampling with the engine's tables (`mis`, the high and ultra presets' mode), with
+// two layers and the bounce; and the ISM's environment VPLs from the same tables. 8 static
+// frames each: the map paths' guards (zero pdf, below-horizon samples, black texels) on every
+// case.
+TEST_F(HardCasesTest, EnvironmentMapPathsStayFiniteOnEveryHardCase) {
+  for (const char* mode : {"ssdo.environment_sampling=map", "ssdo.environment_sampling=mis",
+                           "ism.environment_vpls=64"}) {
+    bench::HardCaseOptions o;
+    o.effects = {std::string(mode).substr(0, std::string(mode).find('.'))};
+    o.sets = {mode, "ssdo.layers=2", "ssdo.bounce=true"};
+    o.environmentMap = std::string(GI_SOURCE_DIR) + "/assets/environments/small_sun.hdr";
+    o.flickerFrames = 8;
+    sweep(o);
+  }
+}
+
 // Obscurance's transfer modes (off by default) on every hard case, 8 static frames each: the
 // albedo transfer (albedo 1 under full occlusion: the guard) and the radiance transfer (its
 // "ambient" and "direct_light", lit neighbours in colour, W above 1), two points per ray.

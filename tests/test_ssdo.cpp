@@ -371,12 +371,18 @@ TEST_F(SsdoTest, ShadowsOnEachSideOfABoxTakeTheColourOfTheOtherSide) {
     return std::abs(p.y) < 1e-3f && std::abs(p.x) < 0.3f && p.z > 1.6f && p.z < 2.0f;
   };
   auto redness = [](glm::dvec3 c) { return c.r / (c.r + c.b); };
+  // Both effects must darken the floor beside the box (a shadow at all), or "grey" and
+  // "coloured" would say nothing: below 0.9 of the open floor's red + blue.
+  auto shade = [](glm::dvec3 c) { return c.r + c.b; };
   const Result ssao = render(s, {"ssao.radius=1"}, "ssao");
   const double aOpen = redness(mean(ssao, ssao.lit, open));
-  std::printf("ssao redness: left %.4f, right %.4f, open %.4f\n",
-              redness(mean(ssao, ssao.lit, left)), redness(mean(ssao, ssao.lit, right)), aOpen);
+  std::printf("ssao redness: left %.4f, right %.4f, open %.4f; shade left / open %.3f\n",
+              redness(mean(ssao, ssao.lit, left)), redness(mean(ssao, ssao.lit, right)), aOpen,
+              shade(mean(ssao, ssao.lit, left)) / shade(mean(ssao, ssao.lit, open)));
   EXPECT_NEAR(redness(mean(ssao, ssao.lit, left)), aOpen, 0.005);
   EXPECT_NEAR(redness(mean(ssao, ssao.lit, right)), aOpen, 0.005);
+  EXPECT_LT(shade(mean(ssao, ssao.lit, left)), 0.9 * shade(mean(ssao, ssao.lit, open)));
+  EXPECT_LT(shade(mean(ssao, ssao.lit, right)), 0.9 * shade(mean(ssao, ssao.lit, open)));
   for (const char* mode : {"sh9", "mis"}) {
     const Result r = render(s, {"ssdo.bounce=false", "ssdo.radius=1",
                                 std::string("ssdo.environment_sampling=") + mode});
@@ -384,8 +390,11 @@ TEST_F(SsdoTest, ShadowsOnEachSideOfABoxTakeTheColourOfTheOtherSide) {
     const double l = redness(mean(r, r.lit, left, &nLeft)),
                  rr = redness(mean(r, r.lit, right, &nRight)),
                  o = redness(mean(r, r.lit, open, &nOpen));
-    std::printf("ssdo %s redness: left %.4f, right %.4f, open %.4f\n", mode, l, rr, o);
+    std::printf("ssdo %s redness: left %.4f, right %.4f, open %.4f; shade left / open %.3f\n", mode,
+                l, rr, o, shade(mean(r, r.lit, left)) / shade(mean(r, r.lit, open)));
     ASSERT_GT(std::min({nLeft, nRight, nOpen}), 20) << mode;
+    EXPECT_LT(shade(mean(r, r.lit, left)), 0.9 * shade(mean(r, r.lit, open))) << mode;
+    EXPECT_LT(shade(mean(r, r.lit, right)), 0.9 * shade(mean(r, r.lit, open))) << mode;
     EXPECT_NEAR(o, 0.5, 0.05) << mode << ": the open floor sees both halves alike";
     EXPECT_GT(l, o + 0.05) << mode << ": the shadow left of the box is red";
     EXPECT_LT(rr, o - 0.05) << mode << ": the shadow right of the box is blue";
@@ -702,6 +711,43 @@ TEST_F(SsdoTest, AdditionalCameraSeesAnOccluderOutsideTheView) {
   EXPECT_TRUE(finite(extra.ambient));
   EXPECT_TRUE(finite(extra.indirect));
   EXPECT_TRUE(finite(extra.lit));
+}
+
+// The same off-screen box as an emissive yellow sender under a black environment: only the
+// additional camera's G-buffer holds it, so only with the camera does the floor beside it
+// receive a bounce, yellow (r = g, b = 0); far from it, none either way.
+TEST_F(SsdoTest, AdditionalCameraAddsTheBounceOfASenderOutsideTheView) {
+  const Scene s = jsonScene("offscreen_sender", R"({
+      "models": [
+        { "primitive": "plane", "size": 8, "material": { "base_color": [1, 1, 1] } },
+        { "primitive": "box", "size": [1, 3, 1], "translation": [-3.2, 1.5, 0],
+          "material": { "base_color": [1, 1, 0], "emission": [1, 1, 0] } } ],
+      "lights": [ { "type": "directional", "intensity": 0, "casts_shadows": false } ],
+      "camera": { "position": [0, 3, 3], "target": [0, 0, 0] },
+      "environment": { "type": "constant", "color": [0, 0, 0] } })");
+  const Result main = render(s, {"ssdo.radius=1", "ssdo.cameras=0"});
+  const Result extra = render(s, {"ssdo.radius=1", "ssdo.cameras=1"});
+  auto nearBox = [](glm::vec3 p) {
+    return std::abs(p.y) < 1e-3f && p.x < -1.9f && std::abs(p.z) < 0.4f;
+  };
+  auto far = [](glm::vec3 p) {
+    return std::abs(p.y) < 1e-3f && p.x > -0.5f && p.x < 1.0f && std::abs(p.z) < 1.0f;
+  };
+  int n = 0;
+  const glm::dvec3 m = mean(main, main.indirect, nearBox, &n),
+                   e = mean(extra, extra.indirect, nearBox);
+  const glm::dvec3 eFar = mean(extra, extra.indirect, far);
+  std::printf(
+      "floor next to the off-screen sender: indirect %.5f without the camera, %.5f %.5f "
+      "%.5f with it; far %.5f\n",
+      m.r, e.r, e.g, e.b, eFar.r);
+  ASSERT_GT(n, 20);
+  EXPECT_EQ(m.r, 0.0) << "the main view alone holds no sender";
+  EXPECT_GT(e.r, 1e-3) << "the additional camera's sender must light the floor";
+  EXPECT_NEAR(e.g, e.r, 0.01 * e.r);
+  EXPECT_LT(e.b, 1e-6);
+  EXPECT_EQ(eFar.r, 0.0) << "beyond the radius of every sender";
+  EXPECT_TRUE(finite(extra.indirect));
 }
 
 // Seed 000 §5, contact shadows: a 0.1 box on a 16 m plane under a directional light (no

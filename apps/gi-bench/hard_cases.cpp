@@ -1,5 +1,7 @@
 #include "hard_cases.h"
 
+#include "gi/environment.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -345,9 +347,13 @@ std::vector<HardCaseRun> runHardCases(vk::Context& ctx, const EffectRegistry& re
     cases = std::move(chosen);
   }
 
+  Environment map;
+  if (!options.environmentMap.empty()) loadEnvironmentMap(map, options.environmentMap);
+
   std::vector<HardCaseRun> runs;
   for (const HardCase& hc : cases) {
-    const Scene scene = hc.build();
+    Scene scene = hc.build();
+    if (!options.environmentMap.empty()) scene.environment = map;
     for (const std::string& effect : effects) {
       const auto start = std::chrono::steady_clock::now();
       HardCaseRun run{hc.name, effect};

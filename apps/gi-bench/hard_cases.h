@@ -39,6 +39,10 @@ struct HardCaseOptions {
   // Settings for the effects, "effect.key=value" (as gi-render --set): e.g. the ISM's
   // environment VPLs, which its defaults leave off.
   std::vector<std::string> sets;
+  // An equirect HDR map (gi::loadEnvironmentMap) that replaces every case's environment (empty:
+  // each case's own): the map paths of effects that read it (SSDO's `environment_sampling`
+  // map and mis, the ISM's environment VPLs) on every case.
+  std::string environmentMap;
 };
 
 // Largest change allowed between two frames of a static camera, relative to max(1, |value|):

@@ -106,6 +106,7 @@ const char* kUsage =
     "                        NRMSE hides (SSAO's NRMSE is ~flat from 1 to 64 samples)\n"
     "  --cases A,B           --hard-cases: only these cases (default: all)\n"
     "  --set E.K=V           --hard-cases: a setting of effect E for its runs (repeatable)\n"
+    "  --environment-map F   --hard-cases: every case under this equirect HDR map\n"
     "  --no-progress         no progress lines on stderr\n"
     "  --validation          Vulkan validation layers (also GI_VALIDATION=1)\n"
     "  --device NAME         Vulkan device by name or index (also GI_DEVICE)\n"
@@ -127,6 +128,7 @@ struct Options {
   bool hardCases = false;
   std::vector<std::string> cases;  // --hard-cases: a subset
   std::vector<std::string> sets;   // --hard-cases: effect settings
+  std::string environmentMap;      // --hard-cases: replaces every case's environment
   bool quick = false, calibrate = false, progress = true, validation = false, aoSplit = false;
   std::optional<ref::Quantity> target;  // --target: one light quantity for every configuration
   bool excludeEmitters = false;         // --exclude-emitters
@@ -192,6 +194,8 @@ Options parseArgs(int argc, char** argv) {
       o.cases = a.list();
     else if (a.is("--set"))
       o.sets.push_back(a.value());
+    else if (a.is("--environment-map"))
+      o.environmentMap = a.value();
     else if (a.is("--target")) {
       const std::string q = a.value();
       if (q != "direct" && q != "direct+indirect")
@@ -235,6 +239,8 @@ Options parseArgs(int argc, char** argv) {
   if (!o.hardCases && !o.cases.empty()) usageError("--cases", "only applies to --hard-cases");
   if (!o.hardCases && !o.sets.empty())
     usageError("--set", "only applies to --hard-cases (sweeps use --grid)");
+  if (!o.hardCases && !o.environmentMap.empty())
+    usageError("--environment-map", "only applies to --hard-cases");
   if (o.target && (o.aoSplit || o.calibrate || o.hardCases))
     usageError("--target", "excludes --ao-split, --calibrate and --hard-cases");
   if (o.hardCases) {
@@ -1349,6 +1355,7 @@ int runHardCaseSweep(const Options& o) {
   hc.flickerFrames = o.frames;
   hc.cases = o.cases;
   hc.sets = o.sets;
+  hc.environmentMap = o.environmentMap;
   if (o.effects)
     for (const std::string& item : *o.effects) hc.effects.push_back(item);
   gi::vk::Context ctx = makeContext(o);
