@@ -657,20 +657,37 @@ TEST_F(SsdoTest, DepthPeelingLightsTheFloorBehindAThinWall) {
   EXPECT_TRUE(finite(two.lit));
 }
 
+// The scene of the additional-camera tests (JSON): a floor and a 1 x 3 x 1 box just left of the
+// main view (off-screen), the box's and the floor's materials and the environment given; and
+// the floor regions next to the box (the image's left edge) and far from it.
+std::string offscreenBoxScene(const std::string& floorMaterial, const std::string& boxMaterial,
+                              const std::string& environment) {
+  return std::string(R"({ "models": [
+        { "primitive": "plane", "size": 8, "material": )") +
+         floorMaterial + R"( },
+        { "primitive": "box", "size": [1, 3, 1], "translation": [-3.2, 1.5, 0], "material": )" +
+         boxMaterial + R"( } ],
+      "lights": [ { "type": "directional", "intensity": 0, "casts_shadows": false } ],
+      "camera": { "position": [0, 3, 3], "target": [0, 0, 0] },
+      "environment": )" +
+         environment + " }";
+}
+bool nextToTheOffscreenBox(glm::vec3 p) {
+  return std::abs(p.y) < 1e-3f && p.x < -1.9f && std::abs(p.z) < 0.4f;
+}
+bool farFromTheOffscreenBox(glm::vec3 p) {
+  return std::abs(p.y) < 1e-3f && p.x > -0.5f && p.x < 1.0f && std::abs(p.z) < 1.0f;
+}
+
 // Seed 000 §4, additional cameras: a box just left of the main view shadows the floor at the
 // image's left edge only when the first additional camera (displaced to the right, aimed at the
 // centre of interest: it sees past the left edge) sees it; the main view's samples there leave
 // the image: open. The floor far from it keeps its value (the extra view
 // adds no self-occlusion), and the bounce stays finite.
 TEST_F(SsdoTest, AdditionalCameraSeesAnOccluderOutsideTheView) {
-  const Scene s = jsonScene("offscreen", R"({
-      "models": [
-        { "primitive": "plane", "size": 8, "material": { "base_color": [0.5, 0.5, 0.5] } },
-        { "primitive": "box", "size": [1, 3, 1], "translation": [-3.2, 1.5, 0],
-          "material": { "base_color": [0.5, 0.5, 0.5] } } ],
-      "lights": [ { "type": "directional", "intensity": 0, "casts_shadows": false } ],
-      "camera": { "position": [0, 3, 3], "target": [0, 0, 0] },
-      "environment": { "type": "constant", "color": [1, 1, 1] } })");
+  const std::string grey = R"({ "base_color": [0.5, 0.5, 0.5] })";
+  const Scene s = jsonScene(
+      "offscreen", offscreenBoxScene(grey, grey, R"({ "type": "constant", "color": [1, 1, 1] })"));
   const Result main = render(s, {"ssdo.radius=1", "ssdo.cameras=0"});
   const Result extra = render(s, {"ssdo.radius=1", "ssdo.cameras=1"});
   for (int y = 0; y < main.h; ++y)
@@ -679,12 +696,8 @@ TEST_F(SsdoTest, AdditionalCameraSeesAnOccluderOutsideTheView) {
           << "the box must be off-screen: " << x << "," << y << " " << main.worldAt(x, y).x << " "
           << main.worldAt(x, y).y << " " << main.worldAt(x, y).z;
     }
-  auto nearBox = [](glm::vec3 p) {
-    return std::abs(p.y) < 1e-3f && p.x < -1.9f && std::abs(p.z) < 0.4f;
-  };
-  auto far = [](glm::vec3 p) {
-    return std::abs(p.y) < 1e-3f && p.x > -0.5f && p.x < 1.0f && std::abs(p.z) < 1.0f;
-  };
+  const auto nearBox = nextToTheOffscreenBox;
+  const auto far = farFromTheOffscreenBox;
   int n = 0;
   const glm::dvec3 m = mean(main, main.ambient, nearBox, &n),
                    e = mean(extra, extra.ambient, nearBox);
@@ -717,26 +730,16 @@ TEST_F(SsdoTest, AdditionalCameraSeesAnOccluderOutsideTheView) {
 // additional camera's G-buffer holds it, so only with the camera does the floor beside it
 // receive a bounce, yellow (r = g, b = 0); far from it, none either way.
 TEST_F(SsdoTest, AdditionalCameraAddsTheBounceOfASenderOutsideTheView) {
-  const Scene s = jsonScene("offscreen_sender", R"({
-      "models": [
-        { "primitive": "plane", "size": 8, "material": { "base_color": [1, 1, 1] } },
-        { "primitive": "box", "size": [1, 3, 1], "translation": [-3.2, 1.5, 0],
-          "material": { "base_color": [1, 1, 0], "emission": [1, 1, 0] } } ],
-      "lights": [ { "type": "directional", "intensity": 0, "casts_shadows": false } ],
-      "camera": { "position": [0, 3, 3], "target": [0, 0, 0] },
-      "environment": { "type": "constant", "color": [0, 0, 0] } })");
+  const Scene s = jsonScene(
+      "offscreen_sender", offscreenBoxScene(R"({ "base_color": [1, 1, 1] })",
+                                            R"({ "base_color": [1, 1, 0], "emission": [1, 1, 0] })",
+                                            R"({ "type": "constant", "color": [0, 0, 0] })"));
   const Result main = render(s, {"ssdo.radius=1", "ssdo.cameras=0"});
   const Result extra = render(s, {"ssdo.radius=1", "ssdo.cameras=1"});
-  auto nearBox = [](glm::vec3 p) {
-    return std::abs(p.y) < 1e-3f && p.x < -1.9f && std::abs(p.z) < 0.4f;
-  };
-  auto far = [](glm::vec3 p) {
-    return std::abs(p.y) < 1e-3f && p.x > -0.5f && p.x < 1.0f && std::abs(p.z) < 1.0f;
-  };
   int n = 0;
-  const glm::dvec3 m = mean(main, main.indirect, nearBox, &n),
-                   e = mean(extra, extra.indirect, nearBox);
-  const glm::dvec3 eFar = mean(extra, extra.indirect, far);
+  const glm::dvec3 m = mean(main, main.indirect, nextToTheOffscreenBox, &n),
+                   e = mean(extra, extra.indirect, nextToTheOffscreenBox);
+  const glm::dvec3 eFar = mean(extra, extra.indirect, farFromTheOffscreenBox);
   std::printf(
       "floor next to the off-screen sender: indirect %.5f without the camera, %.5f %.5f "
       "%.5f with it; far %.5f\n",

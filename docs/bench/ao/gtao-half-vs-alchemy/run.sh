@@ -2,11 +2,11 @@
 # GTAO at half resolution (gtao.downsample=2) and at full resolution against Alchemy at its
 # cheapest settings, one interleaved gi-bench run per scene (8 configurations: one batch, so
 # every pair shares its rounds), passes submitted alone, then paired at matched error.
-# Usage: docs/bench/ao/gtao-half-vs-alchemy/run.sh [REPS]   (41: ~3 min per scene, idle)
+# Usage: docs/bench/ao/gtao-half-vs-alchemy/run.sh [REPS [OUT]]   (41: ~3.5 min in all, idle)
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/../../../.."
 reps=${1:-41}
-out=docs/bench/ao/gtao-half-vs-alchemy
+out=${2:-docs/bench/ao/gtao-half-vs-alchemy}
 for s in default:default bunny_on_plane:assets/scenes/bunny_on_plane.json; do
   name=${s%%:*} scene=${s#*:}
   build/bin/gi-bench --out "$out/$name" --isolate-passes --scenes "$scene" --effects alchemy,gtao \
