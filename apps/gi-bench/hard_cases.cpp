@@ -1,7 +1,5 @@
 #include "hard_cases.h"
 
-#include "gi/environment.h"
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -12,6 +10,7 @@
 
 #include "gi/effect.h"
 #include "gi/effect_config.h"
+#include "gi/environment.h"
 #include "gi/errors.h"
 #include "gi/renderer.h"
 

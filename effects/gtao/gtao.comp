@@ -22,7 +22,7 @@ layout(constant_id = 0) const int kSlices = 3;
 layout(constant_id = 1) const int kSteps = 3;
 layout(constant_id = 2) const bool kBentNormals = false;
 layout(constant_id = 3) const bool kMultiBounce = false;
-// `resolution_divisor`: invocation q computes the frame pixel q x kScale, at 1 / kScale of the
+// `downsample`: invocation q computes the frame pixel q x kScale, at 1 / kScale of the
 // frame's resolution in each axis; the engine's blur upsamples (gi/depth_aware_blur.h).
 layout(constant_id = 4) const int kScale = 1;
 

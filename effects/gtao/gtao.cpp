@@ -1,7 +1,8 @@
 // Ground-truth ambient occlusion (Jimenez et al. 2016; RTR 4th ed. 11.3.7): horizon search in
 // slices through the view vector, the cosine-weighted visible arc in closed form, optional bent
-// normals and multi-bounce fit, and a depth-aware blur that removes the 4x4 interleave pattern.
-// Publishes "ao" (and "gtao_bent_normal"). Estimator: gtao_params.h; settings: README.md.
+// normals and multi-bounce fit, and a depth-aware blur that removes the 4x4 interleave pattern
+// (optionally all at a reduced resolution, upsampled by the engine's blur). Publishes "ao" (and
+// "gtao_bent_normal"). Estimator: gtao_params.h; settings: README.md.
 #include <algorithm>
 #include <array>
 #include <memory>
@@ -83,8 +84,8 @@ class GtaoEffect : public gi::Effect {
          "rotate the slices and jitter the steps in a 4x4 pixel pattern for the blur to average",
          false},
         {"downsample", SettingType::Int, 1, 1, gi::DepthAwareBlur::kMaxScale,
-         "compute at 1 / downsample of the resolution in each axis (Jimenez et al. 2016: half), "
-         "blur there and upsample depth-aware to full resolution (1: full resolution)",
+         "compute at 1 / downsample of the resolution in each axis, blur there and upsample "
+         "depth-aware to full resolution (1: full resolution)",
          true},
     };
   }
