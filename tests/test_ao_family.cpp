@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "effect_fixture.h"
+#include "gi/scene_io.h"
 #include "quad_scene.h"
 #include "test_support.h"
 
@@ -171,6 +172,63 @@ TEST_P(AoFamilyTest, ScaleInvariant) {
     EXPECT_LT(diff / n, 0.005) << "mean |AO(x1) - AO(x" << scale << ")|";
     EXPECT_LT(double(over) / n, 0.01) << "pixels differing by more than 0.05, x" << scale;
   }
+}
+
+// Issue 11's second SSAO defect, on every AO plugin and without a scene file: a 90-degree corner
+// (a 4 x 4 floor and a 2-high wall) loaded as a bare OBJ model at scale 1 and 1e6 (a model a
+// million units wide). Nothing is set: the camera frames the model and every world-length
+// default follows its size (Scene::lengthScale), so both give the same AO image; the crease is
+// occluded and the floor far from it open (no false occlusion or banding on flat faces).
+TEST_P(AoFamilyTest, BareModelAMillionUnitsWideGetsTheSameAOAsAtUnitScale) {
+  auto corner = [](double scale) {
+    std::string obj = "vn 0 1 0\nvn 1 0 0\n";
+    const double v[8][3] = {{-2, 0, -2}, {2, 0, -2},  {2, 0, 2},  {-2, 0, 2},
+                            {-2, 0, -2}, {-2, 2, -2}, {-2, 2, 2}, {-2, 0, 2}};
+    for (const auto& p : v) {
+      char line[128];
+      std::snprintf(line, sizeof line, "v %.17g %.17g %.17g\n", p[0] * scale, p[1] * scale,
+                    p[2] * scale);
+      obj += line;
+    }
+    obj += "f 1//1 4//1 3//1\nf 1//1 3//1 2//1\nf 5//2 6//2 7//2\nf 5//2 7//2 8//2\n";
+    return obj;
+  };
+  test::TempDir dir("ao_family_bare");
+  const Scene unit = loadScene(dir.write("corner_1.obj", corner(1.0)));
+  const Scene huge = loadScene(dir.write("corner_1e6.obj", corner(1e6)));
+  ASSERT_NEAR(huge.lengthScale / unit.lengthScale, 1e6, 1.0);
+  Result a = render(unit, {}), b = render(huge, {});
+  ASSERT_TRUE(finite(a.ao));
+  ASSERT_TRUE(finite(b.ao));
+  double diff = 0.0, darkest = 1.0;
+  size_t over = 0, geometry = 0, openFloor = 0, darkFloor = 0;
+  const size_t n = a.ao.pixels.size() / 4;
+  for (size_t i = 0; i < n; ++i) {
+    const double e = std::abs(a.ao.pixels[i * 4] - b.ao.pixels[i * 4]);
+    diff += e;
+    over += e > 0.05;
+    darkest = std::min<double>(darkest, a.ao.pixels[i * 4]);
+    const int x = int(i % a.w), y = int(i / a.w);
+    if (a.depth.pixels[i * 4] <= 0.0f) continue;
+    ++geometry;
+    const glm::vec3 w = a.worldAt(x, y);
+    // Floor pixels farther than 4 default radii (2 units at the reference size; the model's
+    // lengthScale is its diagonal over the reference's) from the wall: open.
+    if (std::abs(w.y) < 1e-3f && w.x > -2.0f + 2.0f * unit.lengthScale) {
+      ++openFloor;
+      darkFloor += b.ao.pixels[i * 4] < 0.98f;
+    }
+  }
+  std::printf(
+      "bare corner x1 vs x1e6: mean |diff| %.5f, %zu of %zu pixels differ by > 0.05; "
+      "darkest %.3f; %zu of %zu far floor pixels below 0.98 at x1e6\n",
+      diff / n, over, n, darkest, darkFloor, openFloor);
+  ASSERT_GT(geometry, n / 8);  // the framing camera shows the corner with sky around it (4050)
+  ASSERT_LT(darkest, 0.8) << "the crease must be occluded for the comparison to bite";
+  ASSERT_GT(openFloor, 300u);  // 444
+  EXPECT_LT(diff / n, 0.005);
+  EXPECT_LT(double(over) / n, 0.01);
+  EXPECT_LT(double(darkFloor) / openFloor, 0.01) << "false occlusion on the flat floor at x1e6";
 }
 
 TEST_P(AoFamilyTest, NoHaloAcrossDepthDiscontinuities) {
