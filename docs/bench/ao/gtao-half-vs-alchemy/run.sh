@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # GTAO at half resolution (gtao.downsample=2) and at full resolution against Alchemy at its
-# cheapest settings, one interleaved gi-bench run per scene (8 configurations: one batch, so
+# cheapest settings, one interleaved gi-bench run per scene (9 configurations: one batch, so
 # every pair shares its rounds), passes submitted alone, then paired at matched error.
 # Usage: docs/bench/ao/gtao-half-vs-alchemy/run.sh [REPS [OUT]]   (41: ~3.5 min in all, idle)
 set -euo pipefail
