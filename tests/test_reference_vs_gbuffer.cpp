@@ -118,7 +118,7 @@ TEST_F(ReferenceVsGBuffer, LoadedModel) {
 }
 
 TEST_F(ReferenceVsGBuffer, BunnyOnPlane) {
-  GI_REQUIRE_SHARED_ASSET(bunny, "stanford_bunny/reconstruction/bun_zipper.ply");
+  const std::string bunny = gi::test::modelAsset("stanford_bunny/bun_zipper.ply");
   compare(loadScene(std::string(GI_SOURCE_DIR) + "/assets/scenes/bunny_on_plane.json"),
           "bunny on plane");
 }
@@ -130,7 +130,7 @@ TEST_F(ReferenceVsGBuffer, SkinnedAndMorphedModelsAtATime) {
   compare(loadScene(test::assimpModel(
               "glTF2/glTF-Sample-Models/AnimatedMorphCube-glTF/AnimatedMorphCube.gltf")),
           "AnimatedMorphCube", 1.3, 0.05);
-  GI_REQUIRE_SHARED_ASSET(path, "cesium_man/glTF/CesiumMan.gltf");
+  const std::string path = gi::test::modelAsset("cesium_man/glTF/CesiumMan.gltf");
   compare(loadScene(path), "CesiumMan", 1.1, 0.03);
 }
 

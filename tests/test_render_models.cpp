@@ -51,22 +51,22 @@ TEST_F(ModelRenderTest, TwoCylinderEngine) {
 }
 
 TEST_F(ModelRenderTest, Fox) {
-  GI_REQUIRE_SHARED_ASSET(path, "fox/glTF-Binary/Fox.glb");
+  const std::string path = gi::test::modelAsset("fox/glTF-Binary/Fox.glb");
   expectRenders(path);
 }
 
 TEST_F(ModelRenderTest, CesiumMan) {
-  GI_REQUIRE_SHARED_ASSET(path, "cesium_man/glTF/CesiumMan.gltf");
+  const std::string path = gi::test::modelAsset("cesium_man/glTF/CesiumMan.gltf");
   expectRenders(path);
 }
 
 TEST_F(ModelRenderTest, CornellBoxObj) {
-  GI_REQUIRE_SHARED_ASSET(path, "cornell_box/cornell_box.obj");
+  const std::string path = gi::test::modelAsset("cornell_box/cornell_box.obj");
   expectRenders(path);
 }
 
 TEST_F(ModelRenderTest, StanfordBunnyPly) {
-  GI_REQUIRE_SHARED_ASSET(path, "stanford_bunny/reconstruction/bun_zipper.ply");
+  const std::string path = gi::test::modelAsset("stanford_bunny/bun_zipper.ply");
   expectRenders(path);
 }
 

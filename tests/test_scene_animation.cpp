@@ -390,7 +390,7 @@ TEST(AnimationFiles, AnimatedMorphCube) {
 }
 
 TEST(AnimationFiles, CesiumMan) {
-  GI_REQUIRE_SHARED_ASSET(path, "cesium_man/glTF/CesiumMan.gltf");
+  const std::string path = gi::test::modelAsset("cesium_man/glTF/CesiumMan.gltf");
   Scene s = loadGltf(path);
   ASSERT_EQ(s.skins.size(), 1u);
   EXPECT_EQ(s.skins[0].joints.size(), 19u);
@@ -411,7 +411,7 @@ TEST(AnimationFiles, CesiumMan) {
 }
 
 TEST(AnimationFiles, FoxHasThreeClips) {
-  GI_REQUIRE_SHARED_ASSET(path, "fox/glTF/Fox.gltf");
+  const std::string path = gi::test::modelAsset("fox/glTF/Fox.gltf");
   Scene s = loadGltf(path);
   ASSERT_EQ(s.animations.size(), 3u);
   EXPECT_EQ(s.animations[0].name, "Survey");

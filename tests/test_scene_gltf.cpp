@@ -520,8 +520,8 @@ TEST(GltfModels, TwoCylinderEngine) {
 }
 
 TEST(GltfModels, Fox) {
-  GI_REQUIRE_SHARED_ASSET(gltf, "fox/glTF/Fox.gltf");
-  for (const std::string& file : {gltf, gi::test::sharedAsset("fox/glTF-Binary/Fox.glb")}) {
+  const std::string gltf = gi::test::modelAsset("fox/glTF/Fox.gltf");
+  for (const std::string& file : {gltf, gi::test::modelAsset("fox/glTF-Binary/Fox.glb")}) {
     SCOPED_TRACE(file);
     gi::Scene scene = gi::loadGltf(file);  // skinned and animated: both are ignored
     EXPECT_EQ(scene.triangleCount(), declaredTriangles(readGltfJson(file)));
@@ -534,9 +534,9 @@ TEST(GltfModels, Fox) {
 }
 
 TEST(GltfModels, CesiumMan) {
-  GI_REQUIRE_SHARED_ASSET(gltf, "cesium_man/glTF/CesiumMan.gltf");
+  const std::string gltf = gi::test::modelAsset("cesium_man/glTF/CesiumMan.gltf");
   for (const std::string& file :
-       {gltf, gi::test::sharedAsset("cesium_man/glTF-Binary/CesiumMan.glb")}) {
+       {gltf, gi::test::modelAsset("cesium_man/glTF-Binary/CesiumMan.glb")}) {
     SCOPED_TRACE(file);
     gi::Scene scene = gi::loadGltf(file);
     EXPECT_EQ(scene.triangleCount(), declaredTriangles(readGltfJson(file)));

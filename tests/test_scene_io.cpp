@@ -105,7 +105,7 @@ size_t plyHeaderFaces(const std::string& path) {
 // OBJ / PLY
 
 TEST(SceneIo, CornellBoxObj) {
-  GI_REQUIRE_SHARED_ASSET(path, "cornell_box/cornell_box.obj");
+  const std::string path = gi::test::modelAsset("cornell_box/cornell_box.obj");
   gi::Scene s = gi::loadScene(path);
   expectSaneScene(s);
   const size_t expected = objTriangles(path);
@@ -135,7 +135,7 @@ TEST(SceneIo, CornellBoxObj) {
 }
 
 TEST(SceneIo, BunnyPly) {
-  GI_REQUIRE_SHARED_ASSET(path, "stanford_bunny/reconstruction/bun_zipper.ply");
+  const std::string path = gi::test::modelAsset("stanford_bunny/bun_zipper.ply");
   gi::Scene s = gi::loadScene(path);
   expectSaneScene(s);
   EXPECT_EQ(plyHeaderFaces(path), 69451u);
@@ -517,18 +517,19 @@ TEST(SceneIo, JsonPathVariables) {
         R"({"models": [{"file": "${ASSIMP_MODELS}/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb"}]})"));
     EXPECT_GT(s.triangleCount(), 1000u);
   }
-  // ${GI_SHARED_ASSETS} from the environment variable.
+  // ${ASSIMP_MODELS} from the environment variable.
   dir.write("assets/t.obj", kTriangleObj);
-  ::setenv("GI_SHARED_ASSETS", dir.path("assets").c_str(), 1);
+  ::setenv("ASSIMP_MODELS", dir.path("assets").c_str(), 1);
   gi::Scene s =
-      gi::loadScene(dir.write("s.json", R"({"models": [{"file": "${GI_SHARED_ASSETS}/t.obj"}]})"));
-  ::unsetenv("GI_SHARED_ASSETS");
+      gi::loadScene(dir.write("s.json", R"({"models": [{"file": "${ASSIMP_MODELS}/t.obj"}]})"));
+  ::unsetenv("ASSIMP_MODELS");
   EXPECT_EQ(s.triangleCount(), 1u);
-  // ... and from a shared/assets folder above the scene file.
+  // Nothing is searched for above the scene file: a variable for a folder there is unknown.
   dir.write("shared/assets/u.obj", kTriangleObj);
-  gi::Scene u = gi::loadScene(
-      dir.write("deep/er/s.json", R"({"models": [{"file": "${GI_SHARED_ASSETS}/u.obj"}]})"));
-  EXPECT_EQ(u.triangleCount(), 1u);
+  const std::string above =
+      dir.write("deep/er/s.json", R"({"models": [{"file": "${SHARED}/u.obj"}]})");
+  expectError([&] { gi::loadScene(above); }, gi::ErrorKind::Schema, above,
+              "unknown variable '${SHARED}' (known: ${ASSIMP_MODELS}");
   const std::string bad = dir.write("v.json", R"({"models": [{"file": "${NOPE}/u.obj"}]})");
   expectError([&] { gi::loadScene(bad); }, gi::ErrorKind::Schema, bad, "NOPE");
 }
@@ -623,7 +624,7 @@ TEST(SceneIo, JsonErrors) {
 TEST(SceneIo, ExampleScenes) {
   const fs::path scenes = fs::path(GI_SOURCE_DIR) / "assets" / "scenes";
   {
-    GI_REQUIRE_SHARED_ASSET(obj, "cornell_box/cornell_box.obj");
+    const std::string obj = gi::test::modelAsset("cornell_box/cornell_box.obj");
     gi::Scene s = gi::loadScene((scenes / "cornell_box.json").string());
     expectSaneScene(s);
     EXPECT_EQ(s.triangleCount(), objTriangles(obj));
@@ -635,7 +636,7 @@ TEST(SceneIo, ExampleScenes) {
     EXPECT_NEAR(bmax.x, 5.56f, 1e-3f);  // scaled from millimetres
   }
   {
-    GI_REQUIRE_SHARED_ASSET(ply, "stanford_bunny/reconstruction/bun_zipper.ply");
+    const std::string ply = gi::test::modelAsset("stanford_bunny/bun_zipper.ply");
     gi::Scene s = gi::loadScene((scenes / "bunny_on_plane.json").string());
     expectSaneScene(s);
     EXPECT_EQ(s.triangleCount(), plyHeaderFaces(ply) + 2);  // + the ground plane
@@ -646,7 +647,7 @@ TEST(SceneIo, ExampleScenes) {
   {
     // The room with the bunny inside it: the room's bounds (so from the room's camera the same
     // pixels are geometry, docs/bench/ao/triangles), the bunny's triangles added.
-    GI_REQUIRE_SHARED_ASSET(ply, "stanford_bunny/reconstruction/bun_zipper.ply");
+    const std::string ply = gi::test::modelAsset("stanford_bunny/bun_zipper.ply");
     const gi::Scene room = gi::makeDefaultScene();
     gi::Scene s = gi::loadScene((scenes / "room_bunny.json").string());
     expectSaneScene(s);

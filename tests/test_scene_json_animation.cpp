@@ -178,7 +178,7 @@ TEST(JsonAnimation, ClipSelection) {
   p = dir.write("f.json", R"({"models": [{"primitive": "box", "clip": 0}]})");
   expectError([&] { loadScene(p); }, ErrorKind::Schema, p, "models[0].clip: unknown key");
 
-  GI_REQUIRE_SHARED_ASSET(fox, "fox/glTF/Fox.gltf");
+  const std::string fox = gi::test::modelAsset("fox/glTF/Fox.gltf");
   Scene f = loadScene(
       dir.write("fox.json", "{\"models\": [{\"file\": \"" + fox + "\", \"clip\": \"Walk\"}]}"));
   ASSERT_EQ(f.animations.size(), 1u);
@@ -438,8 +438,6 @@ TEST(JsonAnimation, DefaultSceneSphereBounces) {
 // ---- assets/scenes/animated.json ----------------------------------------------------------
 
 TEST(JsonAnimation, AnimatedExampleScene) {
-  GI_REQUIRE_SHARED_ASSET(cesium, "cesium_man/glTF/CesiumMan.gltf");
-  GI_REQUIRE_SHARED_ASSET(fox, "fox/glTF/Fox.gltf");
   const std::string skin = test::assimpModel("glTF2/simple_skin/simple_skin.gltf");
   const std::string cube =
       test::assimpModel("glTF2/glTF-Sample-Models/AnimatedMorphCube-glTF/AnimatedMorphCube.gltf");

@@ -70,7 +70,7 @@ void expectGpuMatchesCpu(vk::Context& ctx, const Scene& scene, const std::vector
 }
 
 TEST_F(SkinningTest, GpuMatchesCpuOnCesiumMan) {
-  GI_REQUIRE_SHARED_ASSET(path, "cesium_man/glTF/CesiumMan.gltf");
+  const std::string path = gi::test::modelAsset("cesium_man/glTF/CesiumMan.gltf");
   expectGpuMatchesCpu(ctx(), loadGltf(path), {0.0, 0.37, 1.1, 1.9});
 }
 
@@ -80,7 +80,7 @@ TEST_F(SkinningTest, GpuMatchesCpuOnSimpleSkin) {
 }
 
 TEST_F(SkinningTest, GpuMatchesCpuOnFox) {
-  GI_REQUIRE_SHARED_ASSET(path, "fox/glTF/Fox.gltf");
+  const std::string path = gi::test::modelAsset("fox/glTF/Fox.gltf");
   Scene fox = loadGltf(path);
   fox.animations.resize(1);  // one clip at a time (all clips would fight over the joints)
   expectGpuMatchesCpu(ctx(), fox, {0.0, 1.3});
@@ -139,7 +139,7 @@ TEST_F(SkinningTest, DegenerateSkinsStayFinite) {
 }
 
 TEST_F(SkinningTest, RendersDifferWhereTheCharacterMovedAndOnlyChangesAreReskinned) {
-  GI_REQUIRE_SHARED_ASSET(path, "cesium_man/glTF/CesiumMan.gltf");
+  const std::string path = gi::test::modelAsset("cesium_man/glTF/CesiumMan.gltf");
   Scene scene = loadGltf(path);
   RenderSettings rs;
   rs.width = 96;

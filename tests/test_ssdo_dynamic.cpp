@@ -61,8 +61,6 @@ class SsdoDynamicTest : public test::EffectTest {
 // Measured: darkening 1.6..3.2 pixels off the footprint, its motion 0..1.5 pixels off the
 // footprint's; bounce 0.7..3.7 pixels off. A one-frame lag (a stale input) would be ~9 pixels.
 TEST_F(SsdoDynamicTest, ShadowAndBounceFollowTheWalkingFoxFrameByFrame) {
-  GI_REQUIRE_SHARED_ASSET(fox, "fox/glTF/Fox.gltf");
-  GI_REQUIRE_SHARED_ASSET(cesium, "cesium_man/glTF/CesiumMan.gltf");
   for (const char* m : {"glTF2/simple_skin/simple_skin.gltf",
                         "glTF2/glTF-Sample-Models/AnimatedMorphCube-glTF/AnimatedMorphCube.gltf"})
     if (!std::filesystem::exists(test::assimpModel(m))) GTEST_SKIP() << m << " absent";

@@ -78,7 +78,7 @@ TEST_F(SurfacePointsGpuTest, FollowSimpleSkin) {
 }
 
 TEST_F(SurfacePointsGpuTest, FollowCesiumMan) {
-  GI_REQUIRE_SHARED_ASSET(path, "cesium_man/glTF/CesiumMan.gltf");
+  const std::string path = gi::test::modelAsset("cesium_man/glTF/CesiumMan.gltf");
   expectGpuPointsMatchCpu(ctx(), loadGltf(path), 100000, {0.25, 0.9, 1.7});
 }
 

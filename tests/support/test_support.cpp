@@ -8,10 +8,8 @@
 
 namespace gi::test {
 
-std::string sharedAsset(const std::string& relative) {
-  std::filesystem::path root(GI_SHARED_ASSETS);
-  if (!std::filesystem::is_directory(root)) return {};
-  return (root / relative).string();
+std::string modelAsset(const std::string& relative) {
+  return (std::filesystem::path(GI_SOURCE_DIR) / "assets" / "models" / relative).string();
 }
 
 std::string assimpModel(const std::string& relative) {

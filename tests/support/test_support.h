@@ -1,4 +1,4 @@
-// Helpers shared by the tests: asset paths (skipping when optional assets are absent).
+// Helpers shared by the tests: asset paths, temporary folders, expected errors.
 #pragma once
 
 #include <functional>
@@ -12,8 +12,8 @@
 
 namespace gi::test {
 
-// ../shared/assets/<relative>; empty string when the shared assets folder is absent.
-std::string sharedAsset(const std::string& relative);
+// assets/models/<relative> in the source tree (the models the repository ships).
+std::string modelAsset(const std::string& relative);
 // /usr/share/assimp/models/<relative> (installed by the set-up as a dependency).
 std::string assimpModel(const std::string& relative);
 // Path to a built executable in build/bin.
@@ -46,10 +46,3 @@ class TempDir {
 };
 
 }  // namespace gi::test
-
-// Skips the current test with a printed reason when ../shared/assets is missing.
-#define GI_REQUIRE_SHARED_ASSET(var, rel)                            \
-  const std::string var = ::gi::test::sharedAsset(rel);              \
-  if (var.empty())                                                   \
-    GTEST_SKIP() << "shared assets folder absent (" GI_SHARED_ASSETS \
-                    "): skipping test that needs " rel;

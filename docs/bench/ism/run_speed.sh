@@ -1,8 +1,8 @@
-#!/bin/sh
+#!/usr/bin/env bash
 # Before (the main build's binary, OLD) vs after (this tree), interleaved (compare.py).
 # usage: docs/bench/ism/run_speed.sh OLD_BIN_DIR [REPS]
-set -e
-OLD=${1:-/work/main/build/bin}
+set -euo pipefail
+OLD=${1:?usage: docs/bench/ism/run_speed.sh OLD_BIN_DIR [REPS]}
 REPS=${2:-3}
 NEW=${NEW:-build/bin}
 D=docs/bench/ism

@@ -8,8 +8,7 @@
 //   "include_default_scene": false,        // start from the built-in Cornell-box room
 //   "models": [                            // each becomes a root node with this transform
 //     { "file": "model.gltf",              // .gltf .glb .obj .ply; relative to this file's folder,
-//                                          // or starting with ${GI_SHARED_ASSETS} /
-//                                          ${ASSIMP_MODELS}
+//                                          // absolute, or starting with ${ASSIMP_MODELS}
 //       "name": "engine",
 //       "translation": [0, 0, 0],
 //       "rotation": [0, 0, 0, 1],          // quaternion [x, y, z, w], or Euler degrees [x, y, z]
@@ -36,7 +35,7 @@
 //   "environment": { "type": "sky" | "constant" | "map", "intensity": 1,
 //                    "color": [r, g, b] (constant only),
 //                    "file": "sky.hdr" (map only, required: equirectangular Radiance .hdr,
-//                            relative to the scene file; ${GI_SHARED_ASSETS} expands),
+//                            relative to the scene file; ${ASSIMP_MODELS} expands),
 //                    "zenith_color", "horizon_color", "ground_color": [r, g, b] (sky only) },
 //   "effects": [ "ssao", { "name": "bloom", "settings": { ... } } ]
 // }
@@ -52,9 +51,9 @@
 // parts without a track keep the entry's value. An orbit turns the whole transform about the
 // axis through the centre (a camera orbiting its target keeps looking at it).
 //
-// ${GI_SHARED_ASSETS} expands to the environment variable of that name when set, else to the
-// nearest "shared/assets" folder found walking up from the scene file's folder (the checkout's
-// ../shared/assets). ${ASSIMP_MODELS} expands to $ASSIMP_MODELS, else /usr/share/assimp/models.
+// ${ASSIMP_MODELS} expands to $ASSIMP_MODELS, else /usr/share/assimp/models (Debian's
+// assimp-testmodels). It is the only variable: a scene names every other file relative to itself,
+// so a scene folder with its models (assets/scenes + assets/models) stands alone.
 //
 // Without a "camera" (and no camera in the models) the scene is framed automatically; without
 // any light a sun is added (addDefaultCameraAndLight). The JSON camera becomes the active one.
@@ -87,9 +86,8 @@ std::string indexed(const std::string& list, size_t i) {
   return list + "[" + std::to_string(i) + "]";
 }
 
-// Expands a leading ${GI_SHARED_ASSETS} / ${ASSIMP_MODELS}; other ${...} are errors.
-fs::path expandModelPath(const std::string& file, const fs::path& sceneDir, const JsonObject& o,
-                         const std::string& scenePath) {
+// Expands a leading ${ASSIMP_MODELS}; other ${...} are errors.
+fs::path expandModelPath(const std::string& file, const fs::path& sceneDir, const JsonObject& o) {
   if (file.rfind("${", 0) != 0) {
     fs::path p(file);
     return p.is_absolute() ? p : sceneDir / p;
@@ -97,26 +95,14 @@ fs::path expandModelPath(const std::string& file, const fs::path& sceneDir, cons
   const size_t close = file.find('}');
   if (close == std::string::npos) o.schemaError("file", "unterminated '${' in '" + file + "'");
   const std::string var = file.substr(2, close - 2);
+  if (var != "ASSIMP_MODELS")
+    o.schemaError("file", "unknown variable '${" + var +
+                              "}' (known: ${ASSIMP_MODELS}; name other files relative to the "
+                              "scene file)");
   std::string rest = file.substr(close + 1);
   while (!rest.empty() && (rest.front() == '/' || rest.front() == '\\')) rest.erase(0, 1);
-  if (const char* env = std::getenv(var.c_str());
-      env && *env && (var == "GI_SHARED_ASSETS" || var == "ASSIMP_MODELS"))
-    return fs::path(env) / rest;
-  if (var == "ASSIMP_MODELS") return fs::path("/usr/share/assimp/models") / rest;
-  if (var == "GI_SHARED_ASSETS") {
-    std::error_code ec;
-    const fs::path start = fs::weakly_canonical(sceneDir.empty() ? fs::path(".") : sceneDir, ec);
-    for (fs::path dir = start; !dir.empty(); dir = dir.parent_path()) {
-      if (fs::is_directory(dir / "shared" / "assets", ec)) return dir / "shared" / "assets" / rest;
-      if (dir == dir.parent_path()) break;
-    }
-    throw Error(ErrorKind::MissingResource, scenePath,
-                o.pathOf("file") + ": '" + file +
-                    "': no shared/assets folder above the scene file and GI_SHARED_ASSETS is "
-                    "not set");
-  }
-  o.schemaError("file",
-                "unknown variable '${" + var + "}' (known: ${GI_SHARED_ASSETS}, ${ASSIMP_MODELS})");
+  const char* env = std::getenv("ASSIMP_MODELS");
+  return fs::path(env && *env ? env : "/usr/share/assimp/models") / rest;
 }
 
 glm::mat4 readTransform(const JsonObject& o) {
@@ -329,7 +315,7 @@ class SceneJsonLoader {
       } else {
         m.allowOnly({"file", "name", "translation", "rotation", "scale", "clip", "animation"});
         const std::string file = m.requireString("file");
-        const fs::path resolved = expandModelPath(file, sceneDir, m, path_);
+        const fs::path resolved = expandModelPath(file, sceneDir, m);
         model = loadModel(resolved.string(), m);
         name = m.string("name").value_or(resolved.stem().string());
         if (m.has("clip")) selectClip(m, model, resolved.filename().string());
@@ -675,7 +661,7 @@ class SceneJsonLoader {
       for (const char* k : {"color", "zenith_color", "horizon_color", "ground_color"})
         if (e.has(k)) e.schemaError(k, "not for \"type\": \"map\"");
       const std::string file = e.requireString("file");
-      const fs::path resolved = expandModelPath(file, fs::path(path_).parent_path(), e, path_);
+      const fs::path resolved = expandModelPath(file, fs::path(path_).parent_path(), e);
       std::error_code ec;
       if (!fs::exists(resolved, ec))
         throw Error(
