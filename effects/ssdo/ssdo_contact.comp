@@ -4,7 +4,8 @@
 
 // Contact shadows under the shadow-map bias (seed 000 §5). The lighting pass tests a receiver
 // pushed toward the light by b = texel x (bias constant + bias slope x tan theta) (lights.glsl,
-// shadowFactor), so an occluder closer than b along the light is missed: the shadow detaches
+// shadowFactor; with PCF also moved off the surface by (r + 1) texels x sin theta along the
+// normal), so an occluder closer than b along the light is missed: the shadow detaches
 // from the contact. Per pixel P and per shadow-casting light i (the first four in `lights`
 // order), kSamples points Q_k = P + t_k b l on that segment (t_k = (k + 1) / kSamples, l toward
 // the light) are projected and tested against the surface S seen at their pixel; channel i =

@@ -81,9 +81,10 @@ vec3 lightIncident(Light light, vec3 pos, out vec3 l) {
   return light.radiance.rgb * attenuation;
 }
 
-// Fraction of the light reaching view-space position `pos` ((2r+1)^2 PCF, r = frame.options.x).
-// `ndl` sets the slope-scaled part of the bias.
-float shadowFactor(Light light, vec3 pos, float ndl) {
+// Fraction of the light reaching view-space position `pos` with unit normal `n` ((2r+1)^2 PCF,
+// r = frame.options.x). `ndl` sets the slope-scaled part of the depth bias; with PCF the lookup
+// moves off the surface along `n` (normal offset; n = vec3(0): none).
+float shadowFactor(Light light, vec3 pos, vec3 n, float ndl) {
   int first = int(light.shadow.x);
   if (GI_SHADOW_TYPES == 0 || first < 0) return 1.0;
   // Directional and spot lights read their one view with the light's (uniform) index, which
@@ -97,16 +98,29 @@ float shadowFactor(Light light, vec3 pos, float ndl) {
   } else {
     sv = shadowViews[min(first, GI_MAX_SHADOW_VIEWS - 1)];
   }
+  float near = sv.params.y, far = sv.params.z;
+  bool perspective = sv.params.x > 0.5;
+  float sinTheta = sqrt(max(1.0 - ndl * ndl, 0.0));
+  int k = GI_PCF_RADIUS;
+  // Normal offset: with PCF the lookup leaves the surface by the filter's reach (k + 1 texels),
+  // scaled by sin theta (how far along the map a step along n goes). Every tap is compared with
+  // the pixel's one biased depth; on a face lit at a grazing angle, a few texels wide in the
+  // map, the kernel would otherwise reach the face's own continuation and the nearer face beside
+  // it (a box's top seen above its front) and shadow the lit face in bands: the moire on the
+  // Cornell box's blocks (tests/test_shadows.cpp, GrazingShadowTest).
+  if (k > 0) {
+    vec4 c0 = sv.viewToClip * vec4(pos, 1.0);
+    float texel0 = sv.params.w * (perspective ? max(c0.w, 0.0) : 1.0);
+    pos += n * (texel0 * (float(k) + 1.0) * sinTheta);
+  }
   vec4 clip = sv.viewToClip * vec4(pos, 1.0);
   if (clip.w <= 0.0) return 1.0;
   vec3 ndc = clip.xyz / clip.w;
   vec2 uv = ndc.xy * 0.5 + 0.5;
   if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0))) || ndc.z < 0.0) return 1.0;
-  float near = sv.params.y, far = sv.params.z;
-  bool perspective = sv.params.x > 0.5;
   float receiver = perspective ? clip.w : near + (1.0 - ndc.z) * (far - near);
   float texel = perspective ? sv.params.w * receiver : sv.params.w;
-  float tanTheta = min(sqrt(max(1.0 - ndl * ndl, 0.0)) / max(ndl, 1e-4), 10.0);
+  float tanTheta = min(sinTheta / max(ndl, 1e-4), 10.0);
   float r = receiver - texel * (light.shadow.y + light.shadow.z * tanTheta);
   // The occluder test "biased receiver <= linear occluder depth" as a test on the stored
   // reverse-Z depth, once per pixel instead of a division per tap (both maps are monotonic):
@@ -118,7 +132,6 @@ float shadowFactor(Light light, vec3 pos, float ndl) {
   int layer = int(light.shadow.w);
   ivec2 lo = ivec2(sv.tile.xy), size = ivec2(sv.tile.z), hi = lo + size - 1;
   ivec2 center = lo + clamp(ivec2(uv * vec2(size)), ivec2(0), size - 1);
-  int k = GI_PCF_RADIUS;
   float lit = 0.0;
   for (int dy = -k; dy <= k; ++dy)
     for (int dx = -k; dx <= k; ++dx)
@@ -127,6 +140,12 @@ float shadowFactor(Light light, vec3 pos, float ndl) {
                  ? 1.0
                  : 0.0;
   return lit / float((2 * k + 1) * (2 * k + 1));
+}
+
+// The same without the receiver's normal (no normal offset: PCF can shadow a face lit at a
+// grazing angle in bands). Kept for effects written before the normal was passed.
+float shadowFactor(Light light, vec3 pos, float ndl) {
+  return shadowFactor(light, pos, vec3(0.0), ndl);
 }
 
 // The scene's lights at one surface point as the lighting pass evaluates them (Lambert +
@@ -155,7 +174,7 @@ LightSum sumLights(vec3 pos, vec3 n, vec3 v, vec3 f0, float shininess, vec4 cont
     vec3 incident = lightIncident(light, pos, l);
     float ndl = max(dot(n, l), 0.0);
     if (ndl <= 0.0 || all(lessThanEqual(incident, vec3(0.0)))) continue;
-    float visibility = shadowFactor(light, pos, ndl);
+    float visibility = shadowFactor(light, pos, n, ndl);
     if (useContact && light.shadow.x >= 0.0 && channel < 4)
       visibility *= clamp(contact[channel], 0.0, 1.0);
     if (visibility <= 0.0) continue;

@@ -37,7 +37,7 @@ void main() {
     vec3 l;
     vec3 incident = lightIncident(lights[i], pos, l);
     float ndl = max(dot(n, l), 0.0);
-    if (ndl > 0.0) e += incident * ndl * shadowFactor(lights[i], pos, ndl);
+    if (ndl > 0.0) e += incident * ndl * shadowFactor(lights[i], pos, n, ndl);
   }
   // One environment sample per pixel (an R2 sequence over the pixels), unoccluded.
   EnvironmentSample s = sampleEnvironment(fract(vec2(p) * vec2(0.7548776662, 0.5698402910)));
