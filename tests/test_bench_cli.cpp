@@ -380,9 +380,14 @@ TEST(BenchCli, CalibratedPresetLoadsAndFitsTheBudget) {
   auto bad = test::runCommand(
       bench("--calibrate --budget-ms 0.000001 --width 64 --height 48 --frames 1 --ref-spp 4 "
             "--effects ssao --cache '" +
-            dir + "/cache' --out '" + none + "'"));
+            dir + "/cache-none' --out '" + none + "'"));
   EXPECT_NE(bad.exitCode, 0) << bad.output;
   EXPECT_NE(bad.output.find("budget"), std::string::npos) << bad.output;
+  // ... at once: only the cheapest configuration measured, no reference rendered.
+  EXPECT_NE(bad.output.find("ssao at its cheapest (ssao.samples=1"), std::string::npos)
+      << bad.output;
+  EXPECT_NE(bad.output.find("stopped before the search"), std::string::npos) << bad.output;
+  EXPECT_FALSE(fs::exists(dir + "/cache-none") && !fs::is_empty(dir + "/cache-none")) << bad.output;
   EXPECT_FALSE(fs::exists(none));
   for (const auto& e : fs::directory_iterator(dir))
     EXPECT_EQ(e.path().string().find(".check"), std::string::npos) << e.path();

@@ -151,10 +151,15 @@ TEST(CliArgs, OutputsAreCheckedBeforeAnyWork) {
   cli::checkOutputWritable(ok);
   EXPECT_FALSE(fs::exists(ok)) << "the check leaves nothing behind";
   EXPECT_FALSE(fs::exists(ok + ".partial"));
+  // A missing folder is made when the file is written: only its existing ancestor is checked.
+  cli::checkOutputWritable(dir.path("nodir/deeper/x.png"));
+  EXPECT_FALSE(fs::exists(dir.path("nodir"))) << "the check leaves nothing behind";
   std::string msg =
-      errorOf([&] { cli::checkOutputWritable(dir.path("nodir/x.png")); }, ErrorKind::FileNotFound);
-  EXPECT_NE(msg.find("output folder " + dir.path("nodir") + " does not exist"), std::string::npos)
-      << msg;
+      errorOf([] { cli::checkOutputWritable("/sys/gi-nodir/x.png"); }, ErrorKind::FileNotFound);
+  EXPECT_NE(msg.find("cannot write in the output folder /sys: "), std::string::npos) << msg;
+  const std::string plain = dir.write("plain", "x");
+  msg = errorOf([&] { cli::checkOutputWritable(plain + "/x.png"); }, ErrorKind::FileNotFound);
+  EXPECT_NE(msg.find("is not a folder"), std::string::npos) << msg;
   fs::create_directories(dir.path("folder.png"));
   msg = errorOf([&] { cli::checkOutputWritable(dir.path("folder.png")); }, ErrorKind::FileNotFound);
   EXPECT_NE(msg.find("output path is a folder"), std::string::npos) << msg;
@@ -180,8 +185,12 @@ TEST(CliArgs, AtomicWritesLeaveNothingOnFailure) {
   std::getline(in, text);
   EXPECT_EQ(text, "hello");
   EXPECT_FALSE(fs::exists(path + ".partial"));
-  errorOf([&] { cli::writeFileAtomic(dir.path("nodir/a.txt"), "x"); }, ErrorKind::FileNotFound);
-  EXPECT_FALSE(fs::exists(dir.path("nodir")));
+  // Missing folders are made; a folder that cannot be made fails and leaves no file.
+  cli::writeFileAtomic(dir.path("nodir/deeper/a.txt"), "x");
+  EXPECT_TRUE(fs::is_regular_file(dir.path("nodir/deeper/a.txt")));
+  const std::string plain = dir.write("plain", "x");
+  errorOf([&] { cli::writeFileAtomic(plain + "/a.txt", "x"); }, ErrorKind::FileNotFound);
+  EXPECT_FALSE(fs::exists(plain + "/a.txt.partial"));
 }
 
 }  // namespace

@@ -268,7 +268,6 @@ TEST(Demo, RepeatedResizesAndViewsLeaveMemoryWhereItStarted) {
 
 TEST(Demo, DemoSceneRuns) {
   REQUIRE_DEMO();
-  GI_REQUIRE_SHARED_ASSET(fox, "fox/glTF/Fox.gltf");
   const std::string dir = test::makeTempDir("demo_scene");
   const std::string script =
       writeScript(dir, "frames 3\nscreenshot " + dir + "/demo.png\nprint passes\n");
@@ -348,6 +347,20 @@ TEST(Demo, AccuracyCheckComparesTheFrameWithTheReference) {
   EXPECT_LT(nrmse, 0.5) << r.output;
 }
 
+// An accuracy check right after a view change has no frame of the new graph to compare: the
+// error says to render one first.
+TEST(Demo, AccuracyBeforeAnyFrameOfTheViewSaysToRenderOne) {
+  REQUIRE_DEMO();
+  const std::string dir = test::makeTempDir("demo_accuracy_first");
+  const std::string script = writeScript(dir, "view output\naccuracy ssao 4\n");
+  auto r = runDemo(" --scene default --effects ssao --paused" + kSize + " --script " + script);
+  EXPECT_NE(r.exitCode, 0) << r.output;
+  EXPECT_NE(r.output.find("line 2: "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("render a frame after changing the effects, view, preset or size"),
+            std::string::npos)
+      << r.output;
+}
+
 // Hot reload: a copy of ssao.comp in --shader-dir is broken (the compiler's message is reported,
 // the last good pipeline keeps giving the same image), changed to a constant AO of 0.5 (every
 // pixel of the AO view is 128), then restored (the first image again, bit for bit); no
@@ -424,6 +437,9 @@ TEST(Demo, BadScriptFailsWithOneLineBeforeAnyWindow) {
                             " --scene default --script " + script);
   EXPECT_EQ(r.exitCode, 1) << r.output;
   EXPECT_NE(r.output.find("line 2: unknown step 'fly'"), std::string::npos) << r.output;
+  // ... and lists the steps there are.
+  EXPECT_NE(r.output.find("(steps: accuracy, camera, copy, effect, frames,"), std::string::npos)
+      << r.output;
   EXPECT_EQ(r.output.find('\n'), r.output.size() - 1) << r.output;
 
   auto none = test::runCommand("env -u DISPLAY -u WAYLAND_DISPLAY " + test::binPath("gi-demo") +

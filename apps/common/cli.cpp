@@ -199,8 +199,14 @@ void checkOutputWritable(const std::string& path) {
   std::error_code ec;
   if (fs::is_directory(path, ec))
     throw Error(ErrorKind::FileNotFound, path, "output path is a folder, not a file");
-  checkWritableFolder(fs::path(path).parent_path(), path,
-                      fs::path(path).filename().string() + ".partial");
+  const fs::path folder = fs::path(path).parent_path();
+  if (!folder.empty() && !fs::exists(folder, ec)) {
+    // Made when the file is written (with its missing parents): the nearest existing
+    // ancestor must take new entries.
+    checkOutputFolder(folder.string());
+    return;
+  }
+  checkWritableFolder(folder, path, fs::path(path).filename().string() + ".partial");
   if (fs::exists(path, ec) && ::access(path.c_str(), W_OK) != 0)
     throw Error(ErrorKind::FileNotFound, path, "output file exists and is not writable");
 }
@@ -221,6 +227,8 @@ void checkOutputFolder(const std::string& dir) {
 void writeFileAtomic(const std::string& path, const std::string& text) {
   const std::string tmp = path + ".partial";
   std::error_code ec;
+  if (const fs::path folder = fs::path(path).parent_path(); !folder.empty())
+    fs::create_directories(folder, ec);  // a failure shows as "cannot write" below
   {
     std::ofstream out(tmp, std::ios::binary);
     out << text;

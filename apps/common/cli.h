@@ -52,6 +52,11 @@ class Args {
   std::vector<std::string> list(bool allowDuplicates = false) {
     return splitList(flag_, value(), allowDuplicates);
   }
+  // --effects: a list of effect names, where "none" (as in gi-bench) and "" are the engine alone.
+  std::vector<std::string> effectList() {
+    const std::string text = value();
+    return text == "none" ? std::vector<std::string>{} : splitList(flag_, text);
+  }
   [[noreturn]] void fail(const std::string& message) const { usageError(app_, flag_, message); }
   [[noreturn]] void unknown() const;
   const char* app() const { return app_; }
@@ -64,15 +69,17 @@ class Args {
   std::string flag_;
 };
 
-// An output file that will be written later: its folder must exist and be writable and the
-// path must not be a folder. Checked before any work, so a long render never ends in "cannot
-// write". Throws FileNotFound naming `path`.
+// An output file that will be written later: its folder must be writable (or, when missing,
+// its nearest existing ancestor: the writers make the missing folders) and the path must not be
+// a folder. Checked before any work, so a long render never ends in "cannot write". Throws
+// FileNotFound naming `path`.
 void checkOutputWritable(const std::string& path);
 // A folder that will be created or filled (gi-bench --out DIR): as checkOutputWritable for the
 // folder's nearest existing ancestor; an existing non-folder is refused.
 void checkOutputFolder(const std::string& dir);
 
-// Writes `text` to `path` through `path`.partial and a rename: a failure leaves nothing behind.
+// Writes `text` to `path` through `path`.partial and a rename: a failure leaves nothing behind
+// (but the missing folders of `path`, made first).
 void writeFileAtomic(const std::string& path, const std::string& text);
 
 // Runs the app's body and turns exceptions into its one-line error and exit code.

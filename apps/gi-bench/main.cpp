@@ -91,7 +91,8 @@ const char* kUsage =
     "  --ao-split            AO effects: split the reference's occlusion into what the depth\n"
     "                        buffer holds, off-screen and hidden occluders (gi-reference\n"
     "                        --quantity ao-split) and report where the effect cannot converge\n"
-    "  --cache DIR           reference cache (default <bin>/../bench-cache)\n"
+    "  --cache DIR           reference cache (default: build/bench-cache in a build tree,\n"
+    "                        else ~/.cache/gi/bench-cache)\n"
     "  --isolate-passes      submit each pass alone and wait (a CPU driver otherwise lets a\n"
     "                        pass's work spill into the next pass's timestamps) and also\n"
     "                        record each pass's process CPU time (repetitions.csv: robust\n"
@@ -144,6 +145,21 @@ struct Options {
 
 [[noreturn]] void usageError(const std::string& where, const std::string& message) {
   gi::cli::usageError("gi-bench", where, message);
+}
+
+// The reference cache: build/bench-cache in a build tree (<bin>/../CMakeCache.txt), else the
+// user's cache folder ($XDG_CACHE_HOME or ~/.cache, gi/bench-cache): an installed prefix may
+// not be writable.
+std::string defaultCacheDir() {
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec && fs::exists(exe.parent_path().parent_path() / "CMakeCache.txt", ec))
+    return (exe.parent_path().parent_path() / "bench-cache").string();
+  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg)
+    return (fs::path(xdg) / "gi" / "bench-cache").string();
+  if (const char* home = std::getenv("HOME"); home && *home)
+    return (fs::path(home) / ".cache" / "gi" / "bench-cache").string();
+  return "bench-cache";
 }
 
 Options parseArgs(int argc, char** argv) {
@@ -253,11 +269,7 @@ Options parseArgs(int argc, char** argv) {
     if (!o.framesGiven) o.frames = 2;
     if (!o.sppGiven) o.refSpp = 16;
   }
-  if (o.cache.empty()) {
-    std::error_code ec;
-    const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-    o.cache = ec ? "bench-cache" : (exe.parent_path().parent_path() / "bench-cache").string();
-  }
+  if (o.cache.empty()) o.cache = defaultCacheDir();
   // Where results go is checked now, not after the sweep and its references.
   if (o.calibrate)
     gi::cli::checkOutputWritable(o.out);
@@ -1187,6 +1199,35 @@ CalibrationItem calibrationItem(const std::string& label, const Setup& s) {
   return it;
 }
 
+// Before any reference or sweep: each item's cheapest candidate (every sample count at its
+// minimum; cost does not fall as a count rises) measured alone. When even its median is over
+// the limit no candidate can fit, so the run stops at once instead of after the whole search.
+void failFastWhenNothingFits(gi::vk::Context& ctx, const gi::EffectRegistry& registry,
+                             const gi::Scene& scene, const gi::SettingValues& engine,
+                             const std::vector<CalibrationItem>& items, const Options& o,
+                             double limit) {
+  std::vector<RenderJob> jobs;
+  for (const CalibrationItem& it : items)
+    jobs.push_back({&scene, &it.configs.front(), &engine, it.cmp.resource});  // the minimum
+  const std::vector<Measurement> cheapest =
+      measureAll(ctx, registry, jobs, o, false, [](size_t, const Measurement&) {});
+  std::string unfit;
+  for (size_t i = 0; i < items.size(); ++i) {
+    const Interval& t = cheapest[i].total;
+    if (t.median > limit)
+      unfit += (unfit.empty() ? "" : "; ") + items[i].label + " at its cheapest (" +
+               items[i].labels.front() + ") " + formatDouble(t.median) + " ms [" +
+               formatDouble(t.lo) + ", " + formatDouble(t.hi) + "]";
+  }
+  if (!unfit.empty())
+    throw gi::Error(gi::ErrorKind::InvalidData, o.out,
+                    "no configuration can fit the budget of " + formatDouble(o.budgetMs) +
+                        " ms (limit " + formatDouble(limit) + " ms after the headroom): " + unfit +
+                        " at " + std::to_string(o.width) + "x" + std::to_string(o.height) +
+                        "; stopped before the search: give a larger --budget-ms or a smaller "
+                        "--width/--height; nothing written");
+}
+
 int runCalibrate(const Options& o) {
   Setup s;
   loadInputs(o, s);
@@ -1208,11 +1249,12 @@ int runCalibrate(const Options& o) {
   for (const auto& l : labels) items.push_back(calibrationItem(l, s));
   const gi::Scene& scene = s.scenes[0].scene;
   const gi::SettingValues engine = gi::resolveEngineSettings(scene, nullptr, {}, {});
+  gi::vk::Context ctx = makeContext(o);
+  const double limit = o.budgetMs * (1.0 - o.headroom);
+  failFastWhenNothingFits(ctx, s.registry, scene, engine, items, o, limit);
   std::vector<ReferenceKey> keys;
   for (const auto& it : items) keys.push_back(ReferenceKey{0, it.cmp.target});
   const std::map<ReferenceKey, Reference> refs = computeReferences(o, s, keys);
-  gi::vk::Context ctx = makeContext(o);
-  const double limit = o.budgetMs * (1.0 - o.headroom);
   std::printf(
       "calibrating on %s: %s %ux%u, budget %.3f ms (the upper end of the measured "
       "time's interval must stay under %.3f); each effect set alone in the frame\n",

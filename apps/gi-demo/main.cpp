@@ -46,7 +46,7 @@ demo::AppOptions parseArgs(int argc, char** argv) {
     else if (a.is("--preset"))
       o.controller.preset = a.value();
     else if (a.is("--effects"))
-      o.controller.overrides.effects = a.list();  // a name twice is refused
+      o.controller.overrides.effects = a.effectList();  // a name twice is refused
     else if (a.is("--set"))
       o.controller.overrides.sets.push_back(a.value());
     else if (a.is("--view"))

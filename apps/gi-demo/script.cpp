@@ -48,7 +48,11 @@ std::vector<ScriptStep> loadScript(const std::string& path) {
     if (!(words >> s.verb)) continue;
     for (std::string w; words >> w;) s.args.push_back(w);
     const auto verb = kVerbs.find(s.verb);
-    if (verb == kVerbs.end()) fail(path, line, "unknown step '" + s.verb + "'");
+    if (verb == kVerbs.end()) {
+      std::string known;
+      for (const auto& [name, count] : kVerbs) known += (known.empty() ? "" : ", ") + name;
+      fail(path, line, "unknown step '" + s.verb + "' (steps: " + known + ")");
+    }
     if (int(s.args.size()) != verb->second)
       fail(path, line,
            s.verb + " takes " + std::to_string(verb->second) + " argument(s), got " +

@@ -13,7 +13,8 @@
 //   step                     advance the stopped clock by one frame's time
 //   time T                   set the clock
 //   accuracy EFFECT SPP      compare the last frame of EFFECT with the CPU reference (SPP
-//                            samples per pixel; waits) and print its NRMSE
+//                            samples per pixel; waits) and print its NRMSE; needs a frame
+//                            rendered since the last effect, view, preset or size change
 //   screenshot PATH          write the rendered image (without the panel) as PNG
 //   print passes|views|timings|memory|camera   print to stdout (views: what `view` takes)
 //   copy FROM TO             copy a file (e.g. an edited shader into --shader-dir)

@@ -45,7 +45,7 @@ const char* kUsage =
     "  --view NAME            write a raw resource instead of the final image: output, lit,\n"
     "                         depth, normal, albedo, material, emission, motion, floor, or an\n"
     "                         effect's name for its debug view (e.g. ssao)\n"
-    "  --effects A,B          effects to run, replacing the scene's list ('' for none)\n"
+    "  --effects A,B          effects to run, replacing the scene's list ('none': no effect)\n"
     "  --preset NAME|FILE     quality preset (assets/presets): settings for the effects\n"
     "  --set EFFECT.KEY=V     override one setting (after preset and scene; repeatable);\n"
     "                         engine.KEY=V sets the engine's own (see --list-effects)\n"
@@ -110,7 +110,7 @@ Options parseArgs(int argc, char** argv) {
     else if (a.is("--window"))
       o.window = true;
     else if (a.is("--effects"))
-      o.overrides.effects = a.list();  // a name twice is refused
+      o.overrides.effects = a.effectList();  // a name twice is refused
     else if (a.is("--preset"))
       o.preset = a.value();
     else if (a.is("--set"))

@@ -5,7 +5,11 @@
 #      (tools/new-effect) out of tree against that prefix only (find_package(gi)),
 #   3. runs the INSTALLED gi-render with GI_PLUGIN_PATH pointing at both builds: the effects
 #      are listed with their settings and module paths, run with validation on, show up as
-#      executed passes, and the vignette darkens the image corners.
+#      executed passes, and the vignette darkens the image corners;
+#   4. runs the other installed apps from the prefix alone, on the installed scenes (their
+#      models come with them) and presets: gi-reference scores the Cornell box, gi-bench
+#      benchmarks the out-of-tree effects, gi-demo shows them (under Xvfb) with the shipped
+#      script.
 # usage: run_test.sh BUILD_DIR SOURCE_DIR      (ctest: external_effect)
 set -euo pipefail
 build="$(cd "$1" && pwd)"
@@ -35,6 +39,13 @@ prefix="$tmp/install"
 gi="$prefix/bin/gi-render"
 [ -x "$gi" ] || fail "no installed gi-render at $gi"
 [ -f "$prefix/share/gi/shaders/common.glsl" ] || fail "common.glsl not installed"
+for app in gi-bench gi-reference gi-demo; do
+  [ -x "$prefix/bin/$app" ] || fail "no installed $app"
+done
+for f in presets/medium.json scenes/demo.json scenes/cornell_box.json models/fox/glTF/Fox.gltf \
+  models/fox/LICENSE.md scripts/tour.txt environments/small_sun.hdr; do
+  [ -f "$prefix/share/gi/$f" ] || fail "share/gi/$f not installed"
+done
 
 configure_and_build() {  # SRC_DIR BUILD_DIR
   cmake -S "$1" -B "$2" -G Ninja -DCMAKE_PREFIX_PATH="$prefix" >"$2.log" 2>&1 || {
@@ -156,5 +167,43 @@ if [ -f "$(dirname "$gi")/plugins/gi_effect_ssao.so" ]; then
   got=$(sed -n 's/^  \[run\] *//p' "$tmp/ssao_vignette.log" | tr '\n' ' ')
   want="gbuffer shadow_0 ssao ssao_blur lighting vignette tonemap "
   [ "$got" = "$want" ] || fail "executed passes: got '$got', want '$want'"
+fi
+step "the installed apps from the prefix alone (run from an empty folder)"
+share="$prefix/share/gi"
+mkdir -p "$tmp/run" && cd "$tmp/run"
+"$gi" --scene "$share/scenes/cornell_box.json" --effects vignette --preset medium --validation \
+  --width 96 --height 72 --out "$tmp/run/box.png" >"$tmp/box.log" 2>&1 || {
+  cat "$tmp/box.log" >&2
+  fail "installed gi-render on the installed Cornell box scene"
+}
+"$prefix/bin/gi-reference" --scene "$share/scenes/cornell_box.json" --quantity ao --radius 0.5 \
+  --spp 4 --width 96 --height 72 --out "$tmp/run/ao.pfm" >"$tmp/ref.log" 2>&1 || {
+  cat "$tmp/ref.log" >&2
+  fail "installed gi-reference"
+}
+[ -s "$tmp/run/ao.pfm" ] || fail "gi-reference wrote no image"
+"$prefix/bin/gi-bench" --scenes default,"$share/scenes/bunny_on_plane.json" \
+  --effects vignette,ext_grey,none --presets none --width 64 --height 48 --frames 1 --reps 2 \
+  --ref-spp 4 --cache "$tmp/cache" --no-progress --out "$tmp/run/bench" >"$tmp/bench.log" 2>&1 || {
+  cat "$tmp/bench.log" >&2
+  fail "installed gi-bench"
+}
+expect "$tmp/run/bench/results.csv" "vignette" "gi-bench did not score the vignette"
+expect "$tmp/run/bench/results.csv" "ext_grey" "gi-bench did not score ext_grey"
+[ -s "$tmp/run/bench/report.md" ] || fail "gi-bench wrote no report"
+if command -v xvfb-run >/dev/null; then
+  sed -e 's/gtao/vignette/g' -e 's/^view ao .*/view vignette/' "$share/scripts/tour.txt" >"$tmp/tour.txt"
+  xvfb-run -a -s '-screen 0 640x480x24' "$prefix/bin/gi-demo" --scene "$share/scenes/demo.json" \
+    --effects vignette --validation --width 160 --height 120 --script "$tmp/tour.txt" \
+    >"$tmp/demo.log" 2>&1 || {
+    cat "$tmp/demo.log" >&2
+    fail "installed gi-demo with the shipped script"
+  }
+  expect "$tmp/demo.log" "^passes:.* vignette" "gi-demo did not run the vignette"
+  [ -s "$tmp/run/out/tour-low.png" ] || fail "gi-demo wrote no screenshot"
+  if grep -qi "validation" "$tmp/demo.log"; then
+    cat "$tmp/demo.log" >&2
+    fail "validation messages from the installed gi-demo"
+  fi
 fi
 step "passed"

@@ -26,7 +26,12 @@ void commitFile(const std::string& tmp, const std::string& path) {
     throw Error(ErrorKind::FileNotFound, path, "cannot write output file");
   }
 }
+// The temporary file beside `path`, whose missing folders are made first (an output named
+// out/img.png in a fresh checkout).
 std::string tempName(const std::string& path) {
+  std::error_code ec;
+  if (const auto folder = std::filesystem::path(path).parent_path(); !folder.empty())
+    std::filesystem::create_directories(folder, ec);  // a failure shows when the file is opened
   return path + ".partial";
 }
 }  // namespace

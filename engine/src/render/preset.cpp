@@ -53,8 +53,11 @@ std::string findPreset(const std::string& nameOrPath) {
     if (fs::exists(p)) return p.string();
     searched += " " + dir;
   }
+  std::string known;
+  for (const std::string& name : presetNames()) known += (known.empty() ? "" : ", ") + name;
   throw Error(ErrorKind::FileNotFound, nameOrPath + ".json",
-              "no preset named '" + nameOrPath + "' (searched:" + searched + ")");
+              "no preset named '" + nameOrPath + "' (presets: " +
+                  (known.empty() ? "none found" : known) + "; searched:" + searched + ")");
 }
 
 void onlyKeys(const json& j, const std::set<std::string>& allowed, const std::string& where,

@@ -11,7 +11,9 @@ namespace gi {
 
 std::vector<uint8_t> readTexels(vk::Context& ctx, const FrameGraph::TextureState& t) {
   if (t.layout == VK_IMAGE_LAYOUT_UNDEFINED)
-    throw Error(ErrorKind::Usage, "", "target read before any frame wrote it");
+    throw Error(ErrorKind::Usage, "",
+                "target read before any frame wrote it: render a frame after changing the "
+                "effects, view, preset or size, then read");
   const bool depth = vk::isDepthFormat(t.format);
   const VkImageAspectFlags aspect = depth ? VK_IMAGE_ASPECT_DEPTH_BIT : VK_IMAGE_ASPECT_COLOR_BIT;
   const size_t bytes = size_t(t.extent.width) * t.extent.height * vk::formatBytesPerPixel(t.format);
