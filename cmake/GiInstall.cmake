@@ -42,7 +42,8 @@ install(DIRECTORY ${CMAKE_SOURCE_DIR}/engine/include/ DESTINATION ${CMAKE_INSTAL
 install(FILES ${CMAKE_SOURCE_DIR}/engine/shaders/common.glsl
   ${CMAKE_SOURCE_DIR}/engine/shaders/environment.glsl
   ${CMAKE_SOURCE_DIR}/engine/shaders/lights.glsl
-  ${CMAKE_SOURCE_DIR}/engine/shaders/depth_aware_blur.glsl DESTINATION ${GI_INSTALL_SHADERDIR})
+  ${CMAKE_SOURCE_DIR}/engine/shaders/depth_aware_blur.glsl
+  ${CMAKE_SOURCE_DIR}/engine/shaders/gbuffer.glsl DESTINATION ${GI_INSTALL_SHADERDIR})
 install(EXPORT giTargets NAMESPACE gi:: DESTINATION ${GI_INSTALL_CMAKEDIR})
 
 # The executables keep the layout of the build tree (bin/, bin/shaders, bin/plugins,

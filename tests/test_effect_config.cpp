@@ -237,7 +237,9 @@ TEST_F(EffectGraphTest, NoEffectsRunsOnlyTheEnginePasses) {
   r->renderFrame();
   // The default scene's ceiling light casts shadows: one shadow pass, read by lighting.
   EXPECT_EQ(r->passNames(), (Passes{"gbuffer", "shadow_0", "lighting", "tonemap"}));
-  EXPECT_EQ(r->culledPassNames(), (Passes{"floor"}));
+  // Culled: the G-buffer's unpacking passes (no channel is read) and the floor.
+  EXPECT_EQ(r->culledPassNames(), (Passes{"gbuffer_normal", "gbuffer_albedo", "gbuffer_material",
+                                          "gbuffer_emission", "floor"}));
 }
 
 TEST_F(EffectGraphTest, AnAOEffectFeedsLighting) {
@@ -250,7 +252,8 @@ TEST_F(EffectGraphTest, RequestedEffectWhoseOutputReachesNothingIsCulled) {
   auto r = make(scene, {"const_ao", "orphan"});
   r->renderFrame();
   EXPECT_EQ(r->passNames(), (Passes{"gbuffer", "shadow_0", "const_ao", "lighting", "tonemap"}));
-  EXPECT_EQ(r->culledPassNames(), (Passes{"orphan", "floor"}));
+  EXPECT_EQ(r->culledPassNames(), (Passes{"gbuffer_normal", "gbuffer_albedo", "gbuffer_material",
+                                          "gbuffer_emission", "orphan", "floor"}));
 }
 
 TEST_F(EffectGraphTest, DebugViewKeepsOnlyWhatFeedsIt) {

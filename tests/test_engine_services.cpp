@@ -11,6 +11,7 @@
 
 #include "gi/effect.h"
 #include "gi/effect_registry.h"
+#include "gi/gbuffer.h"
 #include "gi/renderer.h"
 #include "gi/scene_io.h"
 #include "gi/vk/resources.h"
@@ -169,8 +170,7 @@ class Probe : public Effect {
   std::vector<std::string> outputs() const {
     switch (c_.mode) {
       case ProbeConfig::Mode::CameraGBuffer:
-        return {"probe_depth",    "probe_normal",   "probe_albedo",
-                "probe_material", "probe_emission", "probe_motion"};
+        return {"probe_depth", "probe_gbuffer", "probe_motion"};
       case ProbeConfig::Mode::Rsm:
         return {"probe_depth", "probe_position", "probe_rsm_normal", "probe_flux"};
       case ProbeConfig::Mode::Peel:
@@ -232,16 +232,23 @@ TEST_F(EngineServicesTest, ExtraViewDepthAndGBufferEqualTheMainGBufferWhereViews
     // Same transforms in the same order: equal to float rounding (1e-6 of the depth range).
     EXPECT_LE(worst, 1e-6) << "mode " << int(mode);
     if (mode == ProbeConfig::Mode::CameraGBuffer) {
-      r->setView("normal");
+      // The packed texels of both views, unpacked the same way: every channel equal.
+      RenderSettings keep = r->settings();
+      keep.keepForReadback = {"gbuffer", "probe_gbuffer"};
+      r->applySettings(keep);
       r->renderFrame();
-      const ImageRGBA32F n = r->readTarget("normal");
-      r->setView("probe_normal");
-      r->renderFrame();
-      const ImageRGBA32F pn = r->readTarget("probe_normal");
-      double worstN = 0.0;
-      for (size_t i = 0; i < n.pixels.size(); ++i)
-        worstN = std::max(worstN, double(std::abs(n.pixels[i] - pn.pixels[i])));
-      EXPECT_LE(worstN, 1e-3) << "normals of the extra view differ from the main G-buffer's";
+      const std::vector<uint8_t> main = r->readTargetBytes("gbuffer"),
+                                 probe = r->readTargetBytes("probe_gbuffer");
+      ASSERT_EQ(main.size(), probe.size());
+      for (size_t c = 0; c < gbuffer::kChannels.size(); ++c) {
+        const ImageRGBA32F a = gbuffer::unpackChannel(main, 160, 120, c),
+                           b = gbuffer::unpackChannel(probe, 160, 120, c);
+        double worstC = 0.0;
+        for (size_t i = 0; i < a.pixels.size(); ++i)
+          worstC = std::max(worstC, double(std::abs(a.pixels[i] - b.pixels[i])));
+        EXPECT_LE(worstC, 1e-3) << gbuffer::kChannels[c]
+                                << " of the extra view differs from the main G-buffer's";
+      }
     }
   }
 }

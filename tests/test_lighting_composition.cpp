@@ -90,6 +90,7 @@ Frame renderWith(vk::Context& ctx, const Scene& scene, EffectRegistry& reg,
   RenderSettings rs;
   rs.width = 96;
   rs.height = 72;
+  rs.keepForReadback = {"albedo", "material"};  // read after the frame
   for (const std::string& e : effects) rs.effects.push_back({e, reg.defaultSettings(e)});
   Renderer r(ctx, scene, rs, &reg);
   r.renderFrame();

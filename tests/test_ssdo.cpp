@@ -707,7 +707,10 @@ TEST_F(SsdoTest, AdditionalCameraSeesAnOccluderOutsideTheView) {
       e.r, mFar.r, eFar.r);
   ASSERT_GT(n, 20);
   EXPECT_NEAR(m.r, 0.5, 0.005) << "the main view alone cannot see the box";
-  EXPECT_LT(e.r, 0.485) << "the additional camera's box must shadow the floor";  // 0.480
+  // Relative to the main view's own value: the fixed sample set's estimate of the open floor
+  // moves by ~1% with the normal's last bits (0.4969 with half-float normals, 0.5029 packed),
+  // the camera's shadow does not (0.0164 and 0.0166 below it).
+  EXPECT_LT(e.r, m.r - 0.012) << "the additional camera's box must shadow the floor";
   // The floor pixel nearest the box (the image's left edge, 0.4 from it): darkest.
   float darkest = 1.0f, mainThere = 0.0f;
   for (int y = 0; y < extra.h; ++y)

@@ -12,6 +12,7 @@
 #include "gi/effect_config.h"
 #include "gi/environment.h"
 #include "gi/errors.h"
+#include "gi/gbuffer.h"
 #include "gi/renderer.h"
 
 namespace gi::bench {
@@ -305,8 +306,11 @@ void checkTexture(const std::string& name, const ImageRGBA32F& image, HardCaseRu
     channels = 1, hi = 1.0f;
   else if (name == resources::kDepth)
     channels = 1, hi = 1.0f;
-  else if (name == resources::kLit || name == resources::kAmbient || name == resources::kIndirect)
+  else if (name == resources::kLit || name == resources::kAmbient || name == resources::kIndirect ||
+           name == "gbuffer.emission")
     channels = 3;
+  else if (name == "gbuffer.albedo" || name == "gbuffer.material")
+    channels = 3, hi = 1.0f;
   size_t out = 0;
   float worst = 0.0f;
   for (size_t p = 0; p + 3 < image.pixels.size(); p += 4)
@@ -370,6 +374,15 @@ std::vector<HardCaseRun> runHardCases(vk::Context& ctx, const EffectRegistry& re
       Renderer r(ctx, scene, rs, &registry);
       for (int i = 0; i < std::max(options.warmupFrames, 1); ++i) r.renderFrame();
       for (const Renderer::NamedTexture& t : r.readAllTextures()) {
+        if (t.name == resources::kGBuffer) {  // packed: checked channel by channel, unpacked
+          const std::vector<uint8_t> packed = r.readTargetBytes(t.name);
+          for (size_t c = 0; c < gbuffer::kChannels.size(); ++c) {
+            ++run.textures;
+            checkTexture(std::string("gbuffer.") + gbuffer::kChannels[c],
+                         gbuffer::unpackChannel(packed, int(rs.width), int(rs.height), c), run);
+          }
+          continue;
+        }
         if (!t.decoded) {
           ++run.undecoded;
           continue;

@@ -26,7 +26,8 @@ layout(set = 0, binding = 1) uniform AlchemyParams {
   uvec4 taps[16];  // tap i: taps[i / 4][i % 4], packSnorm2x16 of its unit-disk offset
 } params;
 layout(set = 0, binding = 2) uniform sampler2D gDepth;
-layout(set = 0, binding = 3) uniform sampler2D gNormal;
+#define GI_GBUFFER_BINDING 3
+#include "gbuffer.glsl"  // the packed G-buffer
 layout(set = 0, binding = 4, rgba32f) uniform writeonly image2D outAO;
 
 void main() {
@@ -37,7 +38,7 @@ void main() {
   ivec2 size = ivec2(frame.viewport.xy);
 
   float depth = texelFetch(gDepth, q, 0).r;
-  vec4 normalTexel = texelFetch(gNormal, q, 0);
+  uvec4 gTexel = giGBufferLoad(q);
 
   mat4 proj = frame.proj;
   // Guards: a degenerate projection must not divide by zero.
@@ -53,7 +54,7 @@ void main() {
   float dist = 1.0 / max(ic, 1e-30);
   vec3 C = vec3((ndc.x + p20) * dist / p00, (ndc.y + p21) * dist / p11, -dist);
   // Guard: a zero or NaN normal falls back to facing the camera.
-  vec3 N = safeNormalize(normalTexel.xyz, safeNormalize(-C, vec3(0.0, 0.0, 1.0)));
+  vec3 N = safeNormalize(giGBufferNormal(gTexel), safeNormalize(-C, vec3(0.0, 0.0, 1.0)));
 
   // Projected radius in pixels; guard: clamped to the image size (a camera inside the ball
   // would otherwise send taps to integer overflow).
@@ -100,6 +101,6 @@ void main() {
   // Guard: a grazing plane (N.D near 0) predicts nothing: slope 0.
   vec2 slope = nd < -1e-4 * length(D) ? ic * N.xy * dRay / nd : vec2(0.0);
 
-  bool sky = isSky(depth) || !(normalTexel.w > 0.5);
+  bool sky = isSky(depth) || !giGBufferIsGeometry(gTexel);
   imageStore(outAO, p, sky ? vec4(1.0, 0.0, 0.0, 0.0) : vec4(ao, ic, slope));
 }

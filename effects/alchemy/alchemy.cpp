@@ -48,7 +48,7 @@ class AlchemyEffect : public gi::Effect {
         "Alchemy screen-space ambient obscurance (McGuire et al. 2011: eq. 10, spiral taps, "
         "cross-bilateral filter, guard band)";
     i.stage = gi::EffectStage::BeforeLighting;
-    i.reads = {res::kDepth, res::kNormal};
+    i.reads = {res::kDepth, res::kGBuffer};
     i.writes = {res::kAO};
     i.debugView = res::kAO;
     i.estimates = gi::GroundTruth::AmbientOcclusion;
@@ -158,7 +158,7 @@ class AlchemyEffect : public gi::Effect {
   void addPasses(gi::FrameGraph& graph, gi::EffectContext& ctx,
                  const gi::SettingValues& settings) override {
     struct Io {
-      gi::TextureHandle depth, normal, raw, half, ao;
+      gi::TextureHandle depth, packed, raw, half, ao;
       std::vector<gi::TextureHandle> gbuffer;  // guard band: the larger G-buffer's colours
     };
     auto io = std::make_shared<Io>();
@@ -188,7 +188,7 @@ class AlchemyEffect : public gi::Effect {
             for (size_t i = 0; i < formats.size(); ++i)
               io->gbuffer.push_back(target("alchemy_band_g" + std::to_string(i), formats[i],
                                            gi::TextureUsage::ColorAttachment));
-            io->normal = io->gbuffer[0];  // the normal comes first in sceneColorFormats
+            io->packed = io->gbuffer[0];  // the packed G-buffer comes first in sceneColorFormats
           },
           [io, &scene, view = frame](gi::PassContext& pc) {
             gi::SceneTargets t{pc.view(io->depth), {}, pc.extent(io->depth)};
@@ -203,7 +203,7 @@ class AlchemyEffect : public gi::Effect {
         "alchemy",
         [&](gi::PassBuilder& b) {
           io->depth = b.read(band > 0 ? io->depth : bb.texture(res::kDepth));
-          io->normal = b.read(band > 0 ? io->normal : bb.texture(res::kNormal));
+          io->packed = b.read(band > 0 ? io->packed : bb.texture(res::kGBuffer));
           io->raw = b.write(
               b.create(blurRadius > 0 ? "alchemy_raw" : res::kAO, gi::TextureDesc{kPackedFormat}),
               gi::TextureUsage::StorageWrite);
@@ -214,7 +214,7 @@ class AlchemyEffect : public gi::Effect {
           w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame)
               .buffer(1, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms_.handle())
               .sampled(2, pc.view(io->depth), nearest)
-              .sampled(3, pc.view(io->normal), nearest)
+              .sampled(3, pc.view(io->packed), nearest)
               .storageImage(4, pc.view(io->raw));
           const VkExtent2D e = pc.extent(io->raw);
           pc.dispatch(ao_, w, e, kGroupX, kGroupY);

@@ -33,8 +33,8 @@ layout(set = 0, binding = 1) uniform GtaoParams {
   vec4 noise[16];  // per 4x4 phase: cos, sin of the slice rotation, step jitter in [0, 1), 0
 } gtao;
 layout(set = 0, binding = 2) uniform sampler2D gDepth;
-layout(set = 0, binding = 3) uniform sampler2D gNormal;
-layout(set = 0, binding = 4) uniform sampler2D gAlbedo;  // the normal when multi_bounce is off
+#define GI_GBUFFER_BINDING 3
+#include "gbuffer.glsl"  // the packed G-buffer (normal; albedo for multi_bounce)
 layout(set = 0, binding = 5, rgba32f) uniform writeonly image2D outAO;  // depthAwareBlurPack(Scaled)
 layout(set = 0, binding = 6, rgba16f) uniform writeonly image2D outBent;  // 1x1 when off
 
@@ -137,10 +137,10 @@ void main() {
   ivec2 size = ivec2(frame.viewport.xy);
 
   float depth = texelFetch(gDepth, p, 0).r;
-  vec4 normalTexel = texelFetch(gNormal, p, 0);
+  uvec4 gTexel = giGBufferLoad(p);
   // Guard: sky / far-plane pixels and pixels without geometry are open (selected at the end;
   // an early return saves nothing on llvmpipe).
-  bool open = isSky(depth) || !(normalTexel.w > 0.5);
+  bool open = isSky(depth) || !giGBufferIsGeometry(gTexel);
 
   mat4 proj = frame.proj;
   // Guards: a degenerate projection must not divide by zero.
@@ -154,7 +154,7 @@ void main() {
   // Guard: V = -P / |P| with |P| >= dist > 0.
   vec3 V = safeNormalize(-P, vec3(0.0, 0.0, 1.0));
   // Guard: a zero or NaN normal falls back to facing the camera.
-  vec3 N = safeNormalize(normalTexel.xyz, V);
+  vec3 N = safeNormalize(giGBufferNormal(gTexel), V);
 
   float R = gtao.params.x;
   // The radius in pixels at this depth (|P11| H / 2 pixels per unit at distance 1).
@@ -229,7 +229,7 @@ void main() {
   if (kMultiBounce) {
     // Jimenez et al. 2016 multi-bounce fit on the albedo's luminance (cubic in AO, never
     // below AO: albedo 0 leaves it unchanged).
-    vec3 albedo = texelFetch(gAlbedo, p, 0).rgb;
+    vec3 albedo = giGBufferAlbedo(gTexel);
     float a = dot(albedo, vec3(0.2126, 0.7152, 0.0722));
     float fa = 2.0404 * a - 0.3324, fb = -4.7951 * a + 0.6417, fc = 2.7552 * a + 0.6903;
     ao = clamp(max(ao, ((fa * ao + fb) * ao + fc) * ao), 0.0, 1.0);
@@ -239,12 +239,14 @@ void main() {
   if (kBentNormals) {
     // Guard: no visible arc at all (fully occluded) or NaN falls back to the normal.
     vec3 bn = safeNormalize(bent, N);
+    // Open pixels keep the G-buffer's normal (zero without geometry), as the "normal" view has.
+    vec4 openValue = giGBufferIsGeometry(gTexel) ? vec4(giGBufferNormal(gTexel), 1.0) : vec4(0.0);
     // At a reduced resolution, the frame pixel's bent normal for its whole block (nearest
     // upsampling; the bent normal is not blurred either).
     for (int y = 0; y < kScale; ++y)
       for (int x = 0; x < kScale; ++x) {
         ivec2 t = p + ivec2(x, y);
-        if (t.x < size.x && t.y < size.y) imageStore(outBent, t, open ? normalTexel : vec4(bn, 1.0));
+        if (t.x < size.x && t.y < size.y) imageStore(outBent, t, open ? openValue : vec4(bn, 1.0));
       }
   }
 }

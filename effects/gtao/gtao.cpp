@@ -39,7 +39,7 @@ class GtaoEffect : public gi::Effect {
         "ground-truth ambient occlusion (horizon slices, cosine-weighted; optional bent normals "
         "and multi-bounce)";
     i.stage = gi::EffectStage::BeforeLighting;
-    i.reads = {res::kDepth, res::kNormal, res::kAlbedo};
+    i.reads = {res::kDepth, res::kGBuffer, res::kNormal};  // normal: the bent normal when off
     i.writes = {res::kAO, kBentNormal};
     i.debugView = res::kAO;
     // Declares cosine-weighted AO of `radius` (the default estimatedQuantity): with falloff
@@ -100,7 +100,7 @@ class GtaoEffect : public gi::Effect {
     // outputs vanish from the code when off.
     gtao_ = gi::vk::Pipeline::compute(
         vk, {std::begin(gtao_comp), std::end(gtao_comp)},
-        {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, tex}, {5, img}, {6, img}}, 0,
+        {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {5, img}, {6, img}}, 0,
         {uint32_t(s.integer("slices")), uint32_t(s.integer("steps")),
          s.flag("bent_normals") ? 1u : 0u, s.flag("multi_bounce") ? 1u : 0u,
          uint32_t(s.integer("downsample"))});
@@ -122,7 +122,7 @@ class GtaoEffect : public gi::Effect {
   void addPasses(gi::FrameGraph& graph, gi::EffectContext& ctx,
                  const gi::SettingValues& settings) override {
     struct Io {
-      gi::TextureHandle depth, normal, albedo, raw, ao, bent;
+      gi::TextureHandle depth, gbuffer, raw, ao, bent;
     };
     auto io = std::make_shared<Io>();
     gi::Blackboard& bb = graph.blackboard();
@@ -130,8 +130,7 @@ class GtaoEffect : public gi::Effect {
     const int blurRadius = settings.integer("blur_radius"),
               downsample = settings.integer("downsample");
     const bool blurred = blurRadius > 0 || downsample > 1;
-    const bool bentNormals = settings.flag("bent_normals"),
-               multiBounce = settings.flag("multi_bounce");
+    const bool bentNormals = settings.flag("bent_normals");
     const VkBuffer frame = ctx.frameUniforms();
     const VkSampler nearest = ctx.nearestSampler();
     // Persistent, not transient: no pass of the graph may read the bent normal, and the graph
@@ -146,8 +145,7 @@ class GtaoEffect : public gi::Effect {
         "gtao",
         [&](gi::PassBuilder& b) {
           io->depth = b.read(bb.texture(res::kDepth));
-          io->normal = b.read(bb.texture(res::kNormal));
-          if (multiBounce) io->albedo = b.read(bb.texture(res::kAlbedo));
+          io->gbuffer = b.read(bb.texture(res::kGBuffer));
           io->raw = b.write(
               b.create(blurred ? "gtao_raw" : res::kAO,
                        gi::TextureDesc{gi::DepthAwareBlur::kPackedFormat,
@@ -155,16 +153,14 @@ class GtaoEffect : public gi::Effect {
               gi::TextureUsage::StorageWrite);
           if (bentNormals) io->bent = b.write(bentTexture, gi::TextureUsage::StorageWrite);
         },
-        [this, io, values = &settings, frame, nearest, multiBounce,
-         bentNormals](gi::PassContext& pc) {
+        [this, io, values = &settings, frame, nearest, bentNormals](gi::PassContext& pc) {
           upload(*values);
           if (!bentNormals) prepareUnusedBent(pc.cmd());
           gi::vk::DescriptorWriter w;
           w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame)
               .buffer(1, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms_.handle())
               .sampled(2, pc.view(io->depth), nearest)
-              .sampled(3, pc.view(io->normal), nearest)
-              .sampled(4, pc.view(multiBounce ? io->albedo : io->normal), nearest)
+              .sampled(3, pc.view(io->gbuffer), nearest)
               .storageImage(5, pc.view(io->raw))
               .storageImage(6, bentNormals ? pc.view(io->bent) : unusedBent_.view());
           const VkExtent2D e = pc.extent(io->raw);

@@ -25,7 +25,8 @@ layout(set = 0, binding = 1) uniform HbaoParams {
   vec4 noise[16];  // per 4x4 phase: cos, sin of the direction rotation, step jitter, 0
 } hbao;
 layout(set = 0, binding = 2) uniform sampler2D gDepth;
-layout(set = 0, binding = 3) uniform sampler2D gNormal;
+#define GI_GBUFFER_BINDING 3
+#include "gbuffer.glsl"  // the packed G-buffer
 layout(set = 0, binding = 4, rgba32f) uniform writeonly image2D outAO;  // depthAwareBlurPack
 
 const float kPi = 3.14159265358979;
@@ -46,9 +47,9 @@ void main() {
   if (p.x >= size.x || p.y >= size.y) return;
 
   float depth = texelFetch(gDepth, p, 0).r;
-  vec4 normalTexel = texelFetch(gNormal, p, 0);
+  uvec4 gTexel = giGBufferLoad(p);
   // Guard: sky / far-plane pixels and pixels without geometry are open (selected at the end).
-  bool open = isSky(depth) || !(normalTexel.w > 0.5);
+  bool open = isSky(depth) || !giGBufferIsGeometry(gTexel);
 
   mat4 proj = frame.proj;
   // Guards: a degenerate projection must not divide by zero.
@@ -61,7 +62,7 @@ void main() {
   float dist = -P.z;
   // Guard: |P| >= dist > 0; a zero or NaN normal falls back to facing the camera.
   vec3 Pn = safeNormalize(P, vec3(0.0, 0.0, -1.0));
-  vec3 N = safeNormalize(normalTexel.xyz, -Pn);
+  vec3 N = safeNormalize(giGBufferNormal(gTexel), -Pn);
 
   float R = hbao.params.x, invR2 = hbao.params.y;
   float cosBias = hbao.params.z, sinBias = hbao.params.w;

@@ -33,7 +33,7 @@ class HbaoEffect : public gi::Effect {
         "horizon-based ambient occlusion (Bavoil et al. 2008: attenuated horizons, angle bias, "
         "4x4 interleave, depth-aware blur)";
     i.stage = gi::EffectStage::BeforeLighting;
-    i.reads = {res::kDepth, res::kNormal};
+    i.reads = {res::kDepth, res::kGBuffer};
     i.writes = {res::kAO};
     i.debugView = res::kAO;
     // Declares AO of `radius` (the default estimatedQuantity): its own quantity (README: no
@@ -89,7 +89,7 @@ class HbaoEffect : public gi::Effect {
   void addPasses(gi::FrameGraph& graph, gi::EffectContext& ctx,
                  const gi::SettingValues& settings) override {
     struct Io {
-      gi::TextureHandle depth, normal, raw, ao;
+      gi::TextureHandle depth, gbuffer, raw, ao;
     };
     auto io = std::make_shared<Io>();
     gi::Blackboard& bb = graph.blackboard();
@@ -102,7 +102,7 @@ class HbaoEffect : public gi::Effect {
         "hbao",
         [&](gi::PassBuilder& b) {
           io->depth = b.read(bb.texture(res::kDepth));
-          io->normal = b.read(bb.texture(res::kNormal));
+          io->gbuffer = b.read(bb.texture(res::kGBuffer));
           io->raw = b.write(b.create(blurRadius > 0 ? "hbao_raw" : res::kAO,
                                      gi::TextureDesc{gi::DepthAwareBlur::kPackedFormat}),
                             gi::TextureUsage::StorageWrite);
@@ -113,7 +113,7 @@ class HbaoEffect : public gi::Effect {
           w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame)
               .buffer(1, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms_.handle())
               .sampled(2, pc.view(io->depth), nearest)
-              .sampled(3, pc.view(io->normal), nearest)
+              .sampled(3, pc.view(io->gbuffer), nearest)
               .storageImage(4, pc.view(io->raw));
           const VkExtent2D e = pc.extent(io->raw);
           pc.dispatch(hbao_, w, e, kGroupX, kGroupY);

@@ -88,12 +88,7 @@ class IsmEffect : public gi::Effect {
         "gathering, geometry-aware blur; 1 to 3 diffuse bounces; optionally the environment as "
         "directional VPLs with orthographic ISMs";
     i.stage = gi::EffectStage::BeforeLighting;
-    i.reads = {res::kDepth,
-               res::kNormal,
-               res::kAlbedo,
-               res::kMaterial,
-               res::kSurfacePoints,
-               res::kEnvironmentMap,
+    i.reads = {res::kDepth, res::kGBuffer, res::kSurfacePoints, res::kEnvironmentMap,
                res::kEnvironmentSampling};
     // ambient: published (as "nothing") only with environment VPLs, which then carry the
     // environment's light in "indirect", shadowed, in place of the engine's unshadowed term.
@@ -288,8 +283,8 @@ class IsmEffect : public gi::Effect {
                                               uint32_t(c.glossy),
                                               glm::floatBitsToUint(c.phong),
                                               uint32_t(c.envPerPixel)};
-    const std::vector<gi::vk::Binding> gatherBindings = {
-        {0, ubo}, {1, ubo}, {2, ubo}, {3, tex}, {4, tex}, {5, tex}, {6, img}, {7, tex}, {8, ubo}};
+    const std::vector<gi::vk::Binding> gatherBindings = {{0, ubo}, {1, ubo}, {2, ubo}, {3, tex},
+                                                         {4, tex}, {5, tex}, {6, img}, {8, ubo}};
     gather_ =
         c.classic
             ? gi::vk::Pipeline::compute(
@@ -308,14 +303,14 @@ class IsmEffect : public gi::Effect {
     if (c.scale == 1) {
       blurY_ = gi::vk::Pipeline::compute(
           vk, spv(std::begin(ism_blur_y_comp), std::end(ism_blur_y_comp)),
-          {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, tex}, {5, img}}, 0, blurSpec);
+          {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {5, img}}, 0, blurSpec);
     } else {
       blurY_ = gi::vk::Pipeline::compute(
           vk, spv(std::begin(ism_blur_y_low_comp), std::end(ism_blur_y_low_comp)),
           {{0, ubo}, {1, ubo}, {2, tex}, {3, img}}, 0, blurSpec);
       upsample_ = gi::vk::Pipeline::compute(
           vk, spv(std::begin(ism_upsample_comp), std::end(ism_upsample_comp)),
-          {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, tex}, {5, tex}, {6, tex}, {7, img}}, 0,
+          {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, tex}, {7, img}}, 0,
           {uint32_t(c.scale), uint32_t(c.glossy)});
     }
     if (!uniforms_)
@@ -335,8 +330,8 @@ class IsmEffect : public gi::Effect {
   void addPasses(gi::FrameGraph& graph, gi::EffectContext& ctx,
                  const gi::SettingValues& settings) override {
     struct Io {
-      gi::TextureHandle rsmDepth, rsmPos, rsmNormal, rsmFlux, atlas, depth, normal, albedo,
-          material, raw, half, low, indirect, atlasView;
+      gi::TextureHandle rsmDepth, rsmPos, rsmNormal, rsmFlux, atlas, depth, gbuffer, raw, half, low,
+          indirect, atlasView;
       gi::BufferHandle cdf, vpls, points, envVpls, envSampling;
       gi::TextureHandle envMap, ambient;
     };
@@ -485,10 +480,9 @@ class IsmEffect : public gi::Effect {
         "ism_gather",
         [&](gi::PassBuilder& b) {
           io->depth = b.read(bb.texture(res::kDepth));
-          io->normal = b.read(bb.texture(res::kNormal));
+          io->gbuffer = b.read(bb.texture(res::kGBuffer));
           io->vpls = b.read(io->vpls, gi::BufferUsage::Uniform);
           io->atlas = b.read(io->atlas, gi::TextureUsage::Sampled, gi::Subresource::mipLevel(0));
-          io->material = b.read(bb.texture(res::kMaterial));  // glossy: roughness
           if (c.env > 0) io->envVpls = b.read(io->envVpls, gi::BufferUsage::Uniform);
           io->raw = b.write(b.create("ism_raw", rawDesc), gi::TextureUsage::StorageWrite);
         },
@@ -498,10 +492,9 @@ class IsmEffect : public gi::Effect {
               .buffer(1, ubo, params)
               .buffer(2, ubo, pc.buffer(io->vpls))
               .sampled(3, pc.view(io->depth), nearest)
-              .sampled(4, pc.view(io->normal), nearest)
+              .sampled(4, pc.view(io->gbuffer), nearest)
               .sampled(5, pc.view(io->atlas, gi::Subresource::mipLevel(0)), nearest)
               .storageImage(6, pc.view(io->raw))
-              .sampled(7, pc.view(io->material), nearest)
               .buffer(8, ubo, c.env > 0 ? pc.buffer(io->envVpls) : envBuffer_.handle());
           pc.descriptors().bind(pc.cmd(), gather_, w);
           const VkExtent2D e = pc.extent(io->raw);
@@ -516,12 +509,10 @@ class IsmEffect : public gi::Effect {
         "ism_blur",
         [&](gi::PassBuilder& b) {
           io->raw = b.read(io->raw);
-          io->albedo = b.read(bb.texture(res::kAlbedo));
-          io->material = b.read(bb.texture(res::kMaterial));
+          io->gbuffer = b.read(bb.texture(res::kGBuffer));
           io->half = b.write(b.create("ism_blur_x", rawDesc), gi::TextureUsage::StorageWrite);
           if (c.scale > 1) {
             io->depth = b.read(bb.texture(res::kDepth));
-            io->normal = b.read(bb.texture(res::kNormal));
             io->low = b.write(b.create("ism_blur_y", rawDesc), gi::TextureUsage::StorageWrite);
           }
           io->indirect = b.write(b.create(res::kIndirect, gi::TextureDesc{kOutFormat}),
@@ -549,9 +540,7 @@ class IsmEffect : public gi::Effect {
                 .buffer(1, ubo, params)
                 .sampled(2, pc.view(io->low), nearest, VK_IMAGE_LAYOUT_GENERAL)
                 .sampled(3, pc.view(io->depth), nearest)
-                .sampled(4, pc.view(io->normal), nearest)
-                .sampled(5, pc.view(io->albedo), nearest)
-                .sampled(6, pc.view(io->material), nearest)
+                .sampled(4, pc.view(io->gbuffer), nearest)
                 .storageImage(7, pc.view(io->indirect));
             pc.dispatch(upsample_, u, e, kGroupX, kGroupY);
             return;
@@ -560,8 +549,7 @@ class IsmEffect : public gi::Effect {
           y.buffer(0, ubo, frame)
               .buffer(1, ubo, params)
               .sampled(2, pc.view(io->half), nearest, VK_IMAGE_LAYOUT_GENERAL)
-              .sampled(3, pc.view(io->albedo), nearest)
-              .sampled(4, pc.view(io->material), nearest)
+              .sampled(3, pc.view(io->gbuffer), nearest)
               .storageImage(5, pc.view(io->indirect));
           pc.dispatch(blurY_, y, e, kGroupX, kGroupY);
         });

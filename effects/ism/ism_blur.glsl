@@ -20,8 +20,8 @@ layout(set = 0, binding = 2) uniform usampler2D inRaw;
 #if AXIS == 0 || defined(LOW)
 layout(set = 0, binding = 3, rgba32ui) uniform writeonly uimage2D outRaw;
 #else
-layout(set = 0, binding = 3) uniform sampler2D gAlbedo;
-layout(set = 0, binding = 4) uniform sampler2D gMaterial;
+#define GI_GBUFFER_BINDING 3
+#include "gbuffer.glsl"  // the packed G-buffer (albedo, metallic)
 layout(set = 0, binding = 5, rgba16f) uniform writeonly image2D outIndirect;
 #endif
 
@@ -73,8 +73,9 @@ void main() {
                        : uvec2(packHalf2x16(e.rg), packHalf2x16(vec2(e.b, 0.0)));
   imageStore(outRaw, p, uvec4(value, c.z, c.w));
 #else
-  vec3 albedo = texelFetch(gAlbedo, p, 0).rgb;
-  float metallic = texelFetch(gMaterial, p, 0).g;
+  uvec4 surface = giGBufferLoad(p);
+  vec3 albedo = giGBufferAlbedo(surface);
+  float metallic = giGBufferMetallic(surface);
   vec3 diffuse = albedo * (1.0 - metallic);
   vec3 l = diffuse * e / 3.14159265;
   if (GLOSSY) l += mix(vec3(0.04), albedo, metallic) * spec;

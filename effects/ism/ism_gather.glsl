@@ -26,10 +26,10 @@ layout(local_size_x = 32, local_size_y = 16) in;
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 layout(set = 0, binding = 2, std140) uniform Vpls { Vpl vpls[ISM_VPL_SLOTS]; };
 layout(set = 0, binding = 3) uniform sampler2D gDepth;
-layout(set = 0, binding = 4) uniform sampler2D gNormal;
+#define GI_GBUFFER_BINDING 4
+#include "gbuffer.glsl"  // the packed G-buffer (normal; roughness when GLOSSY)
 #include "ism_lookup.glsl"
 layout(set = 0, binding = 6, rgba32ui) uniform writeonly uimage2D outRaw;
-layout(set = 0, binding = 7) uniform sampler2D gMaterial;  // GLOSSY: roughness
 layout(set = 0, binding = 8, std140) uniform EnvVpls { Vpl envVpls[ISM_VPL_SLOTS]; };
 
 // The receiver's BRDF (diffuse, + Phong when GLOSSY): adds VPL v's irradiance at x to e and,
@@ -61,12 +61,13 @@ void main() {
   }
   vec2 uv = (vec2(g) + 0.5) * frame.viewport.zw;
   vec3 viewPos = viewPositionFromDepth(frame.invProj, uv, depth);
-  vec3 viewN = safeNormalize(texelFetch(gNormal, g, 0).xyz, vec3(0.0, 0.0, 1.0));
+  uvec4 surface = giGBufferLoad(g);
+  vec3 viewN = giGBufferNormal(surface);
   vec3 x = (frame.invView * vec4(viewPos, 1.0)).xyz;
   vec3 n = safeNormalize(mat3(frame.invView) * viewN, vec3(0.0, 1.0, 0.0));
   vec3 e = vec3(0.0), spec = vec3(0.0);
   vec3 view = safeNormalize(mat3(frame.invView) * -viewPos, n);
-  float exponent = GLOSSY ? ismPhongExponent(PHONG_EXPONENT, texelFetch(gMaterial, g, 0).r) : 1.0;
+  float exponent = GLOSSY ? ismPhongExponent(PHONG_EXPONENT, giGBufferRoughness(surface)) : 1.0;
   for (int j = 0; j < PER_PIXEL; ++j) {
     uint i = phase + uint(j * K * K);
     reflectVpl(vpls[i], min(i, uint(ism.blur.w) - 1u), x, n, view, exponent, e, spec);

@@ -17,9 +17,8 @@ layout(local_size_x = 32, local_size_y = 16) in;
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 layout(set = 0, binding = 2) uniform usampler2D lowRaw;
 layout(set = 0, binding = 3) uniform sampler2D gDepth;
-layout(set = 0, binding = 4) uniform sampler2D gNormal;
-layout(set = 0, binding = 5) uniform sampler2D gAlbedo;
-layout(set = 0, binding = 6) uniform sampler2D gMaterial;
+#define GI_GBUFFER_BINDING 4
+#include "gbuffer.glsl"  // the packed G-buffer (normal, albedo, metallic)
 layout(set = 0, binding = 7, rgba16f) uniform writeonly image2D outIndirect;
 
 vec2 signNotZero(vec2 v) { return vec2(v.x >= 0.0 ? 1.0 : -1.0, v.y >= 0.0 ? 1.0 : -1.0); }
@@ -37,7 +36,8 @@ void main() {
   if (p.x >= size.x || p.y >= size.y) return;
   float depth = texelFetch(gDepth, p, 0).r;
   vec3 viewPos = viewPositionFromDepth(frame.invProj, (vec2(p) + 0.5) * frame.viewport.zw, depth);
-  vec3 n = safeNormalize(texelFetch(gNormal, p, 0).xyz, vec3(0.0, 0.0, 1.0));
+  uvec4 surface = giGBufferLoad(p);
+  vec3 n = giGBufferNormal(surface);
   float z = length(viewPos);
   ivec2 lowSize = textureSize(lowRaw, 0);
   vec2 u = vec2(p) / float(SCALE);
@@ -68,8 +68,8 @@ void main() {
   }
   vec3 e = wsum > 0.0 ? sum / wsum : any / max(asum, 1e-6);
   vec3 spec = wsum > 0.0 ? specSum / wsum : specAny / max(asum, 1e-6);
-  vec3 albedo = texelFetch(gAlbedo, p, 0).rgb;
-  float metallic = texelFetch(gMaterial, p, 0).g;
+  vec3 albedo = giGBufferAlbedo(surface);
+  float metallic = giGBufferMetallic(surface);
   vec3 l = albedo * (1.0 - metallic) * e / 3.14159265;
   if (GLOSSY) l += mix(vec3(0.04), albedo, metallic) * spec;
   vec3 outv = isSky(depth) ? vec3(0.0) : min(l, vec3(65000.0));

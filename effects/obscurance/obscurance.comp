@@ -30,9 +30,9 @@ layout(set = 0, binding = 1) uniform ObscuranceParams {
   uvec4 kernel[16];  // tap i: kernel[i / 4][i % 4], 11/11/10 bits (packTap)
 } obs;
 layout(set = 0, binding = 2) uniform sampler2D gDepth;
-layout(set = 0, binding = 3) uniform sampler2D gNormal;
-layout(set = 0, binding = 4) uniform sampler2D gAlbedo;
-layout(set = 0, binding = 5) uniform sampler2D gEmission;  // MODE 3: the occluders' L_d
+#define GI_GBUFFER_BINDING 3
+#include "gbuffer.glsl"  // the packed G-buffer: normal, the occluders' albedo and emission
+layout(set = 0, binding = 5) uniform sampler2D gRadiance;  // MODE 3: the occluders' L_d
 layout(set = 0, binding = 6, rgba32ui) uniform writeonly uimage2D outSums;
 
 // Guard: test points at or behind the camera plane (clip.w below this) are untestable: open.
@@ -58,10 +58,10 @@ void main() {
   if (p.x >= size.x || p.y >= size.y) return;
 
   float depth = texelFetch(gDepth, p, 0).r;
-  vec4 normalTexel = texelFetch(gNormal, p, 0);
+  uvec4 gTexel = giGBufferLoad(p);
   // Guard: sky / far-plane pixels and pixels without geometry are open (O = W = 1).
   // 1 / distance 0 marks them for the filter (nothing is averaged into or out of them).
-  if (isSky(depth) || !(normalTexel.w > 0.5)) {
+  if (isSky(depth) || !giGBufferIsGeometry(gTexel)) {
     imageStore(outSums, p, uvec4(packHalf2x16(vec2(1.0)), 0u, 0u, 0u));
     return;
   }
@@ -75,7 +75,7 @@ void main() {
   vec2 ndc = (vec2(p) + 0.5) * 2.0 * frame.viewport.zw - 1.0;
   float dist = p32 / max(depth + p22, 1e-30);
   vec3 P = vec3((ndc.x + p20) * dist / p00, (ndc.y + p21) * dist / p11, -dist);
-  vec3 N = safeNormalize(normalTexel.xyz, safeNormalize(-P, vec3(0.0, 0.0, 1.0)));
+  vec3 N = safeNormalize(giGBufferNormal(gTexel), safeNormalize(-P, vec3(0.0, 0.0, 1.0)));
 
   // Tangent frame without a helper axis (Duff et al. 2017): never degenerates.
   float s = N.z >= 0.0 ? 1.0 : -1.0;
@@ -144,13 +144,14 @@ void main() {
     float J = inside ? 0.0 : 1.0;
     nSum += J;
     if (MODE != 0) {
-      float albedo = clamp(dot(texelFetch(gAlbedo, hit, 0).rgb, kLuma), 0.0, 1.0);
+      uvec4 occluder = giGBufferLoad(hit);
+      float albedo = clamp(dot(giGBufferAlbedo(occluder), kLuma), 0.0, 1.0);
       dSum += J + (1.0 - J) * (1.0 - albedo);  // = 1 - (1 - J) a, without cancellation
       if (MODE == 2) {
-        float e = max(dot(texelFetch(gEmission, hit, 0).rgb, kLuma), 0.0) * invAmbient;
+        float e = max(dot(giGBufferEmission(occluder), kLuma), 0.0) * invAmbient;
         nSum += (1.0 - J) * min(e, kMaxEmissionRatio);
       }
-      if (MODE == 3) sent += (1.0 - J) * max(texelFetch(gEmission, hit, 0).rgb, vec3(0.0));
+      if (MODE == 3) sent += (1.0 - J) * max(texelFetch(gRadiance, hit, 0).rgb, vec3(0.0));
     }
   }
   float invN = 1.0 / float(SAMPLES);

@@ -51,8 +51,7 @@ class ObscuranceEffect : public gi::Effect {
         "obscurance with a fuzzy membership and the ambient transfer function with "
         "interreflections (seed 001)";
     i.stage = gi::EffectStage::BeforeLighting;
-    i.reads = {res::kDepth,    res::kNormal, res::kAlbedo,      res::kMaterial,
-               res::kEmission, res::kLights, res::kShadowViews, res::kShadowMaps};
+    i.reads = {res::kDepth, res::kGBuffer, res::kLights, res::kShadowViews, res::kShadowMaps};
     // "ambient" and "direct_light" only with transfer = radiance, "ao" otherwise.
     i.writes = {res::kAO, res::kAmbient, res::kDirectLight};
     i.debugView = res::kAO;
@@ -127,14 +126,14 @@ class ObscuranceEffect : public gi::Effect {
     radiance_ = mode == int(obs::Transfer::Radiance);
     if (radiance_) {
       std::vector<gi::vk::Binding> bindings = gi::LitSurfaceInputs::layout(1);
-      bindings.insert(bindings.end(), {{0, ubo}, {9, img}, {10, img}});
+      bindings.insert(bindings.end(), {{0, ubo}, {6, img}, {7, img}});
       radiancePipeline_ = gi::vk::Pipeline::compute(
           vk, words(std::begin(obscurance_radiance_comp), std::end(obscurance_radiance_comp)),
           bindings);
     }
     main_ = gi::vk::Pipeline::compute(
         vk, words(std::begin(obscurance_comp), std::end(obscurance_comp)),
-        {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, tex}, {5, tex}, {6, img}}, 0,
+        {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {5, tex}, {6, img}}, 0,
         {uint32_t(s.integer("samples")), uint32_t(s.integer("points_per_ray")), uint32_t(mode)});
     const std::vector<gi::vk::Binding> filterBindings = {{0, ubo}, {1, ubo}, {2, tex}, {3, img}};
     const std::vector<uint32_t> filterSpec = {uint32_t(mode),
@@ -161,8 +160,9 @@ class ObscuranceEffect : public gi::Effect {
                  const gi::SettingValues& settings) override {
     struct Io {
       gi::LitSurfaceInputs surface;  // transfer = radiance: what obscurance_radiance reads
-      // `sent`: what the taps read of an occluder (the emission, or obscurance_radiance).
-      gi::TextureHandle depth, normal, albedo, radiance, direct, sent, sums, half, out;
+      // `sent`: the occluders' radiance for transfer = radiance (obscurance_radiance), else depth
+      // in its place (the other transfers read the occluders from the packed G-buffer).
+      gi::TextureHandle depth, gbuffer, radiance, direct, sent, sums, half, out;
     };
     auto io = std::make_shared<Io>();
     gi::Blackboard& bb = graph.blackboard();
@@ -189,7 +189,7 @@ class ObscuranceEffect : public gi::Effect {
             gi::vk::DescriptorWriter w;
             w.buffer(0, ubo, frame);
             io->surface.bind(w, pc, 1, nearest);
-            w.storageImage(9, pc.view(io->radiance)).storageImage(10, pc.view(io->direct));
+            w.storageImage(6, pc.view(io->radiance)).storageImage(7, pc.view(io->direct));
             pc.dispatch(radiancePipeline_, w, pc.extent(io->radiance), kGroupX, kGroupY);
           });
 
@@ -197,9 +197,9 @@ class ObscuranceEffect : public gi::Effect {
         "obscurance",
         [&](gi::PassBuilder& b) {
           io->depth = b.read(bb.texture(res::kDepth));
-          io->normal = b.read(bb.texture(res::kNormal));
-          io->albedo = b.read(bb.texture(res::kAlbedo));
-          io->sent = b.read(radiance ? io->radiance : bb.texture(res::kEmission));
+          io->gbuffer = b.read(bb.texture(res::kGBuffer));
+          // MODE 3 reads the radiance pass's output; the other modes bind depth in its place.
+          io->sent = radiance ? b.read(io->radiance) : io->depth;
           io->sums = b.write(b.create("obscurance_sums", gi::TextureDesc{kSumsFormat}),
                              gi::TextureUsage::StorageWrite);
         },
@@ -209,8 +209,7 @@ class ObscuranceEffect : public gi::Effect {
           w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame)
               .buffer(1, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms_.handle())
               .sampled(2, pc.view(io->depth), nearest)
-              .sampled(3, pc.view(io->normal), nearest)
-              .sampled(4, pc.view(io->albedo), nearest)
+              .sampled(3, pc.view(io->gbuffer), nearest)
               .sampled(5, pc.view(io->sent), nearest)
               .storageImage(6, pc.view(io->sums));
           const VkExtent2D e = pc.extent(io->sums);

@@ -13,18 +13,17 @@
 layout(local_size_x = 32, local_size_y = 16) in;
 
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
-layout(set = 0, binding = 1) uniform sampler2D gDepth;
-layout(set = 0, binding = 2) uniform sampler2D gNormal;
-layout(set = 0, binding = 3) uniform sampler2D gAlbedo;
-layout(set = 0, binding = 4) uniform sampler2D gMaterial;
-layout(set = 0, binding = 5) uniform sampler2D gEmission;
+// Bindings 1-5: gi::LitSurfaceInputs.
+#define GI_DEPTH_BINDING 1
+#define GI_GBUFFER_BINDING 2
+#include "gbuffer.glsl"
 #define GI_LIGHTS_SET 0
-#define GI_LIGHTS_BINDING 6
-#define GI_SHADOW_VIEWS_BINDING 7
-#define GI_SHADOW_MAPS_BINDING 8
+#define GI_LIGHTS_BINDING 3
+#define GI_SHADOW_VIEWS_BINDING 4
+#define GI_SHADOW_MAPS_BINDING 5
 #include "lights.glsl"
-layout(set = 0, binding = 9, rgba16f) uniform writeonly image2D outRadiance;
-layout(set = 0, binding = 10, rgba16f) uniform writeonly image2D outDirect;  // "direct_light"
+layout(set = 0, binding = 6, rgba16f) uniform writeonly image2D outRadiance;
+layout(set = 0, binding = 7, rgba16f) uniform writeonly image2D outDirect;  // "direct_light"
 
 // Guard: half floats overflow to inf above 65504.
 const float kMaxRadiance = 65000.0;
@@ -34,24 +33,25 @@ void main() {
   ivec2 size = ivec2(frame.viewport.xy);
   if (p.x >= size.x || p.y >= size.y) return;
 
-  float depth = texelFetch(gDepth, p, 0).r;
-  vec4 normalTexel = texelFetch(gNormal, p, 0);
+  float depth = giGBufferDepth(p);
+  uvec4 g = giGBufferLoad(p);
   // Guard: sky / far-plane pixels and pixels without geometry send nothing (they are never
   // inside a test anyway: their depth is behind every point).
-  if (isSky(depth) || !(normalTexel.w > 0.5)) {
+  if (isSky(depth) || !giGBufferIsGeometry(g)) {
     imageStore(outRadiance, p, vec4(0.0));
     imageStore(outDirect, p, vec4(0.0, 0.0, 0.0, 1.0));  // the lighting pass draws the sky
     return;
   }
   vec2 uv = (vec2(p) + 0.5) * frame.viewport.zw;
   vec3 pos = viewPositionFromDepth(frame.invProj, uv, depth);
-  vec3 n = safeNormalize(normalTexel.xyz, safeNormalize(-pos, vec3(0.0, 0.0, 1.0)));
-  vec3 albedo = texelFetch(gAlbedo, p, 0).rgb;
-  vec2 rm = texelFetch(gMaterial, p, 0).rg;
+  vec3 n = giGBufferNormal(g);
+  vec3 albedo = giGBufferAlbedo(g);
+  float metallic = giGBufferMetallic(g);
   LightSum lights = sumLights(pos, n, safeNormalize(-pos, vec3(0.0, 0.0, 1.0)),
-                              mix(vec3(0.04), albedo, rm.y), shininessOf(rm.x), vec4(1.0), false);
-  vec3 diffuseDirect = albedo * (1.0 - rm.y) * lights.irradiance * (1.0 / 3.14159265358979);
-  vec3 radiance = texelFetch(gEmission, p, 0).rgb + diffuseDirect;
+                              mix(vec3(0.04), albedo, metallic),
+                              shininessOf(giGBufferRoughness(g)), vec4(1.0), false);
+  vec3 diffuseDirect = albedo * (1.0 - metallic) * lights.irradiance * (1.0 / 3.14159265358979);
+  vec3 radiance = giGBufferEmission(g) + diffuseDirect;
   vec3 direct = diffuseDirect + lights.specular;
   // Guards: finite, non-negative, below the half-float maximum; NaN inputs read 0.
   radiance = clamp(radiance, vec3(0.0), vec3(kMaxRadiance));

@@ -20,7 +20,8 @@ layout(set = 0, binding = 1) uniform SsaoParams {
   uvec4 kernel[16];  // tap i: kernel[i / 4][i % 4], 11/11/10 bits (gi::ssao::packTap)
 } ssao;
 layout(set = 0, binding = 2) uniform sampler2D gDepth;
-layout(set = 0, binding = 3) uniform sampler2D gNormal;
+#define GI_GBUFFER_BINDING 3
+#include "gbuffer.glsl"  // the packed G-buffer
 layout(set = 0, binding = 4, rgba32f) uniform writeonly image2D outAO;  // ao, 1/z, slopes
 
 // Guard: taps at or behind the camera plane (clip.w below this) are untestable: open.
@@ -47,9 +48,9 @@ void main() {
   if (p.x >= size.x || p.y >= size.y) return;
 
   float depth = texelFetch(gDepth, p, 0).r;
-  vec4 normalTexel = texelFetch(gNormal, p, 0);
+  uvec4 gTexel = giGBufferLoad(p);
   // Guard: sky / far-plane pixels (depth 0) and pixels without geometry are open; no taps.
-  if (isSky(depth) || !(normalTexel.w > 0.5)) {
+  if (isSky(depth) || !giGBufferIsGeometry(gTexel)) {
     imageStore(outAO, p, depthAwareBlurPack(frame, 1.0, vec3(0.0), vec3(0.0, 0.0, 1.0)));
     return;
   }
@@ -67,7 +68,7 @@ void main() {
   float dist = p32 / max(depth + p22, 1e-30);
   vec3 P = vec3((ndc.x + p20) * dist / p00, (ndc.y + p21) * dist / p11, -dist);
   // Guard: a zero or NaN normal falls back to facing the camera.
-  vec3 N = safeNormalize(normalTexel.xyz, safeNormalize(-P, vec3(0.0, 0.0, 1.0)));
+  vec3 N = safeNormalize(giGBufferNormal(gTexel), safeNormalize(-P, vec3(0.0, 0.0, 1.0)));
 
   // Tangent frame without a helper axis (Duff et al. 2017, "Building an orthonormal basis,
   // revisited"): |s + N.z| >= 1, so it never degenerates, whatever the normal's direction.

@@ -36,7 +36,7 @@ class SsaoEffect : public gi::Effect {
         "screen-space ambient occlusion (hemisphere taps, 4x4 interleave, "
         "depth-aware blur)";
     i.stage = gi::EffectStage::BeforeLighting;
-    i.reads = {res::kDepth, res::kNormal};
+    i.reads = {res::kDepth, res::kGBuffer};
     i.writes = {res::kAO};
     i.debugView = res::kAO;
     i.estimates = gi::GroundTruth::AmbientOcclusion;
@@ -91,7 +91,7 @@ class SsaoEffect : public gi::Effect {
   void addPasses(gi::FrameGraph& graph, gi::EffectContext& ctx,
                  const gi::SettingValues& settings) override {
     struct Io {
-      gi::TextureHandle depth, normal, raw;
+      gi::TextureHandle depth, gbuffer, raw;
     };
     // Without a blur "ao" is the packed texture itself (its red channel is the AO).
     auto io = std::make_shared<Io>();
@@ -106,7 +106,7 @@ class SsaoEffect : public gi::Effect {
         "ssao",
         [&](gi::PassBuilder& b) {
           io->depth = b.read(bb.texture(res::kDepth));
-          io->normal = b.read(bb.texture(res::kNormal));
+          io->gbuffer = b.read(bb.texture(res::kGBuffer));
           io->raw = b.write(b.create(blurRadius > 0 ? "ssao_raw" : res::kAO,
                                      gi::TextureDesc{gi::DepthAwareBlur::kPackedFormat}),
                             gi::TextureUsage::StorageWrite);
@@ -117,7 +117,7 @@ class SsaoEffect : public gi::Effect {
           w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame)
               .buffer(1, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms_.handle())
               .sampled(2, pc.view(io->depth), nearest)
-              .sampled(3, pc.view(io->normal), nearest)
+              .sampled(3, pc.view(io->gbuffer), nearest)
               .storageImage(4, pc.view(io->raw));
           const VkExtent2D e = pc.extent(io->raw);
           pc.dispatch(ssao_, w, e, kGroupX, kGroupY);

@@ -79,11 +79,13 @@ class SsdoEffect : public gi::Effect {
         "screen-space directional occlusion of the environment with one indirect bounce "
         "(Ritschel et al. 2009; 16 interleaved sample sets, geometry-aware blur)";
     i.stage = gi::EffectStage::BeforeLighting;
-    i.reads = {res::kDepth,          res::kNormal,
-               res::kAlbedo,         res::kMaterial,
-               res::kEmission,       res::kLights,
-               res::kShadowViews,    res::kShadowMaps,
-               res::kEnvironmentMap, res::kEnvironmentSampling};
+    i.reads = {res::kDepth,
+               res::kGBuffer,
+               res::kLights,
+               res::kShadowViews,
+               res::kShadowMaps,
+               res::kEnvironmentMap,
+               res::kEnvironmentSampling};
     i.writes = {res::kAmbient, res::kIndirect, res::kContactShadow, res::kDirectLight};
     i.debugView = res::kAmbient;
     i.estimates = gi::GroundTruth::IndirectLight;
@@ -182,8 +184,7 @@ class SsdoEffect : public gi::Effect {
         bounce_
             ? gi::vk::Pipeline::compute(
                   vk, {std::begin(ssdo_resolve_comp), std::end(ssdo_resolve_comp)},
-                  {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, tex}, {5, img}, {6, img}}, 0,
-                  blurConstants)
+                  {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {5, img}, {6, img}}, 0, blurConstants)
             : gi::vk::Pipeline::compute(
                   vk, {std::begin(ssdo_resolve_ambient_comp), std::end(ssdo_resolve_ambient_comp)},
                   {{0, ubo}, {1, ubo}, {2, tex}, {5, img}}, 0, blurConstants);
@@ -248,7 +249,7 @@ class SsdoEffect : public gi::Effect {
   void addPasses(gi::FrameGraph& graph, gi::EffectContext& ctx,
                  const gi::SettingValues& settings) override {
     struct Io {
-      gi::TextureHandle depth, normal, albedo, material, shadowMaps;
+      gi::TextureHandle depth, gbuffer, shadowMaps;
       gi::BufferHandle lights, shadowViews;
       gi::LitSurfaceInputs litInputs;  // what ssdo_surface reads to sum the lights
       gi::TextureHandle envMap;        // the environment (its map and importance-sampling tables)
@@ -261,7 +262,7 @@ class SsdoEffect : public gi::Effect {
       gi::TextureHandle contact;    // contact_shadow (contact_shadows)
       gi::TextureHandle direct;     // direct_light (bounce)
       gi::TextureHandle camDirect;  // the cameras' stand-in for direct_light's binding
-      // Per additional camera: its depth, G-buffer colours and surface texels.
+      // Per additional camera: its depth, G-buffer (packed, motion) and surface texels.
       std::vector<gi::TextureHandle> camDepth, camSurface;
       std::vector<std::vector<gi::TextureHandle>> camG;
     };
@@ -361,10 +362,9 @@ class SsdoEffect : public gi::Effect {
             const auto masks = lightMasks(c->lights());
             if (masks != surfaceMasks_ || pcfRadius(*c) != pcf_) buildSurface(*c, masks);
             for (uint32_t k = 0; k < n; ++k) {
-              const std::vector<gi::TextureHandle>& g = io->camG[k];  // normal .. emission
-              const gi::LitSurfaceInputs camera{
-                  io->camDepth[k], g[0],       g[1],           g[2], g[3],
-                  io->shadowMaps,  io->lights, io->shadowViews};
+              const std::vector<gi::TextureHandle>& g = io->camG[k];  // packed, motion
+              const gi::LitSurfaceInputs camera{io->camDepth[k], g[0], io->shadowMaps, io->lights,
+                                                io->shadowViews};
               gi::vk::DescriptorWriter w;
               w.buffer(0, ubo, views_[k]->buffer()).buffer(1, ubo, uniforms_.handle());
               camera.bind(w, pc, 2, nearest);
@@ -384,7 +384,7 @@ class SsdoEffect : public gi::Effect {
           "ssdo_contact",
           [&](gi::PassBuilder& b) {
             io->depth = b.read(bb.texture(res::kDepth));
-            io->normal = b.read(bb.texture(res::kNormal));
+            io->gbuffer = b.read(bb.texture(res::kGBuffer));
             readLights(b);
             io->contact =
                 b.write(b.create(res::kContactShadow, gi::TextureDesc{VK_FORMAT_R8G8B8A8_UNORM}),
@@ -401,7 +401,7 @@ class SsdoEffect : public gi::Effect {
                 .buffer(4, ubo, pc.buffer(io->shadowViews))
                 .sampled(5, pc.view(io->shadowMaps), nearest)
                 .storageImage(6, pc.view(io->contact))
-                .sampled(7, pc.view(io->normal), nearest);
+                .sampled(7, pc.view(io->gbuffer), nearest);
             pc.dispatch(contactPipeline_, w, pc.extent(io->contact), kGroupX, kGroupY);
           });
       if (!bounce_) bb.put(res::kContactShadow, io->contact);
@@ -491,7 +491,7 @@ class SsdoEffect : public gi::Effect {
         [&](gi::PassBuilder& b) {
           if (depthInput()) {
             io->depth = b.read(bb.texture(res::kDepth));
-            io->normal = b.read(bb.texture(res::kNormal));
+            io->gbuffer = b.read(bb.texture(res::kGBuffer));
           } else {
             io->surface = b.read(io->surface);
           }
@@ -515,7 +515,7 @@ class SsdoEffect : public gi::Effect {
                 .buffer(1, ubo, uniforms_.handle())
                 .storageImage(3, pc.view(io->raw))
                 .sampled(9, pc.view(io->depth), nearest)
-                .sampled(10, pc.view(io->normal), nearest);
+                .sampled(10, pc.view(io->gbuffer), nearest);
             bindEnvironment(w, pc, *io, nearest);
             pc.dispatch(ssdo_, w, pc.extent(io->raw), kGroupX, kGroupY);
             return;
@@ -541,10 +541,8 @@ class SsdoEffect : public gi::Effect {
         blurRadius > 0 ? "ssdo_blur" : "ssdo_resolve",
         [&](gi::PassBuilder& b) {
           io->raw = b.read(io->raw);
-          if (bounce_) {  // the albedo for `indirect` (`ambient` is per unit albedo)
-            io->albedo = b.read(bb.texture(res::kAlbedo));
-            io->material = b.read(bb.texture(res::kMaterial));
-          }
+          // The albedo for `indirect` (`ambient` is per unit albedo).
+          if (bounce_) io->gbuffer = b.read(bb.texture(res::kGBuffer));
           if (blurRadius > 0)
             io->half = b.write(b.create("ssdo_blur_x", gi::TextureDesc{kPackedFormat}),
                                gi::TextureUsage::StorageWrite);
@@ -578,9 +576,7 @@ class SsdoEffect : public gi::Effect {
               .sampled(2, in, nearest, inLayout)
               .storageImage(5, pc.view(io->ambient));
           if (bounce_)
-            w.sampled(3, pc.view(io->albedo), nearest)
-                .sampled(4, pc.view(io->material), nearest)
-                .storageImage(6, pc.view(io->indirect));
+            w.sampled(3, pc.view(io->gbuffer), nearest).storageImage(6, pc.view(io->indirect));
           pc.dispatch(resolve_, w, e, kGroupX, kGroupY);
         });
     bb.put(res::kAmbient, io->ambient);
@@ -675,7 +671,7 @@ class SsdoEffect : public gi::Effect {
     pcf_ = pcfRadius(ctx);
     auto build = [&](uint32_t layers, bool mainView) {
       const bool direct = mainView && bounce_;
-      std::vector<gi::vk::Binding> bindings = gi::LitSurfaceInputs::layout(2);  // 2..9
+      std::vector<gi::vk::Binding> bindings = gi::LitSurfaceInputs::layout(2);  // 2..6
       bindings.insert(bindings.end(),
                       {{0, ubo}, {1, ubo}, {10, img}, {11, tex}, {12, img}, {13, tex}});
       return gi::vk::Pipeline::compute(

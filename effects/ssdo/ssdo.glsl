@@ -60,7 +60,8 @@ layout(set = 0, binding = 13, std430) readonly buffer EnvironmentSamples {
 // read the depth itself (32 bits, not the surface texel's 128) and ssdo_surface does not run.
 // Bit for bit the same values as ssdo_surface.comp writes.
 layout(set = 0, binding = 9) uniform sampler2D gDepth;
-layout(set = 0, binding = 10) uniform sampler2D gNormal;
+#define GI_GBUFFER_BINDING 10
+#include "gbuffer.glsl"  // the packed G-buffer (normals)
 // 1 / view distance of reverse-Z depth d: (d + P22) / P32, as ssdo_surface.comp. Guards: sky,
 // a degenerate projection and non-finite values read 0 (never an occluder).
 float inverseDistance(float d, float p22, float p32) {
@@ -141,10 +142,10 @@ void main() {
 
 #ifdef SSDO_DEPTH_INPUT
   // What ssdo_surface.comp would have written here (x, y; no sender radiance, no layer).
-  vec4 normalTexel = texelFetch(gNormal, p, 0);
+  uvec4 gTexel = giGBufferLoad(p);
   float izG = inverseDistance(texelFetch(gDepth, p, 0).r, frame.proj[2][2], frame.proj[3][2]);
-  uvec4 centre = uvec4(floatBitsToUint(normalTexel.w > 0.5 ? izG : 0.0),
-                       packNormal(safeNormalize(normalTexel.xyz, vec3(0.0, 0.0, 1.0))), 0u, 0u);
+  uvec4 centre = uvec4(floatBitsToUint(giGBufferIsGeometry(gTexel) ? izG : 0.0),
+                       packNormal(giGBufferNormal(gTexel)), 0u, 0u);
 #else
   uvec4 centre = texelFetch(gSurface, p, 0);
 #endif

@@ -32,7 +32,8 @@ layout(set = 0, binding = 2) uniform sampler2D gDepth;
 #define GI_SHADOW_MAPS_BINDING 5
 #include "lights.glsl"
 layout(set = 0, binding = 6, rgba8) uniform writeonly image2D outContact;
-layout(set = 0, binding = 7) uniform sampler2D gNormal;
+#define GI_GBUFFER_BINDING 7
+#include "gbuffer.glsl"  // the packed G-buffer (normals)
 
 // 1 / view distance at pixel t from the reverse-Z depth ((d + P22) / P32, affine in d);
 // guards: sky, pixels without geometry and a degenerate projection read 0 (never in front).
@@ -78,8 +79,8 @@ void main() {
   if (p.x >= size.x || p.y >= size.y) return;
   mat4 proj = frame.proj;
   float p22 = proj[2][2], p32 = proj[3][2];
-  vec4 normalTexel = texelFetch(gNormal, p, 0);
-  float iz = normalTexel.w > 0.5 ? inverseDepthAt(p, p22, p32) : 0.0;
+  uvec4 g = giGBufferLoad(p);
+  float iz = giGBufferIsGeometry(g) ? inverseDepthAt(p, p22, p32) : 0.0;
   float p00 = abs(proj[0][0]) > 1e-30 ? proj[0][0] : 1e-30;
   float p11 = abs(proj[1][1]) > 1e-30 ? proj[1][1] : 1e-30;
   float p20 = proj[2][0], p21 = proj[2][1];
@@ -87,7 +88,7 @@ void main() {
   // Guard: sky pixels (1 / z = 0) are left open (the loop still runs masked on llvmpipe).
   bool geometry = iz > 0.0;
   vec3 P = ssdoViewPosition(vec2(p) + 0.5, max(iz, 1e-30), invSize, p00, p11, p20, p21);
-  vec3 N = safeNormalize(normalTexel.xyz, vec3(0.0, 0.0, 1.0));
+  vec3 N = giGBufferNormal(g);
 
   vec4 result = vec4(1.0);
   int shadowed = 0;
@@ -112,7 +113,7 @@ void main() {
       vec3 S = ssdoViewPosition(vec2(t) + 0.5, max(iS, 1e-30), invSize, p00, p11, p20, p21);
       float zS = -S.z;
       bool inFront = iS > 0.0 && zS < w && w - zS < kRangeScale * b;
-      bool behindPlane = dot(texelFetch(gNormal, t, 0).xyz, Q - S) < -kPlaneEpsilon * w;
+      bool behindPlane = dot(giGBufferNormal(t), Q - S) < -kPlaneEpsilon * w;
       blocked += valid && inFront && behindPlane ? 1.0 : 0.0;
     }
     result[shadowed] = 1.0 - blocked / float(kSamples);

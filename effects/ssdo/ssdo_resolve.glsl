@@ -7,8 +7,8 @@
 #include "ssdo_blur.glsl"
 layout(set = 0, binding = 5, rgba16f) uniform writeonly image2D outAmbient;
 #ifdef SSDO_RESOLVE_INDIRECT
-layout(set = 0, binding = 3) uniform sampler2D gAlbedo;
-layout(set = 0, binding = 4) uniform sampler2D gMaterial;
+#define GI_GBUFFER_BINDING 3
+#include "gbuffer.glsl"  // the packed G-buffer (albedo, metallic)
 layout(set = 0, binding = 6, rgba16f) uniform writeonly image2D outIndirect;
 #endif
 
@@ -22,7 +22,8 @@ void main() {
   // Guard: half floats overflow above 65504.
   imageStore(outAmbient, p, vec4(min(direct, vec3(65000.0)), 2.0));
 #ifdef SSDO_RESOLVE_INDIRECT
-  vec3 diffuse = texelFetch(gAlbedo, p, 0).rgb * (1.0 - texelFetch(gMaterial, p, 0).g);
+  uvec4 g = giGBufferLoad(p);
+  vec3 diffuse = giGBufferAlbedo(g) * (1.0 - giGBufferMetallic(g));
   imageStore(outIndirect, p, vec4(min(diffuse * bounce, vec3(65000.0)), 1.0));
 #endif
 }

@@ -31,15 +31,14 @@ layout(constant_id = 6) const bool kContactInput = false;
 
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 #include "ssdo_common.glsl"
-layout(set = 0, binding = 2) uniform sampler2D gDepth;
-layout(set = 0, binding = 3) uniform sampler2D gNormal;
-layout(set = 0, binding = 4) uniform sampler2D gAlbedo;
-layout(set = 0, binding = 5) uniform sampler2D gMaterial;
-layout(set = 0, binding = 6) uniform sampler2D gEmission;
+// Bindings 2-6: gi::LitSurfaceInputs (the main view's G-buffer, or a camera's).
+#define GI_DEPTH_BINDING 2
+#define GI_GBUFFER_BINDING 3
+#include "gbuffer.glsl"
 #define GI_LIGHTS_SET 0
-#define GI_LIGHTS_BINDING 7
-#define GI_SHADOW_VIEWS_BINDING 8
-#define GI_SHADOW_MAPS_BINDING 9
+#define GI_LIGHTS_BINDING 4
+#define GI_SHADOW_VIEWS_BINDING 5
+#define GI_SHADOW_MAPS_BINDING 6
 #include "lights.glsl"
 layout(set = 0, binding = 10, rgba32ui) uniform writeonly uimage2D outSurface;
 layout(set = 0, binding = 11) uniform sampler2D gLayer1;  // the peeled layer (kLayers 2)
@@ -51,26 +50,27 @@ void main() {
   ivec2 size = ivec2(frame.viewport.xy);
   if (p.x >= size.x || p.y >= size.y) return;
 
-  float depth = texelFetch(gDepth, p, 0).r;
-  vec4 normalTexel = texelFetch(gNormal, p, 0);
+  float depth = giGBufferDepth(p);
+  uvec4 g = giGBufferLoad(p);
   float p22 = frame.proj[2][2], p32 = frame.proj[3][2];
   // Reverse-Z depth to 1 / view distance: (d + P22) / P32 (affine in d). Guards: sky and
   // pixels without geometry read 0 (never an occluder); a degenerate projection gives 0.
   float iz = abs(p32) > 1e-30 ? (depth + p22) / p32 : 0.0;
-  bool geometry = !isSky(depth) && normalTexel.w > 0.5 && iz > 0.0 && !isinf(iz);
+  bool geometry = !isSky(depth) && giGBufferIsGeometry(g) && iz > 0.0 && !isinf(iz);
   iz = geometry ? iz : 0.0;
-  vec3 n = safeNormalize(normalTexel.xyz, vec3(0.0, 0.0, 1.0));
+  vec3 n = giGBufferNormal(g);
 
   vec3 radiance = vec3(0.0);
   if (kBounce) {
     vec2 uv = (vec2(p) + 0.5) * frame.viewport.zw;
     vec3 pos = viewPositionFromDepth(frame.invProj, uv, depth);
-    vec3 albedo = texelFetch(gAlbedo, p, 0).rgb;
-    vec2 rm = texelFetch(gMaterial, p, 0).rg;
-    vec3 diffuse = albedo * (1.0 - rm.y);
+    vec3 albedo = giGBufferAlbedo(g);
+    float metallic = giGBufferMetallic(g);
+    vec3 diffuse = albedo * (1.0 - metallic);
     vec4 contact = kContactInput ? texelFetch(gContact, p, 0) : vec4(1.0);
     LightSum lightSum = sumLights(pos, n, safeNormalize(-pos, vec3(0.0, 0.0, 1.0)),
-                                  mix(vec3(0.04), albedo, rm.y), shininessOf(rm.x), contact,
+                                  mix(vec3(0.04), albedo, metallic),
+                                  shininessOf(giGBufferRoughness(g)), contact,
                                   kContactInput);
     vec3 diffuseDirect = diffuse * lightSum.irradiance * (1.0 / 3.14159265358979);
     if (kDirectOut) {
@@ -82,7 +82,7 @@ void main() {
       imageStore(outDirect, p, vec4(direct, 1.0));
     }
     vec3 nWorld = mat3(frame.invView) * n;
-    radiance = texelFetch(gEmission, p, 0).rgb + diffuseDirect + diffuse * ssdoIrradianceOverPi(nWorld);
+    radiance = giGBufferEmission(g) + diffuseDirect + diffuse * ssdoIrradianceOverPi(nWorld);
     // Guard: half floats overflow to inf above 65504; non-finite inputs read 0.
     radiance = geometry ? clamp(radiance, vec3(0.0), vec3(65000.0)) : vec3(0.0);
     radiance = vec3(isnan(radiance.r) ? 0.0 : radiance.r, isnan(radiance.g) ? 0.0 : radiance.g,

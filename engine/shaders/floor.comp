@@ -6,12 +6,12 @@
 // time as a ratio to this pass measured in the same run.
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
-layout(set = 0, binding = 1) uniform sampler2D gNormal;
+layout(set = 0, binding = 1) uniform usampler2D gPacked;  // the packed G-buffer
 layout(set = 0, binding = 2, rgba8) uniform writeonly image2D outFloor;
 
 void main() {
   ivec2 p = ivec2(gl_GlobalInvocationID.xy);
   if (p.x >= int(frame.viewport.x) || p.y >= int(frame.viewport.y)) return;
-  vec3 n = texelFetch(gNormal, p, 0).xyz;
-  imageStore(outFloor, p, vec4(n * 0.5 + 0.5, 1.0));
+  // The texel's bits as they are (decoding is the readers' work, not the floor's).
+  imageStore(outFloor, p, unpackUnorm4x8(texelFetch(gPacked, p, 0).y));
 }

@@ -2,6 +2,7 @@
 #extension GL_GOOGLE_include_directive : require
 #include "common.glsl"
 #include "material.glsl"
+#include "gbuffer.glsl"
 
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 // The draw's base-colour texture (lavapipe has no descriptor indexing: one set per material).
@@ -12,11 +13,9 @@ layout(location = 1) in vec2 inUV;
 layout(location = 2) in vec4 inPrevClip;
 layout(location = 3) in vec3 inViewPos;
 
-layout(location = 0) out vec4 outNormal;    // view-space normal, w = 1 marks geometry
-layout(location = 1) out vec4 outAlbedo;    // sRGB target: stored encoded, read back linear
-layout(location = 2) out vec4 outMaterial;  // roughness, metallic
-layout(location = 3) out vec4 outEmission;  // linear radiance
-layout(location = 4) out vec2 outMotion;    // current minus previous position, in UV units
+// The packed G-buffer (gbuffer.glsl, gi/gbuffer.h).
+layout(location = 0) out uvec4 outGBuffer;  // normal, albedo + roughness, metallic + flags, emission
+layout(location = 1) out vec2 outMotion;    // current minus previous position, in UV units
 
 void main() {
   vec4 albedo = material.baseColor;
@@ -35,10 +34,8 @@ void main() {
   vec3 n = safeNormalize(inViewNormal, faceN);
   if (dot(n, faceN) < 0.0) n = -n;
 
-  outNormal = vec4(n, 1.0);
-  outAlbedo = vec4(clamp(albedo.rgb, 0.0, 1.0), 1.0);
-  outMaterial = vec4(material.params.xy, 0.0, 1.0);
-  outEmission = material.emission;
+  outGBuffer = giGBufferEncode(n, albedo.rgb, material.params.x, material.params.y,
+                               material.emission.rgb);
   // This pixel's centre in NDC (what the interpolated clip position divided by w gives).
   vec2 cur = gl_FragCoord.xy * frame.viewport.zw * 2.0 - 1.0;
   vec2 prev = inPrevClip.w > 0.0 ? inPrevClip.xy / inPrevClip.w : cur;

@@ -36,24 +36,23 @@ layout(constant_id = 8) const int kDirectInput = 0;
 #define GI_PCF_RADIUS kPcfRadius
 
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
-layout(set = 0, binding = 1) uniform sampler2D gDepth;
-layout(set = 0, binding = 2) uniform sampler2D gNormal;
-layout(set = 0, binding = 3) uniform sampler2D gAlbedo;
-layout(set = 0, binding = 4) uniform sampler2D gMaterial;
-layout(set = 0, binding = 5) uniform sampler2D gEmission;
+// Bindings 1-5: gi::LitSurfaceInputs (the G-buffer, the lights, the shadow maps).
+#define GI_DEPTH_BINDING 1
+#define GI_GBUFFER_BINDING 2
+#include "gbuffer.glsl"
 #define GI_LIGHTS_SET 0
-#define GI_LIGHTS_BINDING 6
-#define GI_SHADOW_VIEWS_BINDING 7
-#define GI_SHADOW_MAPS_BINDING 8
+#define GI_LIGHTS_BINDING 3
+#define GI_SHADOW_VIEWS_BINDING 4
+#define GI_SHADOW_MAPS_BINDING 5
 #include "lights.glsl"
-layout(set = 0, binding = 9, rgba16f) uniform writeonly image2D outLit;
-layout(set = 0, binding = 10) uniform sampler2D aoTexture;        // linear, any size
-layout(set = 0, binding = 11) uniform sampler2D ambientTexture;   // linear, any size
-layout(set = 0, binding = 12) uniform sampler2D indirectTexture;  // linear, any size
+layout(set = 0, binding = 6, rgba16f) uniform writeonly image2D outLit;
+layout(set = 0, binding = 7) uniform sampler2D aoTexture;       // linear, any size
+layout(set = 0, binding = 8) uniform sampler2D ambientTexture;  // linear, any size
+layout(set = 0, binding = 9) uniform sampler2D indirectTexture;  // linear, any size
 // Equirect environment map (kind 2; a 1x1 dummy otherwise).
-layout(set = 0, binding = 13) uniform sampler2D environmentMap;
-layout(set = 0, binding = 14) uniform sampler2D contactTexture;  // linear, any size
-layout(set = 0, binding = 15) uniform sampler2D directTexture;   // linear, any size
+layout(set = 0, binding = 10) uniform sampler2D environmentMap;
+layout(set = 0, binding = 11) uniform sampler2D contactTexture;  // linear, any size
+layout(set = 0, binding = 12) uniform sampler2D directTexture;   // linear, any size
 
 const float PI = 3.14159265358979;
 
@@ -66,7 +65,7 @@ void main() {
   ivec2 size = ivec2(frame.viewport.xy);
   if (p.x >= size.x || p.y >= size.y) return;
   vec2 uv = (vec2(p) + 0.5) * frame.viewport.zw;
-  float depth = texelFetch(gDepth, p, 0).r;
+  float depth = giGBufferDepth(p);
 
   if (isSky(depth)) {
     vec3 viewDirWorld = safeNormalize(
@@ -82,11 +81,11 @@ void main() {
     return;
   }
   vec3 pos = viewPositionFromDepth(frame.invProj, uv, depth);
-  vec3 n = safeNormalize(texelFetch(gNormal, p, 0).xyz, vec3(0, 0, 1));
-  vec3 albedo = texelFetch(gAlbedo, p, 0).rgb;
-  vec2 rm = texelFetch(gMaterial, p, 0).rg;
-  vec3 emission = texelFetch(gEmission, p, 0).rgb;
-  float metallic = rm.y;
+  uvec4 g = giGBufferLoad(p);  // the whole surface in one fetch
+  vec3 n = giGBufferNormal(g);
+  vec3 albedo = giGBufferAlbedo(g);
+  vec3 emission = giGBufferEmission(g);
+  float metallic = giGBufferMetallic(g);
   vec3 v = safeNormalize(-pos, vec3(0, 0, 1));
   vec3 diffuseColor = albedo * (1.0 - metallic);
 
@@ -97,7 +96,7 @@ void main() {
     vec4 contact =
         kContactInput != 0 ? optionalInput(contactTexture, kContactInput, p, uv) : vec4(1.0);
     LightSum lightSum = sumLights(pos, n, v, mix(vec3(0.04), albedo, metallic),
-                                  shininessOf(rm.x), contact, kContactInput != 0);
+                                  shininessOf(giGBufferRoughness(g)), contact, kContactInput != 0);
     color += diffuseColor * lightSum.irradiance * (1.0 / PI) + lightSum.specular;
   }
   vec4 ambient = kAmbientInput != 0 ? optionalInput(ambientTexture, kAmbientInput, p, uv) : vec4(0.0);

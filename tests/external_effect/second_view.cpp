@@ -4,7 +4,7 @@
 // main G-buffer's depth), and a reflective shadow map of the first light seen from above.
 // A second pass computes the irradiance from the engine's lights, shadow maps and environment
 // with lights.glsl and environment.glsl ("second_view_irradiance").
-// Publishes "second_view_depth", "second_view_gdepth", "second_view_normal",
+// Publishes "second_view_depth", "second_view_gdepth", "second_view_gbuffer",
 // "second_view_flux" and "second_view_irradiance"; run_test.sh compares them with the main
 // G-buffer. Settings pick what is drawn and the views' size relative to the output
 // (tools/bench-core times a quarter-size G-buffer with it; the engine's build also has it in
@@ -30,14 +30,14 @@ class SecondViewEffect : public gi::Effect {
     i.description = "the scene drawn again from an extra view and a light (engine services)";
     i.stage = gi::EffectStage::BeforeLighting;
     i.reads = {gi::resources::kDepth,
-               gi::resources::kNormal,
+               gi::resources::kGBuffer,
                gi::resources::kLights,
                gi::resources::kShadowViews,
                gi::resources::kShadowMaps,
                gi::resources::kEnvironmentMap,
                gi::resources::kEnvironmentSampling};
-    i.writes = {"second_view_depth", "second_view_gdepth", "second_view_normal", "second_view_flux",
-                "second_view_irradiance"};
+    i.writes = {"second_view_depth", "second_view_gdepth", "second_view_gbuffer",
+                "second_view_flux", "second_view_irradiance"};
     i.debugView = "second_view_depth";
     return i;
   }
@@ -80,7 +80,7 @@ class SecondViewEffect : public gi::Effect {
                  const gi::SettingValues& settings) override {
     struct Io {
       gi::TextureHandle depth, gdepth, flux, rsmDepth;
-      std::array<gi::TextureHandle, 5> gbuffer;
+      std::vector<gi::TextureHandle> gbuffer;  // sceneColorFormats(GBuffer) order
       std::array<gi::TextureHandle, 2> rsm;
     };
     auto io = std::make_shared<Io>();
@@ -103,11 +103,11 @@ class SecondViewEffect : public gi::Effect {
               target("second_view_depth", gi::kSceneDepthFormat, gi::TextureUsage::DepthAttachment);
           io->gdepth = target("second_view_gdepth", gi::kSceneDepthFormat,
                               gi::TextureUsage::DepthAttachment);
-          io->gbuffer[0] =
-              target("second_view_normal", gformats[0], gi::TextureUsage::ColorAttachment);
+          io->gbuffer.push_back(
+              target("second_view_gbuffer", gformats[0], gi::TextureUsage::ColorAttachment));
           for (size_t i = 1; i < gformats.size(); ++i)
-            io->gbuffer[i] = target(("second_view_g" + std::to_string(i)).c_str(), gformats[i],
-                                    gi::TextureUsage::ColorAttachment);
+            io->gbuffer.push_back(target(("second_view_g" + std::to_string(i)).c_str(), gformats[i],
+                                         gi::TextureUsage::ColorAttachment));
           rsmDesc.format = gi::kSceneDepthFormat;
           io->rsmDepth = b.write(b.create("second_view_rsm_depth", rsmDesc),
                                  gi::TextureUsage::DepthAttachment);
@@ -145,7 +145,7 @@ class SecondViewEffect : public gi::Effect {
     gi::Blackboard& bb = graph.blackboard();
     bb.put("second_view_depth", io->depth);
     bb.put("second_view_gdepth", io->gdepth);
-    bb.put("second_view_normal", io->gbuffer[0]);
+    bb.put("second_view_gbuffer", io->gbuffer[0]);
     bb.put("second_view_flux", io->flux);
     addIrradiancePass(graph, ctx);
   }
@@ -155,7 +155,7 @@ class SecondViewEffect : public gi::Effect {
   void addIrradiancePass(gi::FrameGraph& graph, gi::EffectContext& ctx) {
     namespace res = gi::resources;
     struct Io {
-      gi::TextureHandle depth, normal, shadowMaps, environment, out;
+      gi::TextureHandle depth, gbuffer, shadowMaps, environment, out;
       gi::BufferHandle lights, shadowViews, sampling;
     };
     auto io = std::make_shared<Io>();
@@ -164,7 +164,7 @@ class SecondViewEffect : public gi::Effect {
         "second_view_irradiance",
         [&](gi::PassBuilder& b) {
           io->depth = b.read(bb.texture(res::kDepth));
-          io->normal = b.read(bb.texture(res::kNormal));
+          io->gbuffer = b.read(bb.texture(res::kGBuffer));
           io->lights = b.read(bb.buffer(res::kLights));
           io->shadowViews = b.read(bb.buffer(res::kShadowViews));
           io->shadowMaps = b.read(bb.texture(res::kShadowMaps));
@@ -179,7 +179,7 @@ class SecondViewEffect : public gi::Effect {
           gi::vk::DescriptorWriter w;
           w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame)
               .sampled(1, pc.view(io->depth), nearest)
-              .sampled(2, pc.view(io->normal), nearest)
+              .sampled(2, pc.view(io->gbuffer), nearest)
               .buffer(3, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, pc.buffer(io->lights))
               .buffer(4, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, pc.buffer(io->shadowViews))
               .sampled(5, pc.view(io->shadowMaps), nearest)

@@ -9,7 +9,8 @@
 layout(local_size_x = 16, local_size_y = 16) in;
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 layout(set = 0, binding = 1) uniform sampler2D gDepth;
-layout(set = 0, binding = 2) uniform sampler2D gNormal;
+#define GI_GBUFFER_BINDING 2
+#include "gbuffer.glsl"
 #define GI_LIGHTS_SET 0
 #define GI_LIGHTS_BINDING 3
 #define GI_SHADOW_VIEWS_BINDING 4
@@ -31,7 +32,7 @@ void main() {
   }
   vec2 uv = (vec2(p) + 0.5) * frame.viewport.zw;
   vec3 pos = viewPositionFromDepth(frame.invProj, uv, depth);
-  vec3 n = safeNormalize(texelFetch(gNormal, p, 0).xyz, vec3(0, 0, 1));
+  vec3 n = giGBufferNormal(p);
   vec3 e = vec3(0.0);
   for (int i = 0; i < lightCount(); ++i) {
     vec3 l;

@@ -26,6 +26,7 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size);
 // Present only under a sanitizer: called before the process dies of a report.
+// NOLINTNEXTLINE(bugprone-reserved-identifier): the sanitizer runtime's own name
 extern "C" void __sanitizer_set_death_callback(void (*callback)()) __attribute__((weak));
 
 namespace {
@@ -156,6 +157,7 @@ int main(int argc, char** argv) {
   }
   std::sort(files.begin(), files.end());
   std::vector<Bytes> inputs;
+  inputs.reserve(files.size());
   for (const fs::path& f : files) inputs.push_back(readFile(f));
 
   std::snprintf(gFindingPath, sizeof gFindingPath, "%s/gi-fuzz-finding-%d.bin",

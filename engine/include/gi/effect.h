@@ -21,7 +21,8 @@
 // way that breaks compiled modules; the registry refuses modules built against another value.
 // 8: GpuScene::drawDepthFromBuffer (a new virtual: the vtable moved).
 // 9: DepthAwareBlur gained its reduced-resolution upsample (its layout grew).
-#define GI_EFFECT_ABI_VERSION 9u
+// 10: the packed G-buffer ("gbuffer", gbuffer.glsl); LitSurfaceInputs reads depth + gbuffer.
+#define GI_EFFECT_ABI_VERSION 10u
 
 namespace gi {
 
@@ -31,12 +32,17 @@ class Context;
 
 // Well-known frame-graph resources, shared through the blackboard by these names.
 namespace resources {
-inline constexpr const char* kDepth = "depth";        // D32 reverse-Z (1 near, 0 far/sky)
-inline constexpr const char* kNormal = "normal";      // RGBA16F view-space normal, w=1 geometry
-inline constexpr const char* kAlbedo = "albedo";      // RGBA8 sRGB
-inline constexpr const char* kMaterial = "material";  // RGBA8 roughness, metallic
-inline constexpr const char* kEmission = "emission";  // RGBA16F linear radiance
-inline constexpr const char* kMotion = "motion";      // RG16F current - previous, UV units
+inline constexpr const char* kDepth = "depth";  // D32 reverse-Z (1 near, 0 far/sky)
+// RGBA32UI packed normal, albedo, roughness, metallic, emission, geometry flag: read it through
+// gbuffer.glsl (giGBufferLoad, giGBufferNormal, ...), never by its bits (gi/gbuffer.h).
+inline constexpr const char* kGBuffer = "gbuffer";
+inline constexpr const char* kMotion = "motion";  // RG16F current - previous, UV units
+// The G-buffer's channels unpacked to RGBA32F, each by its own pass that runs only when the
+// channel is viewed or read back (and for effects that have not moved to gbuffer.glsl).
+inline constexpr const char* kNormal = "normal";      // view-space normal, w = 1 on geometry
+inline constexpr const char* kAlbedo = "albedo";      // linear albedo, w = 1
+inline constexpr const char* kMaterial = "material";  // roughness, metallic, 0, 1
+inline constexpr const char* kEmission = "emission";  // linear radiance, w = 1
 inline constexpr const char* kLit = "lit";            // RGBA16F lit image (linear HDR radiance)
 // Optional inputs of the lighting pass (neutral when no effect publishes them; sample them with
 // normalized coordinates: the neutral stand-in is 1x1). See "Lighting composition" in

@@ -70,7 +70,7 @@ struct SceneView {
 // What a draw writes: the colour attachments in sceneColorFormats() order, plus D32 depth.
 enum class SceneOutputs {
   Depth,    // depth only (reverse-Z: 1 at near, cleared 0 = nothing)
-  GBuffer,  // normal, albedo, material, emission, motion: the main G-buffer's set
+  GBuffer,  // the packed G-buffer and motion (gi/gbuffer.h, gbuffer.glsl): the main view's set
   // RGBA32F world position (w 1: geometry), RGBA16F world normal, RGBA32F reflected flux (W)
   ReflectiveShadowMap,
 };

@@ -120,7 +120,9 @@ class Renderer {
 
   ImageRGBA8 readOutput();                           // tonemapped 8-bit image (view "output")
   ImageRGBA32F readTarget(const std::string& name);  // any produced resource as float RGBA
-  std::vector<std::string> viewNames() const;        // images that can be viewed / read
+  // Its texels as stored, tightly packed rows (e.g. the packed "gbuffer", gi/gbuffer.h).
+  std::vector<uint8_t> readTargetBytes(const std::string& name);
+  std::vector<std::string> viewNames() const;  // images that can be viewed / read
   // Every texture the last frame's graph used (G-buffer, effects' transients, history,
   // fallbacks, imports), mip 0 / layer 0. `image` holds float RGBA for formats readTarget
   // reads; other formats (packed integer texels) come back with `decoded` false and no pixels.

@@ -550,6 +550,15 @@ bool FrameGraph::intactAtEnd(TextureHandle h) const {
   return true;
 }
 
+VkFormat FrameGraph::textureFormat(TextureHandle h) const {
+  return resource(h.id).textureDesc.format;
+}
+
+bool FrameGraph::produced(TextureHandle h) const {
+  const Resource& r = resource(h.id);
+  return r.texture && r.image;
+}
+
 FrameGraph::TextureState FrameGraph::textureState(TextureHandle h) const {
   const Resource& r = resource(h.id);
   if (!r.texture || !r.image)

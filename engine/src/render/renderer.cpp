@@ -13,6 +13,7 @@
 #include "gi/effect.h"
 #include "gi/environment.h"
 #include "gi/errors.h"
+#include "gi/gbuffer.h"
 #include "gi/graph/frame_graph.h"
 #include "gi/vk/common.h"
 #include "gi/vk/gpu_timer.h"
@@ -186,7 +187,7 @@ struct Renderer::Impl : EffectContext {
                                 output, noShadows, nearestClamp.handle(), linearClamp.handle()});
     ctx.requireWorkgroup(256, 1, "skinning / surface points");  // local_size_x 256
     skinningPass = makeSkinningPass(*state);
-    gbufferPass = makeGBufferPass();
+    gbufferPass = makeGBufferPass(*state);
     surfacePointsPass = makeSurfacePointsPass(*state);
     shadowPass = makeShadowPass(*state);
     lightingPass = makeLightingPass(*state);
@@ -828,8 +829,27 @@ void Renderer::setCameraOverride(const std::optional<CameraView>& camera) {
   impl_->updateLights();
 }
 ImageRGBA32F Renderer::readTarget(const std::string& name) {
+  // An unpacked G-buffer channel nothing read this frame (its pass was culled): unpacked here
+  // from the packed texels, as the pass would have.
+  for (size_t c = 0; c < gbuffer::kChannels.size(); ++c) {
+    const Blackboard& bb = impl_->graph.blackboard();
+    if (name != gbuffer::kChannels[c] || !bb.has(name) || impl_->graph.produced(bb.texture(name)))
+      continue;
+    if (!impl_->graph.intactAtEnd(bb.texture(res::kGBuffer)))
+      throw Error(ErrorKind::Usage, "",
+                  "'" + name +
+                      "' was not unpacked this frame and the packed G-buffer's memory "
+                      "was reused (frame-graph aliasing); list '" +
+                      name + "' in RenderSettings::keepForReadback");
+    const FrameGraph::TextureState packed = impl_->stateOf(res::kGBuffer);
+    return gbuffer::unpackChannel(readTexels(impl_->ctx, packed), int(packed.extent.width),
+                                  int(packed.extent.height), c);
+  }
   const FrameGraph::TextureState t = impl_->stateOf(name);
   return texelsToFloat(readTexels(impl_->ctx, t), t, name);
+}
+std::vector<uint8_t> Renderer::readTargetBytes(const std::string& name) {
+  return readTexels(impl_->ctx, impl_->stateOf(name));
 }
 std::vector<Renderer::NamedTexture> Renderer::readAllTextures() {
   std::vector<NamedTexture> out;
@@ -844,10 +864,13 @@ std::vector<Renderer::NamedTexture> Renderer::readAllTextures() {
   return out;
 }
 std::vector<std::string> Renderer::viewNames() const {
-  // Images only: a buffer (lights, sampling tables) can be neither shown nor read back.
+  // Images of float or normalized texels only: a buffer (lights, sampling tables) or packed
+  // integer texels (the "gbuffer", whose channels are views of their own) cannot be shown.
   std::vector<std::string> names;
-  for (const std::string& n : impl_->graph.blackboard().names())
-    if (impl_->graph.blackboard().texture(n).valid()) names.push_back(n);
+  const Blackboard& bb = impl_->graph.blackboard();
+  for (const std::string& n : bb.names())
+    if (bb.texture(n).valid() && canDecode(impl_->graph.textureFormat(bb.texture(n))))
+      names.push_back(n);
   return names;
 }
 VkImage Renderer::outputImage() const {

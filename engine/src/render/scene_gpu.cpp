@@ -10,6 +10,7 @@
 
 #include "gi/animation.h"
 #include "gi/errors.h"
+#include "gi/gbuffer.h"
 #include "gi/vk/common.h"
 
 namespace gi {
@@ -119,8 +120,7 @@ std::vector<VkFormat> sceneColorFormats(SceneOutputs outputs) {
     case SceneOutputs::Depth:
       return {};
     case SceneOutputs::GBuffer:
-      return {VK_FORMAT_R16G16B16A16_SFLOAT, VK_FORMAT_R8G8B8A8_SRGB, VK_FORMAT_R8G8B8A8_UNORM,
-              VK_FORMAT_R16G16B16A16_SFLOAT, VK_FORMAT_R16G16_SFLOAT};
+      return {gbuffer::kPackedFormat, gbuffer::kMotionFormat};
     case SceneOutputs::ReflectiveShadowMap:
       // Flux in 32-bit floats: a texel of a large map carries a tiny share of the light's
       // power, which half floats would round to subnormals.
@@ -558,7 +558,7 @@ void SceneGpu::pushDraw(VkCommandBuffer cmd, const Pipeline& p, const SceneDrawI
 
 void SceneGpu::drawGBuffer(PassContext& pc, const SceneTargets& t, VkBuffer viewUniforms) {
   VkCommandBuffer c = pc.cmd();
-  beginRendering(pc, t, 5);
+  beginRendering(pc, t, sceneColorFormats(SceneOutputs::GBuffer).size());
   VkViewport viewport{0, 0, float(t.extent.width), float(t.extent.height), 0.0f, 1.0f};
   VkRect2D scissor{{0, 0}, t.extent};
   vkCmdSetViewport(c, 0, 1, &viewport);
@@ -657,7 +657,7 @@ void SceneGpu::drawDepthPeeled(PassContext& pc, const SceneTargets& t,
 void SceneGpu::drawRsm(PassContext& pc, const SceneTargets& t, const SceneView& view,
                        const LightInfo& light) {
   VkCommandBuffer c = pc.cmd();
-  beginRendering(pc, t, 3);
+  beginRendering(pc, t, sceneColorFormats(SceneOutputs::ReflectiveShadowMap).size());
   const VkDescriptorBufferInfo slot = viewSlot(view, &light, t.extent);
   setViewport(c, view, t.extent);
   if (!draws_.empty()) {

@@ -74,11 +74,14 @@ uint32_t formatBytesPerPixel(VkFormat f) {
     case VK_FORMAT_R32_SFLOAT:
     case VK_FORMAT_D32_SFLOAT:
     case VK_FORMAT_R16G16_SFLOAT:
+    case VK_FORMAT_R32_UINT:
       return 4;
     case VK_FORMAT_R16G16B16A16_SFLOAT:
     case VK_FORMAT_R32G32_SFLOAT:
+    case VK_FORMAT_R32G32_UINT:
       return 8;
     case VK_FORMAT_R32G32B32A32_SFLOAT:
+    case VK_FORMAT_R32G32B32A32_UINT:
       return 16;
     default:
       throw Error(ErrorKind::Unsupported, "",

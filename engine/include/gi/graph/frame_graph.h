@@ -167,6 +167,9 @@ class FrameGraph {
   // (aliasing), so after execute() it no longer holds its own contents. Outputs, imported and
   // persistent textures are always intact.
   bool intactAtEnd(TextureHandle h) const;
+  // After compile(): whether the texture exists this frame (false: its passes were culled).
+  bool produced(TextureHandle h) const;
+  VkFormat textureFormat(TextureHandle h) const;  // as declared
 
   Blackboard& blackboard() { return blackboard_; }
   VkExtent2D outputExtent() const { return outputExtent_; }

@@ -33,7 +33,7 @@ struct EngineState {
 };
 
 std::unique_ptr<Effect> makeSkinningPass(EngineState& state);
-std::unique_ptr<Effect> makeGBufferPass();
+std::unique_ptr<Effect> makeGBufferPass(EngineState& state);
 std::unique_ptr<Effect> makeSurfacePointsPass(EngineState& state);
 std::unique_ptr<Effect> makeShadowPass(EngineState& state);
 std::unique_ptr<Effect> makeLightingPass(EngineState& state);

@@ -16,7 +16,7 @@ class FloorPass final : public Effect {
   explicit FloorPass(EngineState& s) : s_(s) {}
   EffectInfo info() const override {
     EffectInfo i{"floor", "1", "cost floor: one G-buffer read and one 8-bit write per pixel"};
-    i.reads = {res::kNormal};
+    i.reads = {res::kGBuffer};
     i.writes = {res::kFloor};
     return i;
   }
@@ -30,7 +30,7 @@ class FloorPass final : public Effect {
     graph.addPass(
         "floor",
         [&](PassBuilder& b) {
-          io->first = b.read(graph.blackboard().texture(res::kNormal));
+          io->first = b.read(graph.blackboard().texture(res::kGBuffer));
           io->second = b.write(b.create(res::kFloor, TextureDesc{VK_FORMAT_R8G8B8A8_UNORM}),
                                TextureUsage::StorageWrite);
         },

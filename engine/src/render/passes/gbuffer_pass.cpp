@@ -1,7 +1,10 @@
-// "gbuffer": the main camera's G-buffer, drawn through the public GpuScene service exactly as
-// an effect would draw it from another view.
+// "gbuffer": the main camera's packed G-buffer (gi/gbuffer.h, gbuffer.glsl), drawn through the
+// public GpuScene service exactly as an effect would draw it from another view; and, for views
+// and read-backs, one small pass per unpacked channel ("gbuffer_normal", ...), which the frame
+// graph culls unless that channel is asked for.
 #include <array>
 
+#include "gi/gbuffer.h"
 #include "render/passes/builtin_passes.h"
 
 namespace gi {
@@ -11,53 +14,84 @@ namespace res = resources;
 
 class GBufferPass final : public Effect {
  public:
+  explicit GBufferPass(EngineState& s) : s_(s) {}
   EffectInfo info() const override {
-    EffectInfo i{"gbuffer", "1",
-                 "depth, normal, albedo, material, emission and motion of the main view"};
-    i.writes = {res::kDepth,    res::kNormal,   res::kAlbedo,
-                res::kMaterial, res::kEmission, res::kMotion};
+    EffectInfo i{"gbuffer", "2",
+                 "depth, the packed G-buffer (normal, albedo, material, emission) and motion of "
+                 "the main view"};
+    i.writes = {res::kDepth, res::kGBuffer, res::kMotion};
+    for (const char* channel : gbuffer::kChannels) i.writes.push_back(channel);
     return i;
   }
   std::vector<SettingDesc> settings() const override { return {}; }
   void prepare(EffectContext&, const SettingValues&) override {}
   void addPasses(FrameGraph& graph, EffectContext& ctx, const SettingValues&) override {
-    // Order of the attachments = sceneColorFormats(SceneOutputs::GBuffer).
-    static constexpr std::array<const char*, 5> kColors = {
-        res::kNormal, res::kAlbedo, res::kMaterial, res::kEmission, res::kMotion};
     struct Io {
-      TextureHandle depth;
-      std::array<TextureHandle, 5> colors;
+      TextureHandle depth, packed, motion;
     };
     auto io = std::make_shared<Io>();
     GpuScene& scene = ctx.scene();
     const VkBuffer frame = ctx.frameUniforms();
-    const std::vector<VkFormat> formats = sceneColorFormats(SceneOutputs::GBuffer);
     graph.addPass(
         "gbuffer",
         [&](PassBuilder& b) {
           scene.declareRead(b);
           io->depth = b.write(b.create(res::kDepth, TextureDesc{kSceneDepthFormat}),
                               TextureUsage::DepthAttachment);
-          for (size_t i = 0; i < kColors.size(); ++i)
-            io->colors[i] = b.write(b.create(kColors[i], TextureDesc{formats[i]}),
-                                    TextureUsage::ColorAttachment);
+          io->packed = b.write(b.create(res::kGBuffer, TextureDesc{gbuffer::kPackedFormat}),
+                               TextureUsage::ColorAttachment);
+          io->motion = b.write(b.create(res::kMotion, TextureDesc{gbuffer::kMotionFormat}),
+                               TextureUsage::ColorAttachment);
         },
         [io, &scene, frame](PassContext& pc) {
           SceneTargets t;
           t.depth = pc.view(io->depth);
-          for (TextureHandle h : io->colors) t.colors.push_back(pc.view(h));
+          t.colors = {pc.view(io->packed), pc.view(io->motion)};  // sceneColorFormats order
           t.extent = pc.extent(io->depth);
           scene.drawGBuffer(pc, t, frame);
         });
-    graph.blackboard().put(res::kDepth, io->depth);
-    for (size_t i = 0; i < kColors.size(); ++i) graph.blackboard().put(kColors[i], io->colors[i]);
+    Blackboard& bb = graph.blackboard();
+    bb.put(res::kDepth, io->depth);
+    bb.put(res::kGBuffer, io->packed);
+    bb.put(res::kMotion, io->motion);
+    for (size_t c = 0; c < gbuffer::kChannels.size(); ++c) {
+      const char* channel = gbuffer::kChannels[c];
+      auto out = std::make_shared<std::pair<TextureHandle, TextureHandle>>();
+      graph.addPass(
+          std::string("gbuffer_") + channel,
+          [&](PassBuilder& b) {
+            out->first = b.read(io->packed);
+            out->second = b.write(b.create(channel, TextureDesc{VK_FORMAT_R32G32B32A32_SFLOAT}),
+                                  TextureUsage::StorageWrite);
+          },
+          [this, out, c, frame](PassContext& pc) {
+            recordImageFilter(pc, decoder(uint32_t(c)), frame, s_.nearest, out->first, out->second,
+                              kScreenGroupX, kScreenGroupY);
+          });
+      bb.put(channel, out->second);
+    }
   }
+
+ private:
+  // Built when a channel is first unpacked: most frames unpack none.
+  const vk::Pipeline& decoder(uint32_t channel) {
+    if (!decode_[channel].handle())
+      decode_[channel] = vk::Pipeline::compute(s_.ctx, vk::loadSpirv("gbuffer_decode.comp"),
+                                               {{0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
+                                                {1, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER},
+                                                {2, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE}},
+                                               0, {channel});
+    return decode_[channel];
+  }
+
+  EngineState& s_;
+  std::array<vk::Pipeline, gbuffer::kChannels.size()> decode_;
 };
 
 }  // namespace
 
-std::unique_ptr<Effect> makeGBufferPass() {
-  return std::make_unique<GBufferPass>();
+std::unique_ptr<Effect> makeGBufferPass(EngineState& state) {
+  return std::make_unique<GBufferPass>(state);
 }
 
 }  // namespace gi

@@ -22,10 +22,9 @@ class LightingPass final : public Effect {
   EffectInfo info() const override {
     EffectInfo i{"lighting", "2",
                  "direct light with shadows + environment x ambient visibility + indirect"};
-    i.reads = {res::kDepth,       res::kNormal,        res::kAlbedo,      res::kMaterial,
-               res::kEmission,    res::kLights,        res::kShadowViews, res::kShadowMaps,
-               res::kAO,          res::kAmbient,       res::kIndirect,    res::kContactShadow,
-               res::kDirectLight, res::kEnvironmentMap};
+    i.reads = {res::kDepth,         res::kGBuffer,     res::kLights,        res::kShadowViews,
+               res::kShadowMaps,    res::kAO,          res::kAmbient,       res::kIndirect,
+               res::kContactShadow, res::kDirectLight, res::kEnvironmentMap};
     i.writes = {res::kLit};
     return i;
   }
@@ -83,13 +82,13 @@ class LightingPass final : public Effect {
           vk::DescriptorWriter w;
           w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame);
           io->surface.bind(w, pc, 1, nearest);
-          w.storageImage(9, pc.view(io->lit))
-              .sampled(10, pc.view(io->ao), linear)
-              .sampled(11, pc.view(io->ambient), linear)
-              .sampled(12, pc.view(io->indirect), linear)
-              .sampled(13, pc.view(io->environment), s_.scene.linearRepeat())
-              .sampled(14, pc.view(io->contact), linear)
-              .sampled(15, pc.view(io->direct), linear);
+          w.storageImage(6, pc.view(io->lit))
+              .sampled(7, pc.view(io->ao), linear)
+              .sampled(8, pc.view(io->ambient), linear)
+              .sampled(9, pc.view(io->indirect), linear)
+              .sampled(10, pc.view(io->environment), s_.scene.linearRepeat())
+              .sampled(11, pc.view(io->contact), linear)
+              .sampled(12, pc.view(io->direct), linear);
           pc.dispatch(pipeline, w, e, kScreenGroupX, kScreenGroupY);
         });
     bb.put(res::kLit, io->lit);
@@ -123,10 +122,10 @@ class LightingPass final : public Effect {
     const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
                tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
                img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-    std::vector<vk::Binding> bindings = LitSurfaceInputs::layout(1);  // 1..8
+    std::vector<vk::Binding> bindings = LitSurfaceInputs::layout(1);  // 1..5
     bindings.insert(
         bindings.end(),
-        {{0, ubo}, {9, img}, {10, tex}, {11, tex}, {12, tex}, {13, tex}, {14, tex}, {15, tex}});
+        {{0, ubo}, {6, img}, {7, tex}, {8, tex}, {9, tex}, {10, tex}, {11, tex}, {12, tex}});
     return pipelines_
         .emplace(key, vk::Pipeline::compute(s_.ctx, vk::loadSpirv("lighting.comp"), bindings, 0,
                                             {key.begin(), key.end()}))
