@@ -242,6 +242,12 @@ int run(const Options& o) {
                   std::find(passes.begin(), passes.end(), "surface_points") == passes.end()
                       ? " (pass culled: nothing reads them; --view points shows them)"
                       : "");
+    const gi::Renderer::DrawCounts draws = renderer.lastFrameDraws();
+    std::printf(
+        "instance draws (last frame, all views): %llu drawn, %llu culled by the views' "
+        "frusta\n",
+        static_cast<unsigned long long>(draws.drawn),
+        static_cast<unsigned long long>(draws.culled));
     std::printf("frame graph compile %.3f ms (CPU), plugin loading %.3f ms (%zu effect(s))\n",
                 renderer.lastCompileMs(), pluginLoadMs, registry.names().size());
     rusage usage{};

@@ -22,7 +22,8 @@
 // 8: GpuScene::drawDepthFromBuffer (a new virtual: the vtable moved).
 // 9: DepthAwareBlur gained its reduced-resolution upsample (its layout grew).
 // 10: the packed G-buffer ("gbuffer", gbuffer.glsl); LitSurfaceInputs reads depth + gbuffer.
-#define GI_EFFECT_ABI_VERSION 10u
+// 11: GpuScene::drawGBuffer takes an optional culling matrix.
+#define GI_EFFECT_ABI_VERSION 11u
 
 namespace gi {
 

@@ -104,7 +104,9 @@ class GpuScene {
   virtual void declareRead(PassBuilder& builder, BufferUsage usage = BufferUsage::Vertex) const = 0;
 
   // Record draws of every instance, inside their own dynamic rendering scope. Each view draws
-  // into its viewport (a cube's faces, atlas tiles).
+  // into its viewport (a cube's faces, atlas tiles). Perspective and orthographic views skip
+  // the instances whose posed bounds lie wholly outside their frustum (CPU culling, the same
+  // image: what is skipped would have been clipped away).
   virtual void drawDepth(PassContext& pc, const SceneTargets& targets,
                          std::span<const SceneView> views) = 0;
   // As drawDepth, with view i's DrawView record (scene_view.glsl) read on the GPU from `views`
@@ -114,8 +116,10 @@ class GpuScene {
   virtual void drawDepthFromBuffer(PassContext& pc, const SceneTargets& targets, VkBuffer views,
                                    std::span<const VkRect2D> viewports) = 0;
   // The G-buffer set seen through `viewUniforms` (a FrameUniforms buffer: frameUniforms() or
-  // an extra view's), exactly as the main G-buffer pass draws it.
-  virtual void drawGBuffer(PassContext& pc, const SceneTargets& targets, VkBuffer viewUniforms) = 0;
+  // an extra view's), exactly as the main G-buffer pass draws it. With `cullWorldToClip` (that
+  // view's world -> clip matrix), instances wholly outside its frustum are not drawn.
+  virtual void drawGBuffer(PassContext& pc, const SceneTargets& targets, VkBuffer viewUniforms,
+                           const glm::mat4* cullWorldToClip = nullptr) = 0;
   // A reflective shadow map (Dachsbacher and Stamminger 2005) of `light` from `view`: per texel
   // the world position and normal of the visible surface and the flux it reflects, albedo x the
   // flux the light sends through the texel (radiance x texel area for a directional light,

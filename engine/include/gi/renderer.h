@@ -44,6 +44,9 @@ struct RenderSettings {
   // Debug: false gives every transient texture its own memory, so that readAllTextures() sees
   // each one's last version (robustness sweeps); true lets non-overlapping lifetimes share it.
   bool aliasTransients = true;
+  // Skip drawing instances whose posed bounds lie outside a view's frustum (main camera, shadow
+  // maps, cube faces, depth layers): the same image, fewer draws. Off for A/B measurements.
+  bool cullDraws = true;
   std::string view =
       "output";  // the resource the frame delivers (a G-buffer channel, an effect's view)
   // Resources readTarget() will read besides `view`: kept intact to the end of the frame (the
@@ -104,6 +107,11 @@ class Renderer {
   std::string graphDescription() const;  // gi-render --print-graph
   std::string graphDot() const;          // Graphviz
   double lastCompileMs() const;          // CPU time of the last graph build + compile
+  // Instance draws the last frame recorded and skipped by frustum culling (all views).
+  struct DrawCounts {
+    uint64_t drawn = 0, culled = 0;
+  };
+  DrawCounts lastFrameDraws() const;
 
   // Changes one effect's settings: uniform-only changes apply next frame; a change of a
   // setting marked `changesGraph` re-prepares the effect and recompiles the graph.

@@ -543,6 +543,7 @@ struct Renderer::Impl : EffectContext {
 
   void renderFrame() {
     if (graphDirty) buildGraph();
+    sceneGpu->setCulling(settings.cullDraws);
     sceneGpu->beginFrame();
     updateFrameUniforms();
     for (ActiveEffect& a : effects) a.effect->update(*this, a.settings);
@@ -792,6 +793,10 @@ std::string Renderer::graphDescription() const {
 }
 std::string Renderer::graphDot() const {
   return impl_->graph.toDot();
+}
+Renderer::DrawCounts Renderer::lastFrameDraws() const {
+  const SceneGpu::DrawCounts c = impl_->sceneGpu->drawCounts();
+  return {c.drawn, c.culled};
 }
 double Renderer::lastCompileMs() const {
   return impl_->compileMs;

@@ -351,6 +351,7 @@ void SceneGpu::setTime(double seconds) {
 // The previous model matrix is the one the last rendered frame used (none before the first
 // frame: no motion), like the camera's previous view-projection in the renderer.
 void SceneGpu::beginFrame() {
+  counts_ = {};
   const bool first = rendered_.size() != instances_.size();
   for (size_t i = 0; i < instances_.size(); ++i) {
     const glm::mat4 prev = first ? instances_[i].model : rendered_[i];
@@ -410,47 +411,92 @@ const std::pair<glm::vec3, glm::vec3>& SceneGpu::morphDeltaBounds(int mesh, size
   return cached[target];
 }
 
-// World bounds of the posed geometry: each instance's mesh box (widened by its morph targets at
-// the current weights) under its node's transform, and for a skinned instance also under every
-// joint's skinning transform (a skinned vertex is a weighted mean of those transforms of
-// itself, or stays in its bind pose when its weights vanish).
-void SceneGpu::bounds(glm::vec3& lo, glm::vec3& hi) const {
-  lo = glm::vec3(std::numeric_limits<float>::max());
-  hi = -lo;
-  auto addBox = [&](const glm::vec3& bmin, const glm::vec3& bmax, const glm::mat4& m) {
+// World box of an instance: its mesh box (widened by its morph targets at the current weights)
+// under its node's transform, and for a skinned instance also under every joint's skinning
+// transform (a skinned vertex is a weighted mean of those transforms of itself, or stays in its
+// bind pose when its weights vanish). Non-finite corners are left out.
+SceneGpu::Box SceneGpu::instanceBox(size_t node, int m) const {
+  glm::vec3 lo(std::numeric_limits<float>::max()), hi = -lo;
+  auto addBox = [&](const glm::vec3& bmin, const glm::vec3& bmax, const glm::mat4& t) {
     for (int i = 0; i < 8; ++i) {
       const glm::vec3 c(i & 1 ? bmax.x : bmin.x, i & 2 ? bmax.y : bmin.y, i & 4 ? bmax.z : bmin.z);
-      const glm::vec3 w = glm::vec3(m * glm::vec4(c, 1.0f));
+      const glm::vec3 w = glm::vec3(t * glm::vec4(c, 1.0f));
       if (!std::isfinite(w.x) || !std::isfinite(w.y) || !std::isfinite(w.z)) continue;
       lo = glm::min(lo, w);
       hi = glm::max(hi, w);
     }
   };
+  const Mesh& mesh = scene_.meshes[m];
+  glm::vec3 bmin = mesh.boundsMin, bmax = mesh.boundsMax;
+  const std::vector<float>& weights = pose_.nodes[node].morphWeights;
+  for (size_t t = 0; t < mesh.morphTargets.size() && t < weights.size(); ++t) {
+    // Per-axis worst case of w * delta over the target's vertices, added target by target.
+    const float w = std::isfinite(weights[t]) ? weights[t] : 0.0f;
+    const auto& [dmin, dmax] = morphDeltaBounds(m, t);
+    bmin += glm::min(glm::vec3(0.0f), glm::min(w * dmin, w * dmax));
+    bmax += glm::max(glm::vec3(0.0f), glm::max(w * dmin, w * dmax));
+  }
+  const glm::mat4& world = pose_.nodes[node].world;
+  addBox(bmin, bmax, world);
+  // The joint matrices updateDeformations() computed for this instance.
+  const auto d = std::find_if(deformed_.begin(), deformed_.end(), [&](const Deformed& e) {
+    return e.node == int(node) && e.mesh == m;
+  });
+  if (d != deformed_.end())
+    for (const glm::mat4& j : d->lastJoints) addBox(bmin, bmax, world * j);
+  return {lo, hi};
+}
+
+// World bounds of the posed geometry: the union of the instances' boxes.
+void SceneGpu::bounds(glm::vec3& lo, glm::vec3& hi) const {
+  lo = glm::vec3(std::numeric_limits<float>::max());
+  hi = -lo;
   for (size_t n = 0; n < pose_.nodes.size(); ++n)
     for (int m : pose_.nodes[n].meshes) {
-      const Mesh& mesh = scene_.meshes[m];
-      glm::vec3 bmin = mesh.boundsMin, bmax = mesh.boundsMax;
-      const std::vector<float>& weights = pose_.nodes[n].morphWeights;
-      for (size_t t = 0; t < mesh.morphTargets.size() && t < weights.size(); ++t) {
-        // Per-axis worst case of w * delta over the target's vertices, added target by target.
-        const float w = std::isfinite(weights[t]) ? weights[t] : 0.0f;
-        const auto& [dmin, dmax] = morphDeltaBounds(m, t);
-        bmin += glm::min(glm::vec3(0.0f), glm::min(w * dmin, w * dmax));
-        bmax += glm::max(glm::vec3(0.0f), glm::max(w * dmin, w * dmax));
-      }
-      const glm::mat4& world = pose_.nodes[n].world;
-      addBox(bmin, bmax, world);
-      // The joint matrices updateDeformations() computed for this instance.
-      const auto d = std::find_if(deformed_.begin(), deformed_.end(), [&](const Deformed& e) {
-        return e.node == int(n) && e.mesh == m;
-      });
-      if (d != deformed_.end())
-        for (const glm::mat4& j : d->lastJoints) addBox(bmin, bmax, world * j);
+      const Box b = instanceBox(n, m);
+      lo = glm::min(lo, b.first);
+      hi = glm::max(hi, b.second);
     }
   if (lo.x > hi.x) {  // no geometry: a unit box keeps shadow fits finite
     lo = glm::vec3(-1.0f);
     hi = glm::vec3(1.0f);
   }
+}
+
+const std::vector<SceneGpu::Box>& SceneGpu::instanceBoxes() {
+  if (boxesVersion_ != poseVersion_ || instanceBoxes_.size() != instanceRefs_.size()) {
+    instanceBoxes_.clear();
+    for (const SurfacePointsPass::InstanceRef& r : instanceRefs_)
+      instanceBoxes_.push_back(instanceBox(size_t(r.node), r.mesh));
+    boxesVersion_ = poseVersion_;
+  }
+  return instanceBoxes_;
+}
+
+// Culling: the box is outside the view when its eight corners all lie beyond one plane of the
+// clip volume (-w <= x, y <= w; reverse-Z: 0 <= z <= w). Conservative: a box that straddles
+// planes without touching the frustum is still drawn; non-finite corners never cull.
+bool SceneGpu::inView(const SceneDrawItem& d, const glm::mat4* worldToClip) {
+  bool visible = true;
+  if (culling_ && worldToClip && d.instance < instanceBoxes().size()) {
+    const auto& [lo, hi] = instanceBoxes_[d.instance];
+    if (lo.x <= hi.x) {
+      int out[6] = {0, 0, 0, 0, 0, 0};
+      for (int i = 0; i < 8; ++i) {
+        const glm::vec4 c = *worldToClip * glm::vec4(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y,
+                                                     i & 4 ? hi.z : lo.z, 1.0f);
+        out[0] += c.x < -c.w;
+        out[1] += c.x > c.w;
+        out[2] += c.y < -c.w;
+        out[3] += c.y > c.w;
+        out[4] += c.z < 0.0f;
+        out[5] += c.z > c.w;
+      }
+      for (int k : out) visible = visible && k < 8;
+    }
+  }
+  ++(visible ? counts_.drawn : counts_.culled);
+  return visible;
 }
 
 // ---- draws --------------------------------------------------------------------------------
@@ -556,7 +602,8 @@ void SceneGpu::pushDraw(VkCommandBuffer cmd, const Pipeline& p, const SceneDrawI
                      modelOnly ? uint32_t(sizeof(glm::mat4)) : uint32_t(sizeof push), &push);
 }
 
-void SceneGpu::drawGBuffer(PassContext& pc, const SceneTargets& t, VkBuffer viewUniforms) {
+void SceneGpu::drawGBuffer(PassContext& pc, const SceneTargets& t, VkBuffer viewUniforms,
+                           const glm::mat4* cullWorldToClip) {
   VkCommandBuffer c = pc.cmd();
   beginRendering(pc, t, sceneColorFormats(SceneOutputs::GBuffer).size());
   VkViewport viewport{0, 0, float(t.extent.width), float(t.extent.height), 0.0f, 1.0f};
@@ -567,6 +614,7 @@ void SceneGpu::drawGBuffer(PassContext& pc, const SceneTargets& t, VkBuffer view
     bindGeometry(c);
     uint32_t boundMaterial = UINT32_MAX;
     for (const SceneDrawItem& d : draws_) {
+      if (!inView(d, cullWorldToClip)) continue;
       if (d.material != boundMaterial) {
         bindMaterial(pc, gbufferPipeline_, d.material, viewUniforms, 0, VK_WHOLE_SIZE);
         boundMaterial = d.material;
@@ -601,7 +649,10 @@ void SceneGpu::drawDepth(PassContext& pc, const SceneTargets& t, std::span<const
     DescriptorWriter w;
     w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, slot.buffer, slot.offset, slot.range);
     pc.descriptors().bind(c, depthPipeline_, w);
+    const glm::mat4 clip = v.proj * v.view;
+    const glm::mat4* cull = v.projection == Projection::Paraboloid ? nullptr : &clip;
     for (const SceneDrawItem& d : draws_) {
+      if (!inView(d, cull)) continue;
       pushDraw(c, depthPipeline_, d, true);
       vkCmdDrawIndexed(c, d.indexCount, 1, d.firstIndex, d.vertexOffset, 0);
     }
@@ -624,6 +675,7 @@ void SceneGpu::drawDepthFromBuffer(PassContext& pc, const SceneTargets& t, VkBuf
     w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, views, VkDeviceSize(i) * kDrawViewStride,
              sizeof(DrawViewUniforms));
     pc.descriptors().bind(c, depthPipeline_, w);
+    counts_.drawn += draws_.size();  // views computed on the GPU: nothing to cull here
     for (const SceneDrawItem& d : draws_) {
       pushDraw(c, depthPipeline_, d, true);
       vkCmdDrawIndexed(c, d.indexCount, 1, d.firstIndex, d.vertexOffset, 0);
@@ -646,7 +698,10 @@ void SceneGpu::drawDepthPeeled(PassContext& pc, const SceneTargets& t,
     w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, slot.buffer, slot.offset, slot.range)
         .sampled(1, previous, nearestClamp_.handle());
     pc.descriptors().bind(c, peelPipeline_, w);
+    const glm::mat4 clip = v.proj * v.view;
+    const glm::mat4* cull = v.projection == Projection::Paraboloid ? nullptr : &clip;
     for (const SceneDrawItem& d : draws_) {
+      if (!inView(d, cull)) continue;
       pushDraw(c, peelPipeline_, d, true);
       vkCmdDrawIndexed(c, d.indexCount, 1, d.firstIndex, d.vertexOffset, 0);
     }
@@ -663,7 +718,10 @@ void SceneGpu::drawRsm(PassContext& pc, const SceneTargets& t, const SceneView& 
   if (!draws_.empty()) {
     bindGeometry(c);
     uint32_t boundMaterial = UINT32_MAX;
+    const glm::mat4 clip = view.proj * view.view;
+    const glm::mat4* cull = view.projection == Projection::Paraboloid ? nullptr : &clip;
     for (const SceneDrawItem& d : draws_) {
+      if (!inView(d, cull)) continue;
       if (d.material != boundMaterial) {
         bindMaterial(pc, rsmPipeline_, d.material, slot.buffer, slot.offset, slot.range);
         boundMaterial = d.material;

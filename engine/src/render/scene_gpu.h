@@ -35,7 +35,8 @@ class SceneGpu final : public GpuScene {
                  std::span<const SceneView> views) override;
   void drawDepthFromBuffer(PassContext& pc, const SceneTargets& targets, VkBuffer views,
                            std::span<const VkRect2D> viewports) override;
-  void drawGBuffer(PassContext& pc, const SceneTargets& targets, VkBuffer viewUniforms) override;
+  void drawGBuffer(PassContext& pc, const SceneTargets& targets, VkBuffer viewUniforms,
+                   const glm::mat4* cullWorldToClip = nullptr) override;
   void drawRsm(PassContext& pc, const SceneTargets& targets, const SceneView& view,
                const LightInfo& light) override;
   void drawDepthPeeled(PassContext& pc, const SceneTargets& targets,
@@ -55,6 +56,13 @@ class SceneGpu final : public GpuScene {
   // or morph weights): work derived from it (the surface points) is redone only then.
   const uint64_t* poseVersion() const { return &poseVersion_; }
   const Scene& source() const { return scene_; }
+  // Frustum culling of the draws (on by default; off draws every instance into every view).
+  void setCulling(bool on) { culling_ = on; }
+  // Instance draws recorded and skipped by culling since the last beginFrame().
+  struct DrawCounts {
+    uint64_t drawn = 0, culled = 0;
+  };
+  DrawCounts drawCounts() const { return counts_; }
 
   // Skinned/morphed mesh instances: each owns a copy of its mesh's vertices in the vertex
   // buffer, rewritten by the skinning pass from its rest vertices.
@@ -79,6 +87,13 @@ class SceneGpu final : public GpuScene {
   void updateDeformations();
   void createPipelines();
   const std::pair<glm::vec3, glm::vec3>& morphDeltaBounds(int mesh, size_t target) const;
+  using Box = std::pair<glm::vec3, glm::vec3>;
+  // World box of `mesh` at `node` in the current pose (morph targets and joints included).
+  Box instanceBox(size_t node, int mesh) const;
+  // Each instance's box, recomputed when the pose changed.
+  const std::vector<Box>& instanceBoxes();
+  // Whether draw `d` is to be recorded for a view with this world -> clip matrix (null: all).
+  bool inView(const SceneDrawItem& d, const glm::mat4* worldToClip);
   VkDescriptorBufferInfo viewSlot(const SceneView& view, const LightInfo* light, VkExtent2D extent);
   void bindMaterial(PassContext& pc, const vk::Pipeline& p, uint32_t material, VkBuffer uniforms,
                     VkDeviceSize offset, VkDeviceSize range);
@@ -113,6 +128,10 @@ class SceneGpu final : public GpuScene {
   // Per-view uniform slots of drawDepth/drawRsm, host-visible, recycled every frame.
   std::vector<vk::Buffer> viewChunks_;
   size_t viewSlotsUsed_ = 0;
+  bool culling_ = true;
+  std::vector<Box> instanceBoxes_;
+  uint64_t boxesVersion_ = 0;
+  DrawCounts counts_;
 };
 
 }  // namespace gi

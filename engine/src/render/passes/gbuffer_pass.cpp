@@ -43,12 +43,13 @@ class GBufferPass final : public Effect {
           io->motion = b.write(b.create(res::kMotion, TextureDesc{gbuffer::kMotionFormat}),
                                TextureUsage::ColorAttachment);
         },
-        [io, &scene, frame](PassContext& pc) {
+        [io, &scene, frame, c = &ctx](PassContext& pc) {
           SceneTargets t;
           t.depth = pc.view(io->depth);
           t.colors = {pc.view(io->packed), pc.view(io->motion)};  // sceneColorFormats order
           t.extent = pc.extent(io->depth);
-          scene.drawGBuffer(pc, t, frame);
+          const glm::mat4 worldToClip = c->frame().viewProj;  // culls what the camera cannot see
+          scene.drawGBuffer(pc, t, frame, &worldToClip);
         });
     Blackboard& bb = graph.blackboard();
     bb.put(res::kDepth, io->depth);
