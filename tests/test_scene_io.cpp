@@ -534,6 +534,39 @@ TEST(SceneIo, JsonPathVariables) {
   expectError([&] { gi::loadScene(bad); }, gi::ErrorKind::Schema, bad, "NOPE");
 }
 
+// "grid": copies of a model sharing its meshes, offset per cell; and the box's "segments".
+TEST(SceneIo, JsonGridRepeatsAModelSharingItsMeshes) {
+  TempDir dir;
+  const gi::Scene s = gi::loadScene(dir.write("grid.json", R"({"models": [
+      {"primitive": "box", "size": 0.5, "segments": 2, "translation": [1, 2, 3],
+       "grid": {"counts": [3, 2, 4], "spacing": [2, 1, 0.5]}}]})"));
+  ASSERT_EQ(s.meshes.size(), 1u) << "the copies share the mesh";
+  EXPECT_EQ(s.meshes[0].indices.size(), 48u * 3u) << "2 x 2 quads on each of six faces";
+  std::vector<glm::vec3> origins;
+  for (const gi::Node& n : s.nodes)
+    if (!n.meshes.empty()) origins.push_back(glm::vec3(n.world[3]));
+  ASSERT_EQ(origins.size(), 24u);
+  glm::vec3 lo(1e9f), hi(-1e9f);
+  for (const glm::vec3& o : origins) {
+    lo = glm::min(lo, o);
+    hi = glm::max(hi, o);
+  }
+  EXPECT_EQ(lo, glm::vec3(1, 2, 3));
+  EXPECT_EQ(hi, glm::vec3(1 + 2 * 2, 2 + 1 * 1, 3 + 3 * 0.5f));
+  const std::string anim = dir.write("anim.json", R"({"models": [{"primitive": "box",
+      "grid": {"counts": [2, 1, 1]}, "animation": {"orbit": {"center": [0, 0, 0], "period": 2}}}]})");
+  expectError([&] { gi::loadScene(anim); }, gi::ErrorKind::InvalidData, anim,
+              "models[0].grid: a model with animation");
+  for (const char* bad : {"[0, 1, 1]", "[1.5, 1, 1]", "[1001, 1000, 1000]", "[1, 1]"}) {
+    const std::string f = dir.write("bad.json", std::string(R"({"models": [{"primitive": "box",
+        "grid": {"counts": )") + bad + "}}]}");
+    EXPECT_THROW(gi::loadScene(f), gi::Error) << bad;
+  }
+  const std::string seg =
+      dir.write("seg.json", R"({"models": [{"primitive": "box", "segments": 0}]})");
+  expectError([&] { gi::loadScene(seg); }, gi::ErrorKind::InvalidData, seg, "segments");
+}
+
 TEST(SceneIo, JsonErrors) {
   TempDir dir;
   using K = gi::ErrorKind;

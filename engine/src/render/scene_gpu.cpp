@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <map>
+#include <tuple>
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -164,6 +166,20 @@ void SceneGpu::upload() {
   pose_.animations = scene_.animations;
   pose_.cameras = scene_.cameras;
   pose_.activeCameraNode = scene_.activeCameraNode;
+  // Materials that draw alike share one index (and one descriptor bind per pass): e.g. a JSON
+  // scene's primitives each bring a material of their own, often the same one.
+  std::vector<uint32_t> canonical(materials_.size());
+  {
+    std::map<std::tuple<std::array<float, 9>, int>, uint32_t> seen;
+    for (uint32_t i = 0; i < materials_.size(); ++i) {
+      const Material& m = materials_[i];
+      const std::array<float, 9> v = {m.baseColor.r, m.baseColor.g, m.baseColor.b,
+                                      m.baseColor.a, m.emission.r,  m.emission.g,
+                                      m.emission.b,  m.roughness,   m.metallic};
+      const bool finite = std::all_of(v.begin(), v.end(), [](float x) { return std::isfinite(x); });
+      canonical[i] = finite ? seen.try_emplace({v, m.baseColorTexture}, i).first->second : i;
+    }
+  }
   std::vector<Vertex> rest;
   std::vector<glm::uvec4> jointIndices;
   std::vector<glm::vec4> jointWeights;
@@ -201,7 +217,7 @@ void SceneGpu::upload() {
       inst.model = inst.prevModel = node.world;
       inst.normalMatrix = glm::mat4(cofactor3(node.world));
       const uint32_t materialIndex =
-          std::min<uint32_t>(mesh.material, uint32_t(materials_.size() - 1));
+          canonical[std::min<uint32_t>(mesh.material, uint32_t(materials_.size() - 1))];
       inst.material = glm::uvec4(materialIndex, uint32_t(vertexOffset), 0, 0);
       instanceRefs_.push_back({int(n), m, uint32_t(instances_.size()), ranges[m].firstIndex});
       draws_.push_back({ranges[m].firstIndex, ranges[m].indexCount, vertexOffset,

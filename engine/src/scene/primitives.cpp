@@ -41,17 +41,24 @@ Mesh makePlane(float sizeX, float sizeZ) {
   return m;
 }
 
-Mesh makeBox(const glm::vec3& size) {
+Mesh makeBox(const glm::vec3& size, int segments) {
   Mesh m;
   m.name = "box";
   const glm::vec3 h = 0.5f * size;
+  const float s = float(segments);
   for (int axis = 0; axis < 3; ++axis) {
     for (float sign : {1.0f, -1.0f}) {
       glm::vec3 n(0.0f), u(0.0f), v(0.0f);
       n[axis] = sign;
       u[(axis + 1) % 3] = h[(axis + 1) % 3];
       v[(axis + 2) % 3] = h[(axis + 2) % 3];
-      addQuad(m, n * h, u, v, n);
+      // segments x segments quads per face (12 segments^2 triangles in all).
+      for (int i = 0; i < segments; ++i)
+        for (int j = 0; j < segments; ++j)
+          addQuad(m,
+                  n * h + u * ((2.0f * float(i) + 1.0f) / s - 1.0f) +
+                      v * ((2.0f * float(j) + 1.0f) / s - 1.0f),
+                  u / s, v / s, n);
     }
   }
   processMesh(m);

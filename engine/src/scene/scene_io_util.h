@@ -40,8 +40,8 @@ Scene loadMeshFileOnly(const std::string& path);
 int mergeScene(Scene& scene, Scene model, const std::string& name, const glm::mat4& transform);
 
 // Built-in primitives (object space, y up, outward normals, uv in [0,1]), already processed.
-Mesh makePlane(float sizeX, float sizeZ);                // in y = 0, facing +y, centred
-Mesh makeBox(const glm::vec3& size);                     // centred at the origin
+Mesh makePlane(float sizeX, float sizeZ);               // in y = 0, facing +y, centred
+Mesh makeBox(const glm::vec3& size, int segments = 1);  // centred at the origin; s x s quads a face
 Mesh makeSphere(float radius, int segments, int rings);  // UV sphere centred at the origin
 
 }  // namespace gi::detail

@@ -15,9 +15,15 @@
 //                                          // applied about X, then Y, then Z (fixed axes)
 //       "scale": 1.0,                      // or [sx, sy, sz]; no zero components
 //       "clip": "Walk" | 0,                // keep only this animation clip of the file
-//       "animation": { ... } },            // see below
+//       "animation": { ... },              // see below
+//       "grid": { "counts": [nx, ny, nz], "spacing": [dx, dy, dz] } },  // nx*ny*nz copies (at most
+//       100000)
+//                                          // sharing the meshes, offset by i*dx, j*dy, k*dz
+//                                          // (world units, added to the translation); not
+//                                          // with animation, skins, cameras or lights
 //     { "primitive": "plane" | "box" | "sphere",   // instead of "file"
 //       "size": 4.0,                       // plane: number or [x, z]; box: number or [x, y, z]
+//       "segments": 1,                     // box: s x s quads per face (1..64)
 //       "radius": 0.5, "segments": 32, "rings": 16,  // sphere only
 //       "material": { "name": "...", "base_color": [r, g, b(, a)], "emission": [r, g, b],
 //                     "roughness": 0.8, "metallic": 0.0 },
@@ -230,8 +236,10 @@ Scene makePrimitive(const JsonObject& o, const std::string& file) {
   const std::string kind = o.requireString("primitive");
   Mesh mesh;
   if (kind == "plane" || kind == "box") {
-    o.allowOnly(
-        {"primitive", "name", "translation", "rotation", "scale", "size", "material", "animation"});
+    o.allowOnly({"primitive", "name", "translation", "rotation", "scale", "size", "material",
+                 "animation", "grid", "segments"});
+    if (kind == "plane" && o.has("segments"))
+      o.schemaError("segments", "unknown key (a plane has none; a box's faces take segments)");
     glm::vec3 size(1.0f);
     if (o.has("size")) {
       if (o.at("size").is_number())
@@ -244,10 +252,12 @@ Scene makePrimitive(const JsonObject& o, const std::string& file) {
       }
     }
     if (size.x <= 0 || size.y <= 0 || size.z <= 0) o.invalid("size", "must be positive");
-    mesh = kind == "plane" ? detail::makePlane(size.x, size.z) : detail::makeBox(size);
+    const int segments = o.integer("segments").value_or(1);
+    if (segments < 1 || segments > 64) o.invalid("segments", "must be in [1, 64]");
+    mesh = kind == "plane" ? detail::makePlane(size.x, size.z) : detail::makeBox(size, segments);
   } else if (kind == "sphere") {
     o.allowOnly({"primitive", "name", "translation", "rotation", "scale", "radius", "segments",
-                 "rings", "material", "animation"});
+                 "rings", "material", "animation", "grid"});
     const float radius = o.number("radius").value_or(0.5f);
     const int segments = o.integer("segments").value_or(32);
     const int rings = o.integer("rings").value_or(16);
@@ -313,16 +323,67 @@ class SceneJsonLoader {
         model = makePrimitive(m, path_);
         name = m.string("name").value_or(*m.string("primitive"));
       } else {
-        m.allowOnly({"file", "name", "translation", "rotation", "scale", "clip", "animation"});
+        m.allowOnly(
+            {"file", "name", "translation", "rotation", "scale", "clip", "animation", "grid"});
         const std::string file = m.requireString("file");
         const fs::path resolved = expandModelPath(file, sceneDir, m);
         model = loadModel(resolved.string(), m);
         name = m.string("name").value_or(resolved.stem().string());
         if (m.has("clip")) selectClip(m, model, resolved.filename().string());
       }
-      const int node = detail::mergeScene(scene_, std::move(model), name, readTransform(m));
+      const size_t clipsBefore = scene_.animations.size(), skinsBefore = scene_.skins.size();
+      const size_t camerasBefore = scene_.cameras.size(), lightsBefore = scene_.lights.size();
+      const glm::mat4 transform = readTransform(m);
+      const int node = detail::mergeScene(scene_, std::move(model), name, transform);
       if (m.has("animation")) readAnimation(m, node, readTRS(m), Target::Model);
+      if (m.has("grid")) {
+        if (m.has("animation") || scene_.animations.size() != clipsBefore ||
+            scene_.skins.size() != skinsBefore || scene_.cameras.size() != camerasBefore ||
+            scene_.lights.size() != lightsBefore)
+          m.invalid("grid", "a model with animation, skins, cameras or lights cannot be repeated");
+        repeatOnGrid(JsonObject(m.at("grid"), m.pathOf("grid"), path_), node, transform);
+      }
     }
+  }
+
+  // "grid": copies of the model's node tree `root` (placed by `transform`) sharing its meshes,
+  // one per cell but the first, which `root` is.
+  void repeatOnGrid(const JsonObject& g, int root, const glm::mat4& transform) {
+    g.allowOnly({"counts", "spacing"});
+    if (!g.has("counts")) g.schemaError("counts", "missing required key");
+    const std::vector<float> counts = *g.numbers("counts", {3});
+    const glm::vec3 spacing = g.vec3("spacing").value_or(glm::vec3(1.0f));
+    uint64_t total = 1;
+    int n[3];
+    for (int a = 0; a < 3; ++a) {
+      if (!(counts[a] >= 1.0f) || counts[a] != std::floor(counts[a]) || counts[a] > 1e5f)
+        g.invalid("counts", "each count must be a whole number in [1, 100000]");
+      n[a] = int(counts[a]);
+      total *= uint64_t(n[a]);
+    }
+    if (total > 100000) g.invalid("counts", "more than 100000 copies in all");
+    for (int i = 0; i < n[0]; ++i)
+      for (int j = 0; j < n[1]; ++j)
+        for (int k = 0; k < n[2]; ++k) {
+          if (i == 0 && j == 0 && k == 0) continue;  // the model itself
+          const glm::vec3 offset = glm::vec3(float(i), float(j), float(k)) * spacing;
+          const int copy = scene_.addNode(scene_.nodes[root].name,
+                                          glm::translate(glm::mat4(1.0f), offset) * transform);
+          scene_.nodes[copy].meshes = scene_.nodes[root].meshes;
+          for (int child : std::vector<int>(scene_.nodes[root].children)) cloneTree(child, copy);
+        }
+  }
+
+  // Appends a copy of node `src` and its descendants under `parent` (same meshes).
+  void cloneTree(int src, int parent) {
+    Node n = scene_.nodes[src];
+    const std::vector<int> children = n.children;
+    n.children.clear();
+    n.parent = parent;
+    const int copy = int(scene_.nodes.size());
+    scene_.nodes.push_back(std::move(n));
+    scene_.nodes[parent].children.push_back(copy);
+    for (int child : children) cloneTree(child, copy);
   }
 
   // "clip": keeps only the named (or numbered) animation clip of a model file.
