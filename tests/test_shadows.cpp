@@ -50,14 +50,16 @@ Scene boxScene(const std::string& light) {
   return boxSceneWithLights(lightJson(light));
 }
 
-bool rayHitsBox(const glm::vec3& o, const glm::vec3& d, float tMax) {
+// Whether the ray o + t d, 1e-4 < t < tMax, meets the box [lo, hi] (slab test).
+bool rayHitsBox(const glm::vec3& o, const glm::vec3& d, float tMax, const glm::vec3& lo = kBoxMin,
+                const glm::vec3& hi = kBoxMax) {
   float t0 = 1e-4f, t1 = tMax;
   for (int a = 0; a < 3; ++a) {
     if (std::abs(d[a]) < 1e-12f) {
-      if (o[a] < kBoxMin[a] || o[a] > kBoxMax[a]) return false;
+      if (o[a] < lo[a] || o[a] > hi[a]) return false;
       continue;
     }
-    float ta = (kBoxMin[a] - o[a]) / d[a], tb = (kBoxMax[a] - o[a]) / d[a];
+    float ta = (lo[a] - o[a]) / d[a], tb = (hi[a] - o[a]) / d[a];
     if (ta > tb) std::swap(ta, tb);
     t0 = std::max(t0, ta);
     t1 = std::min(t1, tb);
@@ -195,19 +197,7 @@ TEST_P(GrazingShadowTest, LitFacesAndTheOpenFloorAreAsBrightAsWithoutShadows) {
   // floor pixels whose whole neighbourhood (0.06 around) sees the light past the box.
   const glm::vec3 lo(-0.5f, 0.0f, -0.5f), hi(0.5f, 1.0f, 0.5f);
   auto hitsBox = [&](const glm::vec3& o) {
-    const glm::vec3 toLight = toLightAt(o);
-    float t0 = 1e-4f, t1 = point ? glm::length(lightPos - o) : 100.0f;
-    for (int a = 0; a < 3; ++a) {
-      if (std::abs(toLight[a]) < 1e-12f) {
-        if (o[a] < lo[a] || o[a] > hi[a]) return false;
-        continue;
-      }
-      float ta = (lo[a] - o[a]) / toLight[a], tb = (hi[a] - o[a]) / toLight[a];
-      if (ta > tb) std::swap(ta, tb);
-      t0 = std::max(t0, ta);
-      t1 = std::min(t1, tb);
-    }
-    return t0 <= t1;
+    return rayHitsBox(o, toLightAt(o), point ? glm::length(lightPos - o) : 100.0f, lo, hi);
   };
   const float edge = 0.03f, m = 0.06f;
   size_t faces = 0, floor = 0, darkFaces = 0, darkFloor = 0;
