@@ -8,7 +8,7 @@ GI_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 GI_PACKAGES=(
   build-essential cmake ninja-build pkg-config
   libvulkan-dev vulkan-validationlayers mesa-vulkan-drivers vulkan-tools
-  glslang-tools glslang-dev spirv-tools
+  glslang-tools glslang-dev spirv-tools libspirv-cross-c-shared-dev
   libglm-dev libtinygltf-dev nlohmann-json3-dev libopenmesh-dev libglfw3-dev libimgui-dev
   libstb-dev libembree-dev libgtest-dev libbenchmark-dev clang-format clang-tidy
   assimp-testmodels python3  # python3: the external-effect test checks images with it

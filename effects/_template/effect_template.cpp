@@ -49,13 +49,13 @@ class EffectTemplate : public gi::Effect {
   // Long-lived objects (pipelines, samplers, buffers). Runs once, and again only when a
   // setting marked `changesGraph` changed.
   void prepare(gi::EffectContext& ctx, const gi::SettingValues&) override {
-    const std::vector<uint32_t> spirv(std::begin(effect_template_comp),
-                                      std::end(effect_template_comp));
-    pipeline_ = gi::vk::Pipeline::compute(ctx.vulkan(), spirv,
-                                          {{0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
-                                           {1, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER},
-                                           {2, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE}},
-                                          sizeof(Params));
+    // The descriptor layout comes from the shader itself; the push-constant struct is checked
+    // against the shader's block (a member at another offset is an error naming it).
+    gi::vk::ComputeDesc desc{"effect_template: effect_template.comp",
+                             {std::begin(effect_template_comp), std::end(effect_template_comp)}};
+    desc.blocks.pushConstants =
+        gi::vk::cppBlock<Params>("Params", {GI_BLOCK_MEMBER(Params, strength)});
+    pipeline_ = gi::vk::Pipeline::compute(ctx.vulkan(), desc);
   }
 
   // Declares the passes on every graph compile. The setup callback (run now) declares reads
@@ -80,16 +80,12 @@ class EffectTemplate : public gi::Effect {
         // `settings` outlives the graph: read uniform-only values here, not in addPasses.
         [this, io, values = &settings, frame = ctx.frameUniforms(),
          sampler = ctx.nearestSampler()](gi::PassContext& pc) {
-          gi::vk::DescriptorWriter writer;
-          writer.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame)
-              .sampled(1, pc.view(io->in), sampler)
-              .storageImage(2, pc.view(io->out));
-          pc.descriptors().bind(pc.cmd(), pipeline_, writer);
+          gi::vk::DescriptorWriter writer(pipeline_);  // bindings by the shader's names
+          writer.buffer("Frame", frame)
+              .texture("litColor", pc.view(io->in), sampler)
+              .image("outColor", pc.view(io->out));
           const Params params{float(values->number("strength"))};
-          const VkExtent2D size = pc.extent(io->out);
-          vkCmdPushConstants(pc.cmd(), pipeline_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof params,
-                             &params);
-          vkCmdDispatch(pc.cmd(), (size.width + 7) / 8, (size.height + 7) / 8, 1);
+          pc.dispatch(pipeline_, writer, pc.extent(io->out), 8, 8, params);
         });
     bb.put("effect_template", io->out);    // the debug view
     bb.put(gi::resources::kLit, io->out);  // later passes (tonemap) read this from now on

@@ -21,8 +21,14 @@ layout(constant_id = 1) const int kBand = 0;
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 // Keep in sync with gi::alchemy::Uniforms (alchemy_kernel.h).
 layout(set = 0, binding = 1) uniform AlchemyParams {
-  vec4 a;  // radius r, bias beta, 2 sigma / s, contrast k
-  vec4 b;  // epsilon, blur tolerance (world), r^2, 0
+  float radius;         // r, world units
+  float bias;           // beta
+  float scale;          // 2 sigma / s
+  float contrast;       // k
+  float epsilon;        // denominator guard
+  float blurTolerance;  // absolute, world units
+  float radius2;        // r^2
+  float pad;
   uvec4 taps[16];  // tap i: taps[i / 4][i % 4], packSnorm2x16 of its unit-disk offset
 } params;
 layout(set = 0, binding = 2) uniform sampler2D gDepth;
@@ -58,7 +64,7 @@ void main() {
 
   // Projected radius in pixels; guard: clamped to the image size (a camera inside the ball
   // would otherwise send taps to integer overflow).
-  float r = params.a.x, beta = params.a.y, eps = params.b.x, r2 = params.b.z;
+  float r = params.radius, beta = params.bias, eps = params.epsilon, r2 = params.radius2;
   float rpx = min(r * abs(p11) * 0.5 * float(size.y) / dist, float(max(size.x, size.y)));
   // 4x4 interleave: Bayer rank of the output pixel (gi::alchemy::bayerRank), 16 rotations.
   int bx = (p.x ^ p.y) & 3;
@@ -91,8 +97,8 @@ void main() {
     float term = it * max(0.0, dot(w, N) - biasZ * it) / (ww + eps * it2);
     sum += (inside && !isSky(d) && ww < r2 * it2) ? term : 0.0;
   }
-  float base = max(0.0, 1.0 - params.a.z * sum);
-  float ao = base > 0.0 ? min(pow(base, params.a.w), 1.0) : 0.0;  // NaN sum: 0, never NaN
+  float base = max(0.0, 1.0 - params.scale * sum);
+  float ao = base > 0.0 ? min(pow(base, params.contrast), 1.0) : 0.0;  // NaN sum: 0, never NaN
 
   // Tangent-plane slopes of 1/z per pixel for the blur's edge stopping: on the plane N.X = K,
   // 1/z = (N.D)/K with D the pixel's view ray (z = -1), so d(1/z)/dpixel = (1/z) N.xy dRay / (N.D).

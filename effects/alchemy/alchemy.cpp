@@ -118,19 +118,30 @@ class AlchemyEffect : public gi::Effect {
   void prepare(gi::EffectContext& ctx, const gi::SettingValues& s) override {
     gi::vk::Context& vk = ctx.vulkan();
     vk.requireWorkgroup(kGroupX, kGroupY, "alchemy");
-    const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
-               tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-               img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+    using gi::alchemy::Uniforms;
     const int samples = s.integer("samples"), band = s.integer("guard_band"),
               blur = s.integer("blur_radius");
-    ao_ = gi::vk::Pipeline::compute(vk, words(alchemy_comp),
-                                    {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, img}}, 0,
-                                    {uint32_t(samples), uint32_t(band)});
+    const gi::vk::BlockChecks params{
+        {},
+        {{"params",
+          gi::vk::cppBlock<Uniforms>(
+              "gi::alchemy::Uniforms",
+              {GI_BLOCK_MEMBER(Uniforms, radius), GI_BLOCK_MEMBER(Uniforms, bias),
+               GI_BLOCK_MEMBER(Uniforms, scale), GI_BLOCK_MEMBER(Uniforms, contrast),
+               GI_BLOCK_MEMBER(Uniforms, epsilon), GI_BLOCK_MEMBER(Uniforms, blurTolerance),
+               GI_BLOCK_MEMBER(Uniforms, radius2), GI_BLOCK_MEMBER(Uniforms, pad),
+               GI_BLOCK_MEMBER(Uniforms, taps)})}}};
+    ao_ = gi::vk::Pipeline::compute(vk, {"alchemy: alchemy.comp",
+                                         words(alchemy_comp),
+                                         {uint32_t(samples), uint32_t(band)},
+                                         params});
     if (blur > 0) {
-      blurX_ = gi::vk::Pipeline::compute(vk, words(alchemy_blur_x_comp),
-                                         {{0, ubo}, {1, tex}, {2, img}}, 0, {uint32_t(blur)});
-      blurY_ = gi::vk::Pipeline::compute(vk, words(alchemy_blur_y_comp),
-                                         {{0, ubo}, {1, tex}, {2, img}}, 0, {uint32_t(blur)});
+      blurX_ = gi::vk::Pipeline::compute(
+          vk,
+          {"alchemy: alchemy_blur_x.comp", words(alchemy_blur_x_comp), {uint32_t(blur)}, params});
+      blurY_ = gi::vk::Pipeline::compute(
+          vk,
+          {"alchemy: alchemy_blur_y.comp", words(alchemy_blur_y_comp), {uint32_t(blur)}, params});
     }
     if (!uniforms_)
       uniforms_ = gi::vk::Buffer(vk, sizeof(gi::alchemy::Uniforms),
@@ -210,12 +221,12 @@ class AlchemyEffect : public gi::Effect {
         },
         [this, io, values = &settings, frame, nearest](gi::PassContext& pc) {
           upload(*values);
-          gi::vk::DescriptorWriter w;
-          w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame)
-              .buffer(1, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms_.handle())
-              .sampled(2, pc.view(io->depth), nearest)
-              .sampled(3, pc.view(io->packed), nearest)
-              .storageImage(4, pc.view(io->raw));
+          gi::vk::DescriptorWriter w(ao_);
+          w.buffer("Frame", frame)
+              .buffer("params", uniforms_.handle())
+              .texture("gDepth", pc.view(io->depth), nearest)
+              .texture("giGBuffer", pc.view(io->packed), nearest)
+              .image("outAO", pc.view(io->raw));
           const VkExtent2D e = pc.extent(io->raw);
           pc.dispatch(ao_, w, e, kGroupX, kGroupY);
         });
@@ -236,10 +247,10 @@ class AlchemyEffect : public gi::Effect {
             const VkExtent2D e = pc.extent(io->ao);
             auto axis = [&](const gi::vk::Pipeline& p, VkImageView in, VkImageLayout inLayout,
                             VkImageView out) {
-              gi::vk::DescriptorWriter w;
-              w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms_.handle())
-                  .sampled(1, in, nearest, inLayout)
-                  .storageImage(2, out);
+              gi::vk::DescriptorWriter w(p);
+              w.buffer("params", uniforms_.handle())
+                  .texture("inAO", in, nearest, inLayout)
+                  .image("outAO", out);
               pc.dispatch(p, w, e, kGroupX, kGroupY);
             };
             axis(blurX_, pc.view(io->raw), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,

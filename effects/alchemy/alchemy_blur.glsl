@@ -19,8 +19,14 @@ layout(constant_id = 0) const int kRadius = 4;  // 1..gi::alchemy::kMaxBlurRadiu
 
 // Keep in sync with gi::alchemy::Uniforms (alchemy_kernel.h).
 layout(set = 0, binding = 0) uniform AlchemyParams {
-  vec4 a;  // radius r, bias beta, 2 sigma / s, contrast k
-  vec4 b;  // epsilon, blur tolerance (world), r^2, 0
+  float radius;         // r, world units
+  float bias;           // beta
+  float scale;          // 2 sigma / s
+  float contrast;       // k
+  float epsilon;        // denominator guard
+  float blurTolerance;  // absolute, world units
+  float radius2;        // r^2
+  float pad;
   uvec4 taps[16];
 } params;
 layout(set = 0, binding = 1) uniform sampler2D inAO;
@@ -38,7 +44,7 @@ void main() {
   vec4 c = texelFetch(inAO, p, 0);
   float ic = c.y;  // 1 / view distance (0: sky)
   float slope = dot(c.zw, vec2(kAxis));
-  float tol = params.b.y;
+  float tol = params.blurTolerance;
   float sum = c.x, weights = 1.0;
   for (int o = -kRadius; o <= kRadius; ++o) {
     if (o == 0) continue;

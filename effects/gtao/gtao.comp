@@ -29,7 +29,10 @@ layout(constant_id = 4) const int kScale = 1;
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 // Keep in sync with gi::gtao::Uniforms (gtao_params.h).
 layout(set = 0, binding = 1) uniform GtaoParams {
-  vec4 params;     // radius R, falloff slope 1 / (falloff x R), thickness blend, 0
+  float radius;        // R, world units
+  float falloffSlope;  // 1 / (falloff x R)
+  float thickness;     // horizon blend towards lower samples, 0 = off
+  float pad;
   vec4 noise[16];  // per 4x4 phase: cos, sin of the slice rotation, step jitter in [0, 1), 0
 } gtao;
 layout(set = 0, binding = 2) uniform sampler2D gDepth;
@@ -70,7 +73,7 @@ float horizonStep(float hc, int step, float sgn, vec2 d, vec3 tangentLine, float
   float ce = x * inversesqrt(max(x * x + y * y, 1e-30));
   // Falloff: full weight up to R (1 - falloff), none beyond R; the reference counts
   // occluders within R exactly (falloff 0 is its hard cut-off).
-  float w = clamp((R - len) * gtao.params.y, 0.0, 1.0);
+  float w = clamp((R - len) * gtao.falloffSlope, 0.0, 1.0);
   // Guards: off-screen and sky samples (depth 0: a point at infinity, len may overflow to inf
   // and ce be NaN) and samples below the tangent plane are not occluders; selects never
   // propagate the unselected NaN. Depth reconstruction leaves a plane's own samples within
@@ -79,7 +82,7 @@ float horizonStep(float hc, int step, float sgn, vec2 d, vec3 tangentLine, float
   float cw = valid ? mix(1.0, ce, w) : 1.0;
   // Thickness heuristic (Jimenez et al. 2016, sec. 4.3): a sample below the horizon pulls it
   // down by the blend factor (0: the plain maximum).
-  return cw < hc ? cw : mix(hc, cw, gtao.params.z);
+  return cw < hc ? cw : mix(hc, cw, gtao.thickness);
 }
 
 // Up to this many steps per side the march is unrolled; beyond, it stays a loop. Measured on
@@ -156,7 +159,7 @@ void main() {
   // Guard: a zero or NaN normal falls back to facing the camera.
   vec3 N = safeNormalize(giGBufferNormal(gTexel), V);
 
-  float R = gtao.params.x;
+  float R = gtao.radius;
   // The radius in pixels at this depth (|P11| H / 2 pixels per unit at distance 1).
   float radiusPx = R * abs(p11) * 0.5 * frame.viewport.y / max(dist, 1e-30);
   // The phase of the output texel: the blur, which runs at the output's resolution, cancels it.

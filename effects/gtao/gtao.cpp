@@ -93,17 +93,21 @@ class GtaoEffect : public gi::Effect {
   void prepare(gi::EffectContext& ctx, const gi::SettingValues& s) override {
     gi::vk::Context& vk = ctx.vulkan();
     vk.requireWorkgroup(kGroupX, kGroupY, "gtao");
-    const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
-               tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-               img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+    using gi::gtao::Uniforms;
     // Graph-changing settings are specialization constants: the loops unroll and the optional
     // outputs vanish from the code when off.
-    gtao_ = gi::vk::Pipeline::compute(
-        vk, {std::begin(gtao_comp), std::end(gtao_comp)},
-        {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {5, img}, {6, img}}, 0,
-        {uint32_t(s.integer("slices")), uint32_t(s.integer("steps")),
-         s.flag("bent_normals") ? 1u : 0u, s.flag("multi_bounce") ? 1u : 0u,
-         uint32_t(s.integer("downsample"))});
+    gi::vk::ComputeDesc desc{"gtao: gtao.comp",
+                             {std::begin(gtao_comp), std::end(gtao_comp)},
+                             {uint32_t(s.integer("slices")), uint32_t(s.integer("steps")),
+                              s.flag("bent_normals") ? 1u : 0u, s.flag("multi_bounce") ? 1u : 0u,
+                              uint32_t(s.integer("downsample"))}};
+    desc.blocks.uniforms = {
+        {"gtao", gi::vk::cppBlock<Uniforms>(
+                     "gi::gtao::Uniforms",
+                     {GI_BLOCK_MEMBER(Uniforms, radius), GI_BLOCK_MEMBER(Uniforms, falloffSlope),
+                      GI_BLOCK_MEMBER(Uniforms, thickness), GI_BLOCK_MEMBER(Uniforms, pad),
+                      GI_BLOCK_MEMBER(Uniforms, noise)})}};
+    gtao_ = gi::vk::Pipeline::compute(vk, desc);
     // The blur radius and the downsampling are compiled into the blur (changesGraph: prepare
     // runs again); at a reduced resolution the blur also upsamples, even with radius 0.
     if (s.integer("blur_radius") > 0 || s.integer("downsample") > 1)
@@ -156,13 +160,13 @@ class GtaoEffect : public gi::Effect {
         [this, io, values = &settings, frame, nearest, bentNormals](gi::PassContext& pc) {
           upload(*values);
           if (!bentNormals) prepareUnusedBent(pc.cmd());
-          gi::vk::DescriptorWriter w;
-          w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame)
-              .buffer(1, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms_.handle())
-              .sampled(2, pc.view(io->depth), nearest)
-              .sampled(3, pc.view(io->gbuffer), nearest)
-              .storageImage(5, pc.view(io->raw))
-              .storageImage(6, bentNormals ? pc.view(io->bent) : unusedBent_.view());
+          gi::vk::DescriptorWriter w(gtao_);
+          w.buffer("Frame", frame)
+              .buffer("gtao", uniforms_.handle())
+              .texture("gDepth", pc.view(io->depth), nearest)
+              .texture("giGBuffer", pc.view(io->gbuffer), nearest)
+              .image("outAO", pc.view(io->raw))
+              .image("outBent", bentNormals ? pc.view(io->bent) : unusedBent_.view());
           const VkExtent2D e = pc.extent(io->raw);
           pc.dispatch(gtao_, w, e, kGroupX, kGroupY);
         });

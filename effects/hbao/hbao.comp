@@ -21,7 +21,9 @@ layout(constant_id = 1) const int kSteps = 4;
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 // Keep in sync with gi::hbao::Uniforms (hbao_params.h).
 layout(set = 0, binding = 1) uniform HbaoParams {
-  vec4 params;     // radius R, 1 / R^2, cos and sin of the angle bias
+  float radius;      // R, world units
+  float invRadius2;  // 1 / R^2
+  float cosBias, sinBias;  // of the angle bias
   vec4 noise[16];  // per 4x4 phase: cos, sin of the direction rotation, step jitter, 0
 } hbao;
 layout(set = 0, binding = 2) uniform sampler2D gDepth;
@@ -64,8 +66,8 @@ void main() {
   vec3 Pn = safeNormalize(P, vec3(0.0, 0.0, -1.0));
   vec3 N = safeNormalize(giGBufferNormal(gTexel), -Pn);
 
-  float R = hbao.params.x, invR2 = hbao.params.y;
-  float cosBias = hbao.params.z, sinBias = hbao.params.w;
+  float R = hbao.radius, invR2 = hbao.invRadius2;
+  float cosBias = hbao.cosBias, sinBias = hbao.sinBias;
   float radiusPx = R * abs(p11) * 0.5 * frame.viewport.y / max(dist, 1e-30);
   vec4 noise = hbao.noise[(p.y & 3) * 4 + (p.x & 3)];
   vec2 pixelCentre = vec2(p) + 0.5;

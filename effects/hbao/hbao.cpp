@@ -71,14 +71,18 @@ class HbaoEffect : public gi::Effect {
   void prepare(gi::EffectContext& ctx, const gi::SettingValues& s) override {
     gi::vk::Context& vk = ctx.vulkan();
     vk.requireWorkgroup(kGroupX, kGroupY, "hbao");
-    const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
-               tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-               img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+    using gi::hbao::Uniforms;
     // Graph-changing settings are specialization constants: the loops unroll.
-    hbao_ = gi::vk::Pipeline::compute(
-        vk, {std::begin(hbao_comp), std::end(hbao_comp)},
-        {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, img}}, 0,
-        {uint32_t(s.integer("directions")), uint32_t(s.integer("steps"))});
+    gi::vk::ComputeDesc desc{"hbao: hbao.comp",
+                             {std::begin(hbao_comp), std::end(hbao_comp)},
+                             {uint32_t(s.integer("directions")), uint32_t(s.integer("steps"))}};
+    desc.blocks.uniforms = {
+        {"hbao", gi::vk::cppBlock<Uniforms>(
+                     "gi::hbao::Uniforms",
+                     {GI_BLOCK_MEMBER(Uniforms, radius), GI_BLOCK_MEMBER(Uniforms, invRadius2),
+                      GI_BLOCK_MEMBER(Uniforms, cosBias), GI_BLOCK_MEMBER(Uniforms, sinBias),
+                      GI_BLOCK_MEMBER(Uniforms, noise)})}};
+    hbao_ = gi::vk::Pipeline::compute(vk, desc);
     // The blur radius is compiled into the blur (changesGraph: prepare runs again).
     if (s.integer("blur_radius") > 0) blur_.prepare(ctx, s.integer("blur_radius"));
     if (!uniforms_)
@@ -109,12 +113,12 @@ class HbaoEffect : public gi::Effect {
         },
         [this, io, values = &settings, frame, nearest](gi::PassContext& pc) {
           upload(*values);
-          gi::vk::DescriptorWriter w;
-          w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame)
-              .buffer(1, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms_.handle())
-              .sampled(2, pc.view(io->depth), nearest)
-              .sampled(3, pc.view(io->gbuffer), nearest)
-              .storageImage(4, pc.view(io->raw));
+          gi::vk::DescriptorWriter w(hbao_);
+          w.buffer("Frame", frame)
+              .buffer("hbao", uniforms_.handle())
+              .texture("gDepth", pc.view(io->depth), nearest)
+              .texture("giGBuffer", pc.view(io->gbuffer), nearest)
+              .image("outAO", pc.view(io->raw));
           const VkExtent2D e = pc.extent(io->raw);
           pc.dispatch(hbao_, w, e, kGroupX, kGroupY);
         });

@@ -76,11 +76,14 @@ class SsaoEffect : public gi::Effect {
   void prepare(gi::EffectContext& ctx, const gi::SettingValues& settings) override {
     gi::vk::Context& vk = ctx.vulkan();
     vk.requireWorkgroup(kGroupX, kGroupY, "ssao");
-    const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
-               tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-               img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-    ssao_ = gi::vk::Pipeline::compute(vk, {std::begin(ssao_comp), std::end(ssao_comp)},
-                                      {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, img}});
+    using gi::ssao::Uniforms;
+    gi::vk::ComputeDesc desc{"ssao: ssao.comp", {std::begin(ssao_comp), std::end(ssao_comp)}};
+    desc.blocks.uniforms = {
+        {"ssao", gi::vk::cppBlock<Uniforms>(
+                     "gi::ssao::Uniforms",
+                     {GI_BLOCK_MEMBER(Uniforms, params), GI_BLOCK_MEMBER(Uniforms, counts),
+                      GI_BLOCK_MEMBER(Uniforms, rotation), GI_BLOCK_MEMBER(Uniforms, kernel)})}};
+    ssao_ = gi::vk::Pipeline::compute(vk, desc);
     // The blur radius is compiled into the blur (changesGraph: prepare runs again).
     if (settings.integer("blur_radius") > 0) blur_.prepare(ctx, settings.integer("blur_radius"));
     if (!uniforms_)
@@ -113,12 +116,12 @@ class SsaoEffect : public gi::Effect {
         },
         [this, io, values = &settings, frame, nearest](gi::PassContext& pc) {
           upload(*values);
-          gi::vk::DescriptorWriter w;
-          w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame)
-              .buffer(1, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms_.handle())
-              .sampled(2, pc.view(io->depth), nearest)
-              .sampled(3, pc.view(io->gbuffer), nearest)
-              .storageImage(4, pc.view(io->raw));
+          gi::vk::DescriptorWriter w(ssao_);
+          w.buffer("Frame", frame)
+              .buffer("ssao", uniforms_.handle())
+              .texture("gDepth", pc.view(io->depth), nearest)
+              .texture("giGBuffer", pc.view(io->gbuffer), nearest)
+              .image("outAO", pc.view(io->raw));
           const VkExtent2D e = pc.extent(io->raw);
           pc.dispatch(ssao_, w, e, kGroupX, kGroupY);
         });

@@ -40,14 +40,10 @@ inline constexpr int kMaxSamples = 64;
 inline constexpr float kBlurDepthTolerance = 0.25f;
 
 // std140 mirror of the `SsaoParams` uniform block in ssao.comp.
-struct Uniforms {
-  float radius;     // R, world units
-  float bias;       // absolute, world units (setting bias x R)
-  float intensity;  // AO = 1 - intensity x occluded fraction
-  float pad0;
-  int32_t samples;  // taps used, 1..kMaxSamples
-  int32_t pad[3];
-  float rotation[16][4];                // cos, sin of each 4x4 phase's kernel rotation, 0, 0
+struct Uniforms {         // mirrors ssao.comp's SsaoParams (checked when the pipeline is made)
+  float params[4];        // R (world units), bias (absolute: setting x R), intensity, 0
+  int32_t counts[4];      // taps used (1..kMaxSamples), 0, 0, 0
+  float rotation[16][4];  // cos, sin of each 4x4 phase's kernel rotation, 0, 0
   uint32_t kernel[kMaxSamples / 4][4];  // tap i at [i / 4][i % 4], packed by packTap()
 };
 static_assert(sizeof(Uniforms) == 32 + 16 * 16 + kMaxSamples * 4, "std140 layout");
@@ -115,10 +111,10 @@ inline Uniforms makeUniforms(double radius, double bias, double intensity, int s
                              bool interleave) {
   Uniforms u{};
   const int n = samples < 1 ? 1 : samples > kMaxSamples ? kMaxSamples : samples;
-  u.radius = float(radius);
-  u.bias = float(bias * radius);
-  u.intensity = float(intensity);
-  u.samples = n;
+  u.params[0] = float(radius);
+  u.params[1] = float(bias * radius);
+  u.params[2] = float(intensity);
+  u.counts[0] = n;
   for (int e = 0; e < 16; ++e) {
     const double a = rotationAngle(e & 3, e >> 2, n, interleave);
     u.rotation[e][0] = float(std::cos(a));

@@ -20,6 +20,7 @@ enum class ErrorKind {
   Unsupported,      // feature or format we do not handle
   Vulkan,           // Vulkan call failed
   Usage,            // bad command-line argument
+  ShaderInterface,  // a shader's bindings or blocks disagree with the C++ that uses them
 };
 
 const char* errorKindName(ErrorKind kind);

@@ -230,6 +230,18 @@ void FrameGraph::execute(VkCommandBuffer cmd, vk::DescriptorArena& descriptors, 
 void PassContext::dispatch(const vk::Pipeline& pipeline, vk::DescriptorWriter& writer,
                            VkExtent2D extent, uint32_t groupX, uint32_t groupY) const {
   descriptors_->bind(cmd_, pipeline, writer);
+  dispatchGroups(extent, groupX, groupY);
+}
+
+void PassContext::dispatchPushing(const vk::Pipeline& pipeline, vk::DescriptorWriter& writer,
+                                  VkExtent2D extent, uint32_t groupX, uint32_t groupY,
+                                  const void* push, size_t size) const {
+  descriptors_->bind(cmd_, pipeline, writer);
+  pipeline.pushBytes(cmd_, push, size);
+  dispatchGroups(extent, groupX, groupY);
+}
+
+void PassContext::dispatchGroups(VkExtent2D extent, uint32_t groupX, uint32_t groupY) const {
   vkCmdDispatch(cmd_, (extent.width + groupX - 1) / groupX, (extent.height + groupY - 1) / groupY,
                 1);
 }

@@ -172,6 +172,8 @@ const char* errorKindName(ErrorKind kind) {
       return "vulkan error";
     case ErrorKind::Usage:
       return "usage error";
+    case ErrorKind::ShaderInterface:
+      return "shader interface mismatch";
   }
   return "error";
 }

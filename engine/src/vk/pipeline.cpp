@@ -1,16 +1,18 @@
 #include "gi/vk/pipeline.h"
 
+#include <algorithm>
 #include <utility>
 
+#include "gi/errors.h"
 #include "gi/vk/common.h"
 #include "gi/vk/shader_overrides.h"
 
 namespace gi::vk {
 
 namespace {
-// Builds from a hot-reloaded override when `spirv` is a registered effect shader that has one.
-VkShaderModule createModule(VkDevice device, const std::vector<uint32_t>& spirv) {
-  const std::vector<uint32_t> code = resolveShader(spirv);
+// `code` is what resolveShader returned: a hot-reloaded override of a registered effect shader,
+// or the shader itself.
+VkShaderModule createModule(VkDevice device, const std::vector<uint32_t>& code) {
   VkShaderModuleCreateInfo info{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
   info.codeSize = code.size() * 4;
   info.pCode = code.data();
@@ -36,6 +38,114 @@ void Pipeline::createLayout(const std::vector<Binding>& bindings, uint32_t pushC
   info.pushConstantRangeCount = pushConstantBytes ? 1 : 0;
   info.pPushConstantRanges = &range;
   check(vkCreatePipelineLayout(ctx_->device(), &info, nullptr, &layout_), "vkCreatePipelineLayout");
+  pushRange_ = pushConstantBytes;
+}
+
+// A layout from the shader's reflection; the declared C++ blocks are checked against it first,
+// so a mismatch fails before anything is created.
+void Pipeline::useReflection(const std::string& name, ShaderInterface iface,
+                             const BlockChecks& blocks) {
+  name_ = name;
+  interface_ = std::move(iface);
+  const BlockLayout& push = interface_.pushConstants;
+  if (push.size && !blocks.pushConstants)
+    throw Error(ErrorKind::ShaderInterface, "",
+                name + ": the shader has push constants (block '" + push.name +
+                    "'); declare the C++ struct that mirrors it (BlockChecks::pushConstants)");
+  if (blocks.pushConstants) {
+    if (!push.size)
+      throw Error(ErrorKind::ShaderInterface, "",
+                  name + ": C++ push constants " + blocks.pushConstants->type +
+                      " are declared but the shader has none");
+    checkBlockLayout(push, *blocks.pushConstants, name);
+    cppPushSize_ = blocks.pushConstants->size;
+  }
+  for (const auto& [bindingName, cpp] : blocks.uniforms) {
+    const ShaderBinding* b = interface_.find(bindingName);
+    if (!b || b->block.members.empty())
+      throw Error(ErrorKind::ShaderInterface, "",
+                  name + ": no uniform or storage block '" + bindingName + "' in the shader (" +
+                      interface_.describe() + ")");
+    checkBlockLayout(b->block, cpp, name);
+  }
+  std::vector<Binding> bindings;
+  for (const ShaderBinding& b : interface_.bindings)
+    if (interface_.bound(b)) bindings.push_back({b.binding, b.type, b.count, VK_SHADER_STAGE_ALL});
+  createLayout(bindings, push.size);
+}
+
+void Pipeline::pushBytes(VkCommandBuffer cmd, const void* data, size_t size) const {
+  if (cppPushSize_ && size != cppPushSize_)
+    throw Error(ErrorKind::ShaderInterface, "",
+                name_ + ": pushed " + std::to_string(size) +
+                    " bytes of push constants, but the declared C++ struct is " +
+                    std::to_string(cppPushSize_));
+  if (size < pushRange_)
+    throw Error(ErrorKind::ShaderInterface, "",
+                name_ + ": pushed " + std::to_string(size) + " bytes, the shader's block is " +
+                    std::to_string(pushRange_));
+  vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_ALL, 0, pushRange_, data);
+}
+
+namespace {
+// The explicit bindings a pipeline is given must cover what its shader declares.
+void checkExplicitBindings(const std::vector<Binding>& given, const ShaderInterface& shader) {
+  for (const ShaderBinding& s : shader.bindings) {
+    if (!s.active) continue;  // unused: the explicit layout may leave it out
+    auto g = std::find_if(given.begin(), given.end(),
+                          [&](const Binding& b) { return b.binding == s.binding; });
+    if (g == given.end())
+      throw Error(ErrorKind::ShaderInterface, "",
+                  "shader " + shader.shader + ": binding " + std::to_string(s.binding) + " ('" +
+                      s.name + "') is missing from the pipeline's bindings");
+    if (g->type != s.type || g->count < s.count)
+      throw Error(ErrorKind::ShaderInterface, "",
+                  "shader " + shader.shader + ": binding " + std::to_string(s.binding) + " ('" +
+                      s.name + "') is a " + descriptorTypeName(s.type) + " of " +
+                      std::to_string(s.count) + ", the pipeline declares a " +
+                      descriptorTypeName(g->type) + " of " + std::to_string(g->count));
+  }
+}
+
+VkComputePipelineCreateInfo computeInfo(VkShaderModule module, VkPipelineLayout layout,
+                                        const VkSpecializationInfo* spec) {
+  VkComputePipelineCreateInfo info{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+  info.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+  info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+  info.stage.module = module;
+  info.stage.pName = "main";
+  info.stage.pSpecializationInfo = spec;
+  info.layout = layout;
+  return info;
+}
+
+VkPipeline createCompute(Context& ctx, const std::vector<uint32_t>& code, VkPipelineLayout layout,
+                         const std::vector<uint32_t>& specialization) {
+  VkShaderModule module = createModule(ctx.device(), code);
+  std::vector<VkSpecializationMapEntry> entries;
+  for (uint32_t i = 0; i < specialization.size(); ++i)
+    entries.push_back({i, i * uint32_t(sizeof(uint32_t)), sizeof(uint32_t)});
+  const VkSpecializationInfo spec{uint32_t(entries.size()), entries.data(),
+                                  specialization.size() * sizeof(uint32_t), specialization.data()};
+  const VkComputePipelineCreateInfo info =
+      computeInfo(module, layout, specialization.empty() ? nullptr : &spec);
+  VkPipeline pipeline = VK_NULL_HANDLE;
+  VkResult r =
+      vkCreateComputePipelines(ctx.device(), ctx.pipelineCache(), 1, &info, nullptr, &pipeline);
+  vkDestroyShaderModule(ctx.device(), module, nullptr);
+  check(r, "vkCreateComputePipelines");
+  return pipeline;
+}
+}  // namespace
+
+Pipeline Pipeline::compute(Context& ctx, const ComputeDesc& d) {
+  Pipeline p;
+  p.ctx_ = &ctx;
+  p.bindPoint_ = VK_PIPELINE_BIND_POINT_COMPUTE;
+  const std::vector<uint32_t> code = resolveShader(d.spirv);
+  p.useReflection(d.name, reflectShader(code, VK_SHADER_STAGE_COMPUTE_BIT, d.name), d.blocks);
+  p.pipeline_ = createCompute(ctx, code, p.layout_, d.specialization);
+  return p;
 }
 
 Pipeline Pipeline::compute(Context& ctx, const std::vector<uint32_t>& spirv,
@@ -44,24 +154,11 @@ Pipeline Pipeline::compute(Context& ctx, const std::vector<uint32_t>& spirv,
   Pipeline p;
   p.ctx_ = &ctx;
   p.bindPoint_ = VK_PIPELINE_BIND_POINT_COMPUTE;
+  const std::vector<uint32_t> code = resolveShader(spirv);
+  p.interface_ = reflectShader(code, VK_SHADER_STAGE_COMPUTE_BIT, "compute shader");
+  checkExplicitBindings(bindings, p.interface_);
   p.createLayout(bindings, pushConstantBytes);
-  VkShaderModule module = createModule(ctx.device(), spirv);
-  VkComputePipelineCreateInfo info{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
-  info.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
-  info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-  info.stage.module = module;
-  info.stage.pName = "main";
-  std::vector<VkSpecializationMapEntry> entries;
-  for (uint32_t i = 0; i < specialization.size(); ++i)
-    entries.push_back({i, i * uint32_t(sizeof(uint32_t)), sizeof(uint32_t)});
-  const VkSpecializationInfo spec{uint32_t(entries.size()), entries.data(),
-                                  specialization.size() * sizeof(uint32_t), specialization.data()};
-  if (!specialization.empty()) info.stage.pSpecializationInfo = &spec;
-  info.layout = p.layout_;
-  VkResult r =
-      vkCreateComputePipelines(ctx.device(), ctx.pipelineCache(), 1, &info, nullptr, &p.pipeline_);
-  vkDestroyShaderModule(ctx.device(), module, nullptr);
-  check(r, "vkCreateComputePipelines");
+  p.pipeline_ = createCompute(ctx, code, p.layout_, specialization);
   return p;
 }
 
@@ -69,10 +166,25 @@ Pipeline Pipeline::graphics(Context& ctx, const GraphicsDesc& d) {
   Pipeline p;
   p.ctx_ = &ctx;
   p.bindPoint_ = VK_PIPELINE_BIND_POINT_GRAPHICS;
-  p.createLayout(d.bindings, d.pushConstantBytes);
+  const std::vector<uint32_t> vertex = resolveShader(d.vertex),
+                              fragment = resolveShader(d.fragment);
+  const std::string label = d.name.empty() ? std::string("graphics pipeline") : d.name;
+  ShaderInterface iface =
+      mergeInterfaces(reflectShader(vertex, VK_SHADER_STAGE_VERTEX_BIT, label + " (vertex)"),
+                      reflectShader(fragment, VK_SHADER_STAGE_FRAGMENT_BIT, label + " (fragment)"));
+  if (d.name.empty()) {
+    checkExplicitBindings(d.bindings, iface);
+    p.interface_ = std::move(iface);
+    p.createLayout(d.bindings, d.pushConstantBytes);
+  } else {
+    if (!d.bindings.empty() || d.pushConstantBytes)
+      throw Error(ErrorKind::ShaderInterface, "",
+                  d.name + ": a named graphics pipeline takes its bindings from the shaders");
+    p.useReflection(d.name, std::move(iface), d.blocks);
+  }
 
-  VkShaderModule vs = createModule(ctx.device(), d.vertex);
-  VkShaderModule fs = createModule(ctx.device(), d.fragment);
+  VkShaderModule vs = createModule(ctx.device(), vertex);
+  VkShaderModule fs = createModule(ctx.device(), fragment);
   VkPipelineShaderStageCreateInfo stages[2] = {
       {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_VERTEX_BIT,
        vs, "main", nullptr},
@@ -153,6 +265,10 @@ Pipeline& Pipeline::operator=(Pipeline&& o) noexcept {
     layout_ = std::exchange(o.layout_, VK_NULL_HANDLE);
     pipeline_ = std::exchange(o.pipeline_, VK_NULL_HANDLE);
     bindPoint_ = o.bindPoint_;
+    interface_ = std::move(o.interface_);
+    name_ = std::move(o.name_);
+    cppPushSize_ = o.cppPushSize_;
+    pushRange_ = o.pushRange_;
   }
   return *this;
 }
@@ -237,7 +353,62 @@ DescriptorWriter& DescriptorWriter::buffer(uint32_t binding, VkDescriptorType ty
   return *this;
 }
 
+DescriptorWriter::DescriptorWriter(const Pipeline& pipeline) : pipeline_(&pipeline) {}
+
+const ShaderBinding* DescriptorWriter::named(std::string_view name, VkDescriptorType expected,
+                                             const char* call) const {
+  if (!pipeline_)
+    throw Error(ErrorKind::ShaderInterface, "",
+                std::string("DescriptorWriter::") + call + "('" + std::string(name) +
+                    "'): binding by name needs the writer made for a pipeline");
+  const ShaderInterface& iface = pipeline_->shaderInterface();
+  const ShaderBinding* b = iface.find(name);
+  if (!b)
+    throw Error(ErrorKind::ShaderInterface, "",
+                pipeline_->name() + ": the shader has no binding named '" + std::string(name) +
+                    "' (it has " + iface.describe() + ")");
+  const bool buffer =
+      b->type == VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER || b->type == VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+  const bool ok = expected == VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER ? buffer : b->type == expected;
+  if (!ok)
+    throw Error(ErrorKind::ShaderInterface, "",
+                pipeline_->name() + ": '" + b->name + "' is a " + descriptorTypeName(b->type) +
+                    ", not bound with " + call + "()");
+  return iface.bound(*b) ? b : nullptr;  // an unused alias of a used binding: nothing to write
+}
+
+DescriptorWriter& DescriptorWriter::texture(std::string_view name, VkImageView view,
+                                            VkSampler sampler, VkImageLayout layout,
+                                            uint32_t element) {
+  const ShaderBinding* b = named(name, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, "texture");
+  return b ? sampled(b->binding, view, sampler, layout, element) : *this;
+}
+
+DescriptorWriter& DescriptorWriter::image(std::string_view name, VkImageView view,
+                                          uint32_t element) {
+  const ShaderBinding* b = named(name, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, "image");
+  if (!b) return *this;
+  images_.push_back({VK_NULL_HANDLE, view, VK_IMAGE_LAYOUT_GENERAL});
+  pending_.push_back({b->binding, element, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, images_.size() - 1});
+  return *this;
+}
+
+DescriptorWriter& DescriptorWriter::buffer(std::string_view name, VkBuffer buffer,
+                                           VkDeviceSize offset, VkDeviceSize range) {
+  const ShaderBinding* b = named(name, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, "buffer");
+  return b ? this->buffer(b->binding, b->type, buffer, offset, range) : *this;
+}
+
 void DescriptorWriter::update(VkDevice device, VkDescriptorSet set) {
+  if (pipeline_)  // a binding the shader declares and nobody wrote is an error, not a crash
+    for (const ShaderBinding& b : pipeline_->shaderInterface().bindings)
+      if (pipeline_->shaderInterface().bound(b) &&
+          std::none_of(pending_.begin(), pending_.end(),
+                       [&](const Pending& p) { return p.binding == b.binding; }))
+        throw Error(ErrorKind::ShaderInterface, "",
+                    pipeline_->name() + ": binding '" + b.name + "' (" +
+                        descriptorTypeName(b.type) + ", binding " + std::to_string(b.binding) +
+                        ") was not given");
   std::vector<VkWriteDescriptorSet> writes;
   for (const Pending& p : pending_) {
     VkWriteDescriptorSet w{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};

@@ -60,9 +60,19 @@ class PassContext {
   // workgroups to cover `extent` (a compute pass's usual recording).
   void dispatch(const vk::Pipeline& pipeline, vk::DescriptorWriter& writer, VkExtent2D extent,
                 uint32_t groupX, uint32_t groupY) const;
+  // The same with `push` as the shader's push constants (vk::Pipeline::push checks its type).
+  template <class T>
+  void dispatch(const vk::Pipeline& pipeline, vk::DescriptorWriter& writer, VkExtent2D extent,
+                uint32_t groupX, uint32_t groupY, const T& push) const {
+    dispatchPushing(pipeline, writer, extent, groupX, groupY, &push, sizeof(T));
+  }
 
  private:
   friend class FrameGraph;
+  void dispatchGroups(VkExtent2D extent, uint32_t groupX, uint32_t groupY) const;
+  void dispatchPushing(const vk::Pipeline& pipeline, vk::DescriptorWriter& writer,
+                       VkExtent2D extent, uint32_t groupX, uint32_t groupY, const void* push,
+                       size_t size) const;
   const FrameGraph* graph_ = nullptr;
   vk::Context* ctx_ = nullptr;
   vk::DescriptorArena* descriptors_ = nullptr;

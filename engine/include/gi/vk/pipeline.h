@@ -5,10 +5,14 @@
 #include <vulkan/vulkan.h>
 
 #include <cstdint>
+#include <optional>
 #include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 #include "gi/vk/context.h"
+#include "gi/vk/shader_interface.h"
 
 namespace gi::vk {
 
@@ -35,8 +39,27 @@ struct VertexLayout {
   std::vector<VkVertexInputAttributeDescription> attributes;
 };
 
+// C++ structs that mirror a shader's blocks, checked against its reflected layout when the
+// pipeline is made (checkBlockLayout): the push constants and uniform blocks by binding name.
+struct BlockChecks {
+  std::optional<CppBlock> pushConstants;  // required when the shader has push constants
+  std::vector<std::pair<std::string, CppBlock>> uniforms;
+};
+
+// A compute pipeline whose descriptor layout and push-constant range are read from its SPIR-V.
+struct ComputeDesc {
+  std::string name;  // names the pipeline in errors, e.g. "ssao: ssao.comp"
+  std::vector<uint32_t> spirv;
+  std::vector<uint32_t> specialization;  // `layout(constant_id = i)` values
+  BlockChecks blocks;
+};
+
 struct GraphicsDesc {
   std::vector<uint32_t> vertex, fragment;
+  // With a name, the descriptor layout and push-constant range come from the shaders'
+  // reflection and `blocks` is checked (leave bindings and pushConstantBytes empty).
+  std::string name;
+  BlockChecks blocks;
   std::vector<Binding> bindings;
   uint32_t pushConstantBytes = 0;
   VertexLayout vertexLayout;
@@ -57,6 +80,8 @@ class Pipeline {
   static Pipeline compute(Context& ctx, const std::vector<uint32_t>& spirv,
                           const std::vector<Binding>& bindings, uint32_t pushConstantBytes = 0,
                           const std::vector<uint32_t>& specialization = {});
+  // Bindings and push-constant range from the shader's own reflection; `desc.blocks` checked.
+  static Pipeline compute(Context& ctx, const ComputeDesc& desc);
   static Pipeline graphics(Context& ctx, const GraphicsDesc& desc);
   ~Pipeline() { reset(); }
   Pipeline(Pipeline&& o) noexcept { *this = std::move(o); }
@@ -68,11 +93,26 @@ class Pipeline {
   VkPipelineLayout layout() const { return layout_; }
   VkDescriptorSetLayout setLayout() const { return setLayout_; }
   VkPipelineBindPoint bindPoint() const { return bindPoint_; }
+  // What the shaders declare (reflected from the SPIR-V the pipeline was built from).
+  const ShaderInterface& shaderInterface() const { return interface_; }
+  const std::string& name() const { return name_; }
+  // Pushes `value` as the shader's push constants. With a declared CppBlock, T must be that
+  // struct (its size is checked); the bytes beyond the shader's block (padding) are not sent.
+  template <class T>
+  void push(VkCommandBuffer cmd, const T& value) const {
+    pushBytes(cmd, &value, sizeof(T));
+  }
+  void pushBytes(VkCommandBuffer cmd, const void* data, size_t size) const;
   void reset();
 
  private:
   void createLayout(const std::vector<Binding>& bindings, uint32_t pushConstantBytes);
+  void useReflection(const std::string& name, ShaderInterface iface, const BlockChecks& blocks);
   Context* ctx_ = nullptr;
+  ShaderInterface interface_;
+  std::string name_;
+  size_t cppPushSize_ = 0;  // sizeof the declared push-constant struct (0: none declared)
+  uint32_t pushRange_ = 0;
   VkDescriptorSetLayout setLayout_ = VK_NULL_HANDLE;
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
   VkPipeline pipeline_ = VK_NULL_HANDLE;
@@ -101,9 +141,22 @@ class DescriptorArena {
   size_t current_ = 0;
 };
 
-// Collects descriptor writes for one set, then applies them in one call.
+// Collects descriptor writes for one set, then applies them in one call. Made for a pipeline,
+// it binds by the names its shader uses (the descriptor type follows from the shader) and
+// update() fails naming any binding left unwritten.
 class DescriptorWriter {
  public:
+  DescriptorWriter() = default;
+  explicit DescriptorWriter(const Pipeline& pipeline);
+  // A sampled texture (sampler2D ...), element `element` of an array.
+  DescriptorWriter& texture(std::string_view name, VkImageView view, VkSampler sampler,
+                            VkImageLayout layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                            uint32_t element = 0);
+  DescriptorWriter& image(std::string_view name, VkImageView view, uint32_t element = 0);
+  // A uniform or storage buffer (the shader says which).
+  DescriptorWriter& buffer(std::string_view name, VkBuffer buffer, VkDeviceSize offset = 0,
+                           VkDeviceSize range = VK_WHOLE_SIZE);
+
   DescriptorWriter& sampled(uint32_t binding, VkImageView view, VkSampler sampler,
                             VkImageLayout layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
                             uint32_t arrayElement = 0);
@@ -113,6 +166,9 @@ class DescriptorWriter {
   void update(VkDevice device, VkDescriptorSet set);
 
  private:
+  const ShaderBinding* named(std::string_view name, VkDescriptorType expected,
+                             const char* call) const;
+  const Pipeline* pipeline_ = nullptr;
   struct Pending {
     uint32_t binding, element;
     VkDescriptorType type;
