@@ -25,7 +25,10 @@ layout(constant_id = 2) const int MODE = 0;
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 // Keep in sync with gi::obscurance::Uniforms (obscurance_kernel.h).
 layout(set = 0, binding = 1) uniform ObscuranceParams {
-  vec4 params;  // radius, bias (world), filter depth tolerance (world), transfer guard
+  float radius;           // R, world units
+  float bias;             // absolute, world units
+  float filterTolerance;  // absolute, world units
+  float guard;            // the transfer's denominator guard
   vec4 rotation[16];
   uvec4 kernel[16];  // tap i: kernel[i / 4][i % 4], 11/11/10 bits (packTap)
 } obs;
@@ -88,7 +91,7 @@ void main() {
   vec3 Br = rot.x * B - rot.y * T;
 
   // Test points projected incrementally (x, y in pixels, w = view distance), as in ssao.comp.
-  float R = obs.params.x;
+  float R = obs.radius;
   vec2 halfSize = 0.5 * vec2(size);
   vec3 clipP = clipToPixels(P, p00, p11, p20, p21, halfSize),
        clipT = clipToPixels(R * Tr, p00, p11, p20, p21, halfSize),
@@ -109,7 +112,7 @@ void main() {
   }
 
   vec2 sizeF = vec2(size);
-  float bias = obs.params.y;
+  float bias = obs.bias;
   float nSum = 0.0, dSum = 0.0;
   vec3 sent = vec3(0.0);  // MODE 3: sum of (1 - J) L_d(y)
   for (int i = 0; i < SAMPLES; ++i) {
@@ -161,7 +164,7 @@ void main() {
   // averaged over the filter's window. Guard: the sums stay below the half-float maximum.
   vec3 rgb = vec3(0.0);
   if (MODE == 3) {
-    float eta = obs.params.w;
+    float eta = obs.guard;
     rgb = min(la * (sums.x + eta) + sent * invN, vec3(kMaxHalfSum));
     sums = vec2(rgb.r, sums.y + eta);
   }

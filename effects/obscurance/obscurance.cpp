@@ -118,38 +118,42 @@ class ObscuranceEffect : public gi::Effect {
   void prepare(gi::EffectContext& ctx, const gi::SettingValues& s) override {
     gi::vk::Context& vk = ctx.vulkan();
     vk.requireWorkgroup(kGroupX, kGroupY, "obscurance");
-    const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
-               tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-               img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+    using obs::Uniforms;
     const int mode = s.integer("transfer");
     filter_ = s.flag("filter");
     radiance_ = mode == int(obs::Transfer::Radiance);
-    if (radiance_) {
-      std::vector<gi::vk::Binding> bindings = gi::LitSurfaceInputs::layout(1);
-      bindings.insert(bindings.end(), {{0, ubo}, {6, img}, {7, img}});
+    if (radiance_)
       radiancePipeline_ = gi::vk::Pipeline::compute(
-          vk, words(std::begin(obscurance_radiance_comp), std::end(obscurance_radiance_comp)),
-          bindings);
-    }
+          vk, {"obscurance: obscurance_radiance.comp",
+               words(std::begin(obscurance_radiance_comp), std::end(obscurance_radiance_comp))});
+    const gi::vk::BlockChecks params{
+        {},
+        {{"obs", gi::vk::cppBlock<Uniforms>(
+                     "gi::obscurance::Uniforms",
+                     {GI_BLOCK_MEMBER(Uniforms, radius), GI_BLOCK_MEMBER(Uniforms, bias),
+                      GI_BLOCK_MEMBER(Uniforms, filterTolerance), GI_BLOCK_MEMBER(Uniforms, guard),
+                      GI_BLOCK_MEMBER(Uniforms, rotation), GI_BLOCK_MEMBER(Uniforms, kernel)})}}};
     main_ = gi::vk::Pipeline::compute(
-        vk, words(std::begin(obscurance_comp), std::end(obscurance_comp)),
-        {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {5, tex}, {6, img}}, 0,
-        {uint32_t(s.integer("samples")), uint32_t(s.integer("points_per_ray")), uint32_t(mode)});
-    const std::vector<gi::vk::Binding> filterBindings = {{0, ubo}, {1, ubo}, {2, tex}, {3, img}};
+        vk,
+        {"obscurance: obscurance.comp",
+         words(std::begin(obscurance_comp), std::end(obscurance_comp)),
+         {uint32_t(s.integer("samples")), uint32_t(s.integer("points_per_ray")), uint32_t(mode)},
+         params});
     const std::vector<uint32_t> filterSpec = {uint32_t(mode),
                                               uint32_t(filter_ ? kFilterRadius : 0)};
     filterX_ = gi::vk::Pipeline::compute(
-        vk, words(std::begin(obscurance_filter_comp), std::end(obscurance_filter_comp)),
-        filterBindings, 0, filterSpec);
-    resolve_ =
-        radiance_
-            ? gi::vk::Pipeline::compute(vk,
-                                        words(std::begin(obscurance_resolve_ambient_comp),
-                                              std::end(obscurance_resolve_ambient_comp)),
-                                        filterBindings, 0, filterSpec)
-            : gi::vk::Pipeline::compute(
-                  vk, words(std::begin(obscurance_resolve_comp), std::end(obscurance_resolve_comp)),
-                  filterBindings, 0, filterSpec);
+        vk, {"obscurance: obscurance_filter.comp",
+             words(std::begin(obscurance_filter_comp), std::end(obscurance_filter_comp)),
+             filterSpec, params});
+    resolve_ = gi::vk::Pipeline::compute(
+        vk, radiance_ ? gi::vk::ComputeDesc{"obscurance: obscurance_resolve_ambient.comp",
+                                            words(std::begin(obscurance_resolve_ambient_comp),
+                                                  std::end(obscurance_resolve_ambient_comp)),
+                                            filterSpec, params}
+                      : gi::vk::ComputeDesc{"obscurance: obscurance_resolve.comp",
+                                            words(std::begin(obscurance_resolve_comp),
+                                                  std::end(obscurance_resolve_comp)),
+                                            filterSpec, params});
     if (!uniforms_)
       uniforms_ =
           gi::vk::Buffer(vk, sizeof(obs::Uniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true);
@@ -168,7 +172,6 @@ class ObscuranceEffect : public gi::Effect {
     gi::Blackboard& bb = graph.blackboard();
     const VkBuffer frame = ctx.frameUniforms();
     const VkSampler nearest = ctx.nearestSampler();
-    const VkDescriptorType ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
     const bool radiance = radiance_;  // changesGraph: prepare() matched the transfer
 
     // transfer = radiance: the occluders' direct radiance, once per pixel, read by the taps in
@@ -185,11 +188,11 @@ class ObscuranceEffect : public gi::Effect {
             io->direct = b.write(b.create(res::kDirectLight, gi::TextureDesc{kRadianceFormat}),
                                  gi::TextureUsage::StorageWrite);
           },
-          [this, io, frame, nearest, ubo](gi::PassContext& pc) {
-            gi::vk::DescriptorWriter w;
-            w.buffer(0, ubo, frame);
-            io->surface.bind(w, pc, 1, nearest);
-            w.storageImage(6, pc.view(io->radiance)).storageImage(7, pc.view(io->direct));
+          [this, io, frame, nearest](gi::PassContext& pc) {
+            gi::vk::DescriptorWriter w(radiancePipeline_);
+            w.buffer("Frame", frame);
+            io->surface.bind(w, pc, nearest);
+            w.image("outRadiance", pc.view(io->radiance)).image("outDirect", pc.view(io->direct));
             pc.dispatch(radiancePipeline_, w, pc.extent(io->radiance), kGroupX, kGroupY);
           });
 
@@ -205,13 +208,13 @@ class ObscuranceEffect : public gi::Effect {
         },
         [this, io, values = &settings, frame, nearest](gi::PassContext& pc) {
           upload(*values);
-          gi::vk::DescriptorWriter w;
-          w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame)
-              .buffer(1, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms_.handle())
-              .sampled(2, pc.view(io->depth), nearest)
-              .sampled(3, pc.view(io->gbuffer), nearest)
-              .sampled(5, pc.view(io->sent), nearest)
-              .storageImage(6, pc.view(io->sums));
+          gi::vk::DescriptorWriter w(main_);
+          w.buffer("Frame", frame)
+              .buffer("obs", uniforms_.handle())
+              .texture("gDepth", pc.view(io->depth), nearest)
+              .texture("giGBuffer", pc.view(io->gbuffer), nearest)
+              .texture("gRadiance", pc.view(io->sent), nearest)
+              .image("outSums", pc.view(io->sums));
           const VkExtent2D e = pc.extent(io->sums);
           pc.dispatch(main_, w, e, kGroupX, kGroupY);
         });
@@ -234,11 +237,11 @@ class ObscuranceEffect : public gi::Effect {
           const VkExtent2D e = pc.extent(io->out);
           auto axis = [&](const gi::vk::Pipeline& p, VkImageView in, VkImageLayout inLayout,
                           VkImageView out) {
-            gi::vk::DescriptorWriter w;
-            w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame)
-                .buffer(1, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms_.handle())
-                .sampled(2, in, nearest, inLayout)
-                .storageImage(3, out);
+            gi::vk::DescriptorWriter w(p);
+            w.buffer("Frame", frame)
+                .buffer("obs", uniforms_.handle())
+                .texture("inSums", in, nearest, inLayout)
+                .image("outImage", out);
             pc.dispatch(p, w, e, kGroupX, kGroupY);
           };
           if (!filter) {

@@ -22,7 +22,10 @@ layout(constant_id = 1) const int RADIUS = 2;  // 2: the 4x4 box; 0: no filterin
 
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 layout(set = 0, binding = 1) uniform ObscuranceParams {
-  vec4 params;  // radius, bias (world), filter depth tolerance (world), transfer guard
+  float radius;           // R, world units
+  float bias;             // absolute, world units
+  float filterTolerance;  // absolute, world units
+  float guard;            // the transfer's denominator guard
   vec4 rotation[16];
   uvec4 kernel[16];
 } obs;
@@ -48,7 +51,7 @@ void store(ivec2 p, vec4 sums, uvec4 centre) {
   if (MODE != 0) {
     // Guarded transfer ratio (obscurance_kernel.h: the phantom open sample): finite, in [0, 1]
     // for albedo in [0, 1] since N <= D, and 1 when every ray is closed by white occluders.
-    float eta = obs.params.w;
+    float eta = obs.guard;
     w = (sums.x + eta) / (sums.y + eta);
     if (MODE == 2) w = clamp(w, 0.0, 1.0);
   }
@@ -73,7 +76,7 @@ void main() {
     return;
   }
   float slope = dot(unpackHalf2x16(c.z), vec2(axis));
-  float tol = obs.params.z;
+  float tol = obs.filterTolerance;
   float weights = 1.0;
   for (int o = -RADIUS; o <= RADIUS; ++o) {
     if (o == 0) continue;

@@ -30,6 +30,8 @@ struct LitSurfaceInputs {
   // Binds them (textures with `nearest`, a nearest-filtering sampler: the packed texels are
   // integers) while the pass records.
   void bind(vk::DescriptorWriter& w, PassContext& pc, uint32_t first, VkSampler nearest) const;
+  // The same by the names gbuffer.glsl and lights.glsl declare (`w` made for the pipeline).
+  void bind(vk::DescriptorWriter& w, PassContext& pc, VkSampler nearest) const;
 };
 
 }  // namespace gi

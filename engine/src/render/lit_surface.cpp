@@ -28,4 +28,12 @@ void LitSurfaceInputs::bind(vk::DescriptorWriter& w, PassContext& pc, uint32_t f
       .sampled(first + 4, pc.view(shadowMaps), nearest);
 }
 
+void LitSurfaceInputs::bind(vk::DescriptorWriter& w, PassContext& pc, VkSampler nearest) const {
+  w.texture("giDepth", pc.view(depth), nearest)
+      .texture("giGBuffer", pc.view(gbuffer), nearest)
+      .buffer("Lights", pc.buffer(lights))
+      .buffer("ShadowViews", pc.buffer(shadowViews))
+      .texture("shadowMaps", pc.view(shadowMaps), nearest);
+}
+
 }  // namespace gi
