@@ -57,6 +57,27 @@ constexpr VkFormat kLayersFormat = VK_FORMAT_R32_UINT;  // layers 2 and 3: two h
 constexpr uint32_t kGroupX = 32, kGroupY = 16;          // local_size of every SSDO shader
 constexpr int kMaxContactSamples = 16;
 
+// A pipeline of one of the SSDO shaders; those that read ssdo_common.glsl's SsdoParams check it
+// against gi::ssdo::Uniforms.
+template <size_t N>
+gi::vk::ComputeDesc shader(const char* name, const uint32_t (&words)[N],
+                           std::vector<uint32_t> constants, bool readsParams = true) {
+  using gi::ssdo::Uniforms;
+  gi::vk::ComputeDesc d{
+      std::string("ssdo: ") + name, {std::begin(words), std::end(words)}, std::move(constants)};
+  if (readsParams)
+    d.blocks.uniforms = {
+        {"ssdo",
+         gi::vk::cppBlock<Uniforms>(
+             "gi::ssdo::Uniforms",
+             {GI_BLOCK_MEMBER(Uniforms, radius), GI_BLOCK_MEMBER(Uniforms, bias),
+              GI_BLOCK_MEMBER(Uniforms, bounceScale), GI_BLOCK_MEMBER(Uniforms, distanceClamp2),
+              GI_BLOCK_MEMBER(Uniforms, blurTolerance), GI_BLOCK_MEMBER(Uniforms, blurMinCos),
+              GI_BLOCK_MEMBER(Uniforms, pad0), GI_BLOCK_MEMBER(Uniforms, pad1),
+              GI_BLOCK_MEMBER(Uniforms, cameras), GI_BLOCK_MEMBER(Uniforms, samples)})}};
+  return d;
+}
+
 // Bit masks of the light types present and of those with shadow maps (1 directional, 2 point,
 // 4 spot), as the lighting pass's specialization constants.
 std::array<uint32_t, 2> lightMasks(const std::vector<gi::LightInfo>& lights) {
@@ -158,9 +179,6 @@ class SsdoEffect : public gi::Effect {
   void prepare(gi::EffectContext& ctx, const gi::SettingValues& settings) override {
     gi::vk::Context& vk = ctx.vulkan();
     vk.requireWorkgroup(kGroupX, kGroupY, "ssdo");
-    const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
-               tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-               img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
     bounce_ = settings.flag("bounce");
     samples_ = uint32_t(std::clamp(settings.integer("samples"), 1, gi::ssdo::kMaxSamples));
     layers_ = uint32_t(std::clamp(settings.integer("layers"), 1, gi::ssdo::kMaxLayers));
@@ -178,20 +196,14 @@ class SsdoEffect : public gi::Effect {
         uint32_t(std::clamp(settings.integer("blur_radius"), 0, gi::ssdo::kMaxBlurRadius)),
         bounce_ ? 1u : 0u, settings.flag("blur_normals") ? 1u : 0u};
     blurX_ =
-        gi::vk::Pipeline::compute(vk, {std::begin(ssdo_blur_x_comp), std::end(ssdo_blur_x_comp)},
-                                  {{0, ubo}, {1, ubo}, {2, tex}, {3, img}}, 0, blurConstants);
-    resolve_ =
-        bounce_
-            ? gi::vk::Pipeline::compute(
-                  vk, {std::begin(ssdo_resolve_comp), std::end(ssdo_resolve_comp)},
-                  {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {5, img}, {6, img}}, 0, blurConstants)
-            : gi::vk::Pipeline::compute(
-                  vk, {std::begin(ssdo_resolve_ambient_comp), std::end(ssdo_resolve_ambient_comp)},
-                  {{0, ubo}, {1, ubo}, {2, tex}, {5, img}}, 0, blurConstants);
+        gi::vk::Pipeline::compute(vk, shader("ssdo_blur_x.comp", ssdo_blur_x_comp, blurConstants));
+    resolve_ = gi::vk::Pipeline::compute(
+        vk, bounce_
+                ? shader("ssdo_resolve.comp", ssdo_resolve_comp, blurConstants)
+                : shader("ssdo_resolve_ambient.comp", ssdo_resolve_ambient_comp, blurConstants));
     if (layers_ > 2)
-      layersPipeline_ =
-          gi::vk::Pipeline::compute(vk, {std::begin(ssdo_layers_comp), std::end(ssdo_layers_comp)},
-                                    {{0, ubo}, {1, tex}, {2, tex}, {3, img}}, 0, {layers_});
+      layersPipeline_ = gi::vk::Pipeline::compute(
+          vk, shader("ssdo_layers.comp", ssdo_layers_comp, {layers_}, false));
     if (!uniforms_)
       uniforms_ =
           gi::vk::Buffer(vk, sizeof(gi::ssdo::Uniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true);
@@ -203,11 +215,7 @@ class SsdoEffect : public gi::Effect {
                          VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false);
     if (environmentSampling_ == 2)
       environmentSamplesPipeline_ = gi::vk::Pipeline::compute(
-          vk, {std::begin(ssdo_env_samples_comp), std::end(ssdo_env_samples_comp)},
-          {{0, tex},
-           {1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
-           {2, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}},
-          0, {});
+          vk, shader("ssdo_env_samples.comp", ssdo_env_samples_comp, {}, false));
   }
 
   // The additional cameras (seed 000 §4): displaced from the viewer by camera_displacement x
@@ -271,7 +279,6 @@ class SsdoEffect : public gi::Effect {
     const int blurRadius = settings.integer("blur_radius");  // changesGraph: fixed per graph
     const VkBuffer frame = ctx.frameUniforms();
     const VkSampler nearest = ctx.nearestSampler();
-    const VkDescriptorType ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
     gi::GpuScene& scene = ctx.scene();
     // The lights, their shadow views and maps: read by every pass that sums or tests lights.
     auto readLights = [&](gi::PassBuilder& b) {
@@ -357,7 +364,7 @@ class SsdoEffect : public gi::Effect {
                                  gi::TextureDesc{kOutFormat, gi::SizeClass::Absolute, 1.0f, 1, 1}),
                         gi::TextureUsage::StorageWrite);
           },
-          [this, io, values = &settings, nearest, ubo, n, c = &ctx](gi::PassContext& pc) {
+          [this, io, values = &settings, nearest, n, c = &ctx](gi::PassContext& pc) {
             upload(*values);
             const auto masks = lightMasks(c->lights());
             if (masks != surfaceMasks_ || pcfRadius(*c) != pcf_) buildSurface(*c, masks);
@@ -365,13 +372,13 @@ class SsdoEffect : public gi::Effect {
               const std::vector<gi::TextureHandle>& g = io->camG[k];  // packed, motion
               const gi::LitSurfaceInputs camera{io->camDepth[k], g[0], io->shadowMaps, io->lights,
                                                 io->shadowViews};
-              gi::vk::DescriptorWriter w;
-              w.buffer(0, ubo, views_[k]->buffer()).buffer(1, ubo, uniforms_.handle());
-              camera.bind(w, pc, 2, nearest);
-              w.storageImage(10, pc.view(io->camSurface[k]))
-                  .sampled(11, pc.view(io->camDepth[k]), nearest)   // unused: one layer
-                  .storageImage(12, pc.view(io->camDirect))         // unused
-                  .sampled(13, pc.view(io->camDepth[k]), nearest);  // unused: no contact
+              gi::vk::DescriptorWriter w(cameraSurface_);
+              w.buffer("Frame", views_[k]->buffer()).buffer("ssdo", uniforms_.handle());
+              camera.bind(w, pc, nearest);
+              w.image("outSurface", pc.view(io->camSurface[k]))
+                  .texture("gLayer1", pc.view(io->camDepth[k]), nearest)    // unused: one layer
+                  .image("outDirect", pc.view(io->camDirect))               // unused
+                  .texture("gContact", pc.view(io->camDepth[k]), nearest);  // unused: no contact
               pc.dispatch(cameraSurface_, w, pc.extent(io->camSurface[k]), kGroupX, kGroupY);
             }
           });
@@ -390,18 +397,18 @@ class SsdoEffect : public gi::Effect {
                 b.write(b.create(res::kContactShadow, gi::TextureDesc{VK_FORMAT_R8G8B8A8_UNORM}),
                         gi::TextureUsage::StorageWrite);
           },
-          [this, io, frame, nearest, ubo, c = &ctx](gi::PassContext& pc) {
+          [this, io, frame, nearest, c = &ctx](gi::PassContext& pc) {
             const auto masks = lightMasks(c->lights());
             if (masks != contactMasks_) buildContact(*c, masks);
-            gi::vk::DescriptorWriter w;
-            w.buffer(0, ubo, frame)
-                .buffer(1, ubo, uniforms_.handle())
-                .sampled(2, pc.view(io->depth), nearest)
-                .buffer(3, ubo, pc.buffer(io->lights))
-                .buffer(4, ubo, pc.buffer(io->shadowViews))
-                .sampled(5, pc.view(io->shadowMaps), nearest)
-                .storageImage(6, pc.view(io->contact))
-                .sampled(7, pc.view(io->gbuffer), nearest);
+            gi::vk::DescriptorWriter w(contactPipeline_);
+            w.buffer("Frame", frame)
+                .buffer("ssdo", uniforms_.handle())
+                .texture("gDepth", pc.view(io->depth), nearest)
+                .buffer("Lights", pc.buffer(io->lights))
+                .buffer("ShadowViews", pc.buffer(io->shadowViews))
+                .texture("shadowMaps", pc.view(io->shadowMaps), nearest)
+                .image("outContact", pc.view(io->contact))
+                .texture("giGBuffer", pc.view(io->gbuffer), nearest);
             pc.dispatch(contactPipeline_, w, pc.extent(io->contact), kGroupX, kGroupY);
           });
       if (!bounce_) bb.put(res::kContactShadow, io->contact);
@@ -428,7 +435,7 @@ class SsdoEffect : public gi::Effect {
                                      gi::TextureUsage::StorageWrite);
             }
           },
-          [this, io, values = &settings, frame, nearest, ubo, c = &ctx](gi::PassContext& pc) {
+          [this, io, values = &settings, frame, nearest, c = &ctx](gi::PassContext& pc) {
             upload(*values);
             // Light types and the environment's kind can change without a graph rebuild: the
             // specialized pipelines follow (built here, before the dispatches that use them).
@@ -437,25 +444,25 @@ class SsdoEffect : public gi::Effect {
             const uint32_t kind = environmentKind(c->frame());
             if (kind != environmentKind_) buildSsdo(*c, kind);
             const gi::TextureHandle depth = io->litInputs.depth;
-            gi::vk::DescriptorWriter w;
-            w.buffer(0, ubo, frame).buffer(1, ubo, uniforms_.handle());
-            io->litInputs.bind(w, pc, 2, nearest);
-            w.storageImage(10, pc.view(io->surface))
+            gi::vk::DescriptorWriter w(surface_);
+            w.buffer("Frame", frame).buffer("ssdo", uniforms_.handle());
+            io->litInputs.bind(w, pc, nearest);
+            w.image("outSurface", pc.view(io->surface))
                 // The peeled layer (unused with one layer: the depth stands in).
-                .sampled(11, pc.view(layers_ > 1 ? io->peeled[0] : depth), nearest)
+                .texture("gLayer1", pc.view(layers_ > 1 ? io->peeled[0] : depth), nearest)
                 // direct_light and the contact shadows (unused without the bounce and without
                 // contact shadows: the surface and the depth stand in).
-                .storageImage(12, pc.view(io->direct))
-                .sampled(13, pc.view(bounce_ && contact_ ? io->contact : depth), nearest);
+                .image("outDirect", pc.view(io->direct))
+                .texture("gContact", pc.view(bounce_ && contact_ ? io->contact : depth), nearest);
             const VkExtent2D e = pc.extent(io->surface);
             pc.dispatch(surface_, w, e, kGroupX, kGroupY);
             if (layers_ > 2) {
               // Layers 2 and 3 into one R32UI texel (with 3 layers, layer 2 stands in for 3).
-              gi::vk::DescriptorWriter l;
-              l.buffer(0, ubo, frame)
-                  .sampled(1, pc.view(io->peeled[1]), nearest)
-                  .sampled(2, pc.view(io->peeled[layers_ > 3 ? 2 : 1]), nearest)
-                  .storageImage(3, pc.view(io->layers23));
+              gi::vk::DescriptorWriter l(layersPipeline_);
+              l.buffer("Frame", frame)
+                  .texture("gLayer2", pc.view(io->peeled[1]), nearest)
+                  .texture("gLayer3", pc.view(io->peeled[layers_ > 3 ? 2 : 1]), nearest)
+                  .image("outLayers", pc.view(io->layers23));
               pc.dispatch(layersPipeline_, l, e, kGroupX, kGroupY);
             }
           });
@@ -477,11 +484,10 @@ class SsdoEffect : public gi::Effect {
             // Only an equirect map is read per direction (the kind may change at run time
             // without a graph rebuild, as in the ssdo pass).
             if (environmentKind(c->frame()) != 2) return;
-            const auto ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-            gi::vk::DescriptorWriter w;
-            w.sampled(0, pc.view(io->envMap), nearest)
-                .buffer(1, ssbo, pc.buffer(io->envSampling))
-                .buffer(2, ssbo, pc.buffer(io->envSamples));
+            gi::vk::DescriptorWriter w(environmentSamplesPipeline_);
+            w.texture("giEnvironmentMap", pc.view(io->envMap), nearest)
+                .buffer("giEnvironment", pc.buffer(io->envSampling))
+                .buffer("Samples", pc.buffer(io->envSamples));
             pc.dispatch(environmentSamplesPipeline_, w, {uint32_t(kEnvironmentSlots), 1}, 64, 1);
           });
     }
@@ -505,32 +511,35 @@ class SsdoEffect : public gi::Effect {
           io->raw = b.write(b.create("ssdo_raw", gi::TextureDesc{kPackedFormat}),
                             gi::TextureUsage::StorageWrite);
         },
-        [this, io, values = &settings, frame, nearest, ubo, c = &ctx](gi::PassContext& pc) {
+        [this, io, values = &settings, frame, nearest, c = &ctx](gi::PassContext& pc) {
           if (depthInput()) {  // what ssdo_surface's callback does otherwise
             upload(*values);
             const uint32_t kind = environmentKind(c->frame());
             if (kind != environmentKind_) buildSsdo(*c, kind);
-            gi::vk::DescriptorWriter w;
-            w.buffer(0, ubo, frame)
-                .buffer(1, ubo, uniforms_.handle())
-                .storageImage(3, pc.view(io->raw))
-                .sampled(9, pc.view(io->depth), nearest)
-                .sampled(10, pc.view(io->gbuffer), nearest);
+            gi::vk::DescriptorWriter w(ssdo_);
+            w.buffer("Frame", frame)
+                .buffer("ssdo", uniforms_.handle())
+                .image("outRaw", pc.view(io->raw))
+                .texture("gDepth", pc.view(io->depth), nearest)
+                .texture("giGBuffer", pc.view(io->gbuffer), nearest);
             bindEnvironment(w, pc, *io, nearest);
             pc.dispatch(ssdo_, w, pc.extent(io->raw), kGroupX, kGroupY);
             return;
           }
           uploadCameras(c->frame());
-          gi::vk::DescriptorWriter w;
-          w.buffer(0, ubo, frame)
-              .buffer(1, ubo, uniforms_.handle())
-              .sampled(2, pc.view(io->surface), nearest)
-              .storageImage(3, pc.view(io->raw));
+          gi::vk::DescriptorWriter w(ssdo_);
+          w.buffer("Frame", frame)
+              .buffer("ssdo", uniforms_.handle())
+              .texture("gSurface", pc.view(io->surface), nearest)
+              .image("outRaw", pc.view(io->raw));
+          const char* cameraInputs[] = {"gCamera0", "gCamera1", "gCamera2", "gCamera3"};
+          static_assert(std::size(cameraInputs) == gi::ssdo::kMaxCameras);
           for (uint32_t k = 0; k < gi::ssdo::kMaxCameras; ++k)
-            w.sampled(4 + k, pc.view(k < io->camSurface.size() ? io->camSurface[k] : io->surface),
+            w.texture(cameraInputs[k],
+                      pc.view(k < io->camSurface.size() ? io->camSurface[k] : io->surface),
                       nearest);
           // Layers 2 and 3 (unused with up to 2 layers: the surface stands in).
-          w.sampled(8, pc.view(layers_ > 2 ? io->layers23 : io->surface), nearest);
+          w.texture("gLayers23", pc.view(layers_ > 2 ? io->layers23 : io->surface), nearest);
           bindEnvironment(w, pc, *io, nearest);
           pc.dispatch(ssdo_, w, pc.extent(io->raw), kGroupX, kGroupY);
         });
@@ -554,29 +563,30 @@ class SsdoEffect : public gi::Effect {
             io->indirect = b.write(b.create(res::kIndirect, gi::TextureDesc{kOutFormat}),
                                    gi::TextureUsage::StorageWrite);
         },
-        [this, io, frame, nearest, ubo, blurRadius](gi::PassContext& pc) {
+        [this, io, frame, nearest, blurRadius](gi::PassContext& pc) {
           const VkExtent2D e = pc.extent(io->ambient);
           VkImageView in = pc.view(io->raw);
           VkImageLayout inLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
           if (blurRadius > 0) {
-            gi::vk::DescriptorWriter w;
-            w.buffer(0, ubo, frame)
-                .buffer(1, ubo, uniforms_.handle())
-                .sampled(2, in, nearest, inLayout)
-                .storageImage(3, pc.view(io->half));
+            gi::vk::DescriptorWriter w(blurX_);
+            w.buffer("Frame", frame)
+                .buffer("ssdo", uniforms_.handle())
+                .texture("inRaw", in, nearest, inLayout)
+                .image("outRaw", pc.view(io->half));
             pc.dispatch(blurX_, w, e, kGroupX, kGroupY);
             // The y dispatch reads what the x dispatch wrote (the image stays GENERAL).
             gi::vk::storageWriteToSampledRead(pc.cmd(), pc.image(io->half));
             in = pc.view(io->half);
             inLayout = VK_IMAGE_LAYOUT_GENERAL;
           }
-          gi::vk::DescriptorWriter w;
-          w.buffer(0, ubo, frame)
-              .buffer(1, ubo, uniforms_.handle())
-              .sampled(2, in, nearest, inLayout)
-              .storageImage(5, pc.view(io->ambient));
+          gi::vk::DescriptorWriter w(resolve_);
+          w.buffer("Frame", frame)
+              .buffer("ssdo", uniforms_.handle())
+              .texture("inRaw", in, nearest, inLayout)
+              .image("outAmbient", pc.view(io->ambient));
           if (bounce_)
-            w.sampled(3, pc.view(io->gbuffer), nearest).storageImage(6, pc.view(io->indirect));
+            w.texture("giGBuffer", pc.view(io->gbuffer), nearest)
+                .image("outIndirect", pc.view(io->indirect));
           pc.dispatch(resolve_, w, e, kGroupX, kGroupY);
         });
     bb.put(res::kAmbient, io->ambient);
@@ -590,16 +600,14 @@ class SsdoEffect : public gi::Effect {
   // Directional occlusion alone (no bounce, one layer, no cameras): the taps need only depth.
   bool depthInput() const { return !bounce_ && layers_ == 1 && cameras_ == 0; }
 
-  // The environment map and its importance-sampling tables (ssdo.glsl's bindings 11 and 12).
+  // The environment map, its importance-sampling tables and the MIS samples (ssdo.glsl).
   template <class Io>
   void bindEnvironment(gi::vk::DescriptorWriter& w, gi::PassContext& pc, const Io& io,
                        VkSampler sampler) const {
-    const auto ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    w.sampled(11, pc.view(io.envMap), sampler)
-        .buffer(12, ssbo, pc.buffer(io.envSampling))
-        .buffer(
-            13, ssbo,
-            environmentSampling_ == 2 ? pc.buffer(io.envSamples) : environmentSamples_.handle());
+    w.texture("giEnvironmentMap", pc.view(io.envMap), sampler)
+        .buffer("giEnvironment", pc.buffer(io.envSampling))
+        .buffer("EnvironmentSamples", environmentSampling_ == 2 ? pc.buffer(io.envSamples)
+                                                                : environmentSamples_.handle());
   }
 
   static uint32_t environmentKind(const gi::FrameUniforms& f) {
@@ -607,51 +615,19 @@ class SsdoEffect : public gi::Effect {
   }
 
   void buildSsdo(gi::EffectContext& ctx, uint32_t kind) {
-    const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
-               tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-               img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-    const auto ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
     const std::vector<uint32_t> constants = {samples_, bounce_ ? 1u : 0u, kind,
                                              layers_,  cameras_,          environmentSampling_};
-    ssdo_ =
-        depthInput()
-            ? gi::vk::Pipeline::compute(ctx.vulkan(),
-                                        {std::begin(ssdo_depth_comp), std::end(ssdo_depth_comp)},
-                                        {{0, ubo},
-                                         {1, ubo},
-                                         {3, img},
-                                         {9, tex},
-                                         {10, tex},
-                                         {11, tex},
-                                         {12, ssbo},
-                                         {13, ssbo}},
-                                        0, constants)
-            : gi::vk::Pipeline::compute(ctx.vulkan(), {std::begin(ssdo_comp), std::end(ssdo_comp)},
-                                        {{0, ubo},
-                                         {1, ubo},
-                                         {2, tex},
-                                         {3, img},
-                                         {4, tex},
-                                         {5, tex},
-                                         {6, tex},
-                                         {7, tex},
-                                         {8, tex},
-                                         {11, tex},
-                                         {12, ssbo},
-                                         {13, ssbo}},
-                                        0, constants);
+    ssdo_ = gi::vk::Pipeline::compute(
+        ctx.vulkan(), depthInput() ? shader("ssdo_depth.comp", ssdo_depth_comp, constants)
+                                   : shader("ssdo.comp", ssdo_comp, constants));
     environmentKind_ = kind;
   }
 
   // The contact-shadow pipeline, specialized to the sample count and the light types present.
   void buildContact(gi::EffectContext& ctx, std::array<uint32_t, 2> masks) {
-    const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
-               tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-               img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
     contactPipeline_ = gi::vk::Pipeline::compute(
-        ctx.vulkan(), {std::begin(ssdo_contact_comp), std::end(ssdo_contact_comp)},
-        {{0, ubo}, {1, ubo}, {2, tex}, {3, ubo}, {4, ubo}, {5, tex}, {6, img}, {7, tex}}, 0,
-        {contactSamples_, masks[0], masks[1]});
+        ctx.vulkan(),
+        shader("ssdo_contact.comp", ssdo_contact_comp, {contactSamples_, masks[0], masks[1]}));
     contactMasks_ = masks;
   }
 
@@ -665,19 +641,13 @@ class SsdoEffect : public gi::Effect {
   // additional cameras (one layer; their senders' lights with a 1-tap shadow test), specialized
   // to the light types present.
   void buildSurface(gi::EffectContext& ctx, std::array<uint32_t, 2> masks) {
-    const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
-               tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-               img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
     pcf_ = pcfRadius(ctx);
     auto build = [&](uint32_t layers, bool mainView) {
       const bool direct = mainView && bounce_;
-      std::vector<gi::vk::Binding> bindings = gi::LitSurfaceInputs::layout(2);  // 2..6
-      bindings.insert(bindings.end(),
-                      {{0, ubo}, {1, ubo}, {10, img}, {11, tex}, {12, img}, {13, tex}});
       return gi::vk::Pipeline::compute(
-          ctx.vulkan(), {std::begin(ssdo_surface_comp), std::end(ssdo_surface_comp)}, bindings, 0,
-          {bounce_ ? 1u : 0u, masks[0], masks[1], layers, mainView ? pcf_ : 0u, direct ? 1u : 0u,
-           direct && contact_ ? 1u : 0u});
+          ctx.vulkan(), shader("ssdo_surface.comp", ssdo_surface_comp,
+                               {bounce_ ? 1u : 0u, masks[0], masks[1], layers, mainView ? pcf_ : 0u,
+                                direct ? 1u : 0u, direct && contact_ ? 1u : 0u}));
     };
     surface_ = build(layers_, true);
     if (cameras_ > 0) cameraSurface_ = build(1, false);

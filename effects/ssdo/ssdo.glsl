@@ -174,7 +174,7 @@ void main() {
   mat3 toWorld = mat3(frame.invView);
   vec3 Tw = toWorld * T, Bw = toWorld * B, Nw = toWorld * N;  // world frame of the samples
 
-  float R = ssdo.params.x;
+  float R = ssdo.radius;
   vec2 halfSize = 0.5 * vec2(size);
   vec3 clipP = clipToPixels(P, p00, p11, p20, p21, halfSize),
        clipT = clipToPixels(R * T, p00, p11, p20, p21, halfSize),
@@ -189,8 +189,8 @@ void main() {
   float minK = -kSlideMinK * max(-P.z, 1e-20);
 
   vec2 sizeF = vec2(size);
-  float bias = ssdo.params.y;
-  float dMin2 = ssdo.params.w;
+  float bias = ssdo.bias;
+  float dMin2 = ssdo.distanceClamp2;
   int base = ((p.y & 3) * 4 + (p.x & 3)) * 32;
   // Sky: the radiance depends on the world direction's y only, y = up . (T' kx + B' ky + N kz).
   vec3 up = vec3(Tw.y, Bw.y, Nw.y);
@@ -368,7 +368,7 @@ void main() {
   if (kEnvironmentKind == 2 && kEnvironmentSampling == 0)
     direct = shFromMoments(direct.x, m1, m2, m2x, mat3(Tw, Bw, Nw));
   direct *= 1.0 / float(kSamples);
-  bounce *= ssdo.params.z;
+  bounce *= ssdo.bounceScale;
   imageStore(outRaw, p,
              uvec4(packRgb9e5(direct), packRgb9e5(bounce), centre.x, packBlurNormal(N)));
 }

@@ -40,7 +40,7 @@ void ssdoBlur(ivec2 p, ivec2 size, uvec4 centre, out vec3 direct, out vec3 bounc
   vec2 dD = 2.0 * invSize / vec2(p00, p11);
   vec2 slopes = nd < -1e-4 * length(D) ? ic * N.xy * dD / nd : vec2(0.0);
   float slope = GI_BLUR_AXIS == 0 ? slopes.x : slopes.y;
-  float tol = ssdo.blur.x, minCos2 = ssdo.blur.y * ssdo.blur.y;
+  float tol = ssdo.blurTolerance, minCos2 = ssdo.blurMinCos * ssdo.blurMinCos;
   direct = unpackRgb9e5(centre.x);
   bounce = kBounceTerm ? unpackRgb9e5(centre.y) : vec3(0.0);
   float weights = 1.0;

@@ -20,8 +20,13 @@ struct SsdoCamera {
 };
 
 layout(set = 0, binding = 1, std140) uniform SsdoParams {
-  vec4 params;      // R, bias (world), bounce scale A_s / pi, d_min^2
-  vec4 blur;        // plane tolerance (world), min normal cosine
+  float radius;          // R, world units
+  float bias;            // absolute (world)
+  float bounceScale;     // A_s / pi
+  float distanceClamp2;  // d_min^2 of the bounce's 1 / max(d^2, d_min^2)
+  float blurTolerance;   // plane tolerance (world)
+  float blurMinCos;      // min normal cosine
+  float pad0, pad1;
   SsdoCamera cameras[4];  // the `cameras` first are valid (gi::ssdo::kMaxCameras)
   uvec4 samples[128];  // [phase][i] at flat phase * 32 + i (gi::ssdo::pack)
 } ssdo;

@@ -54,7 +54,7 @@ struct Uniforms {
   float distanceClamp2;  // d_min^2 of the bounce's 1 / max(d^2, d_min^2)
   float blurTolerance;   // absolute (kBlurPlaneTolerance x R)
   float blurMinCos;
-  float pad[2];
+  float pad0, pad1;
   Camera cameras[kMaxCameras];                     // written every frame by the plugin
   uint32_t samples[kPhases * kMaxSamples / 4][4];  // [phase][i] at flat phase * kMaxSamples + i
 };
