@@ -45,6 +45,43 @@ constexpr VkFormat kRawFormat = VK_FORMAT_R32G32B32A32_UINT;
 constexpr VkFormat kAtlasFormat = VK_FORMAT_R32_UINT;
 constexpr VkFormat kOutFormat = VK_FORMAT_R16G16B16A16_SFLOAT;
 constexpr uint32_t kGroupX = 32, kGroupY = 16;
+
+// A pipeline of one of the ISM shaders; those that read ism_common.glsl's IsmParams check it
+// against gi::ism::Uniforms, and `Push` (when given) against the shader's push constants.
+template <size_t N>
+gi::vk::ComputeDesc shader(const char* name, const uint32_t (&words)[N],
+                           std::vector<uint32_t> constants = {}, bool readsParams = true) {
+  using gi::ism::Uniforms;
+  gi::vk::ComputeDesc d{
+      std::string("ism: ") + name, {std::begin(words), std::end(words)}, std::move(constants)};
+  if (readsParams)
+    d.blocks.uniforms = {
+        {"ism", gi::vk::cppBlock<Uniforms>(
+                    "gi::ism::Uniforms",
+                    {GI_BLOCK_MEMBER(Uniforms, rsm), GI_BLOCK_MEMBER(Uniforms, atlas),
+                     GI_BLOCK_MEMBER(Uniforms, bias), GI_BLOCK_MEMBER(Uniforms, pull),
+                     GI_BLOCK_MEMBER(Uniforms, gather), GI_BLOCK_MEMBER(Uniforms, blur),
+                     GI_BLOCK_MEMBER(Uniforms, envSphere), GI_BLOCK_MEMBER(Uniforms, envVpls)})}};
+  return d;
+}
+
+// The push constants of ism_splat.comp, ism_pull_push.comp, ism_classic_views.comp,
+// ism_irsm.glsl and ism_bounce.comp.
+struct SplatPush {
+  int32_t base, firstTile;
+};
+struct PullPushPush {
+  int32_t tileBegin, tileEnd, firstBlockRow;
+};
+struct ClassicViewsPush {
+  int32_t first, count, firstTile;
+};
+struct IrsmPush {
+  int32_t base;
+};
+struct BouncePush {
+  int32_t bounce;
+};
 // Debug view of the shadow-map atlas (distances, R32F); its pass runs only when it is viewed.
 constexpr const char* kAtlasView = "ism_atlas";
 constexpr VkDeviceSize kVplBytes = 3 * sizeof(glm::vec4);
@@ -218,100 +255,75 @@ class IsmEffect : public gi::Effect {
       ctx.requestSurfacePoints(uint32_t(
           std::min<uint64_t>(uint64_t(c.tiles()) * uint64_t(c.perIsm), gi::ism::kMaxPoints)));
 
-    const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
-               tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-               img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    auto spv = [](const uint32_t* b, const uint32_t* e) { return std::vector<uint32_t>(b, e); };
-    vpl_ = gi::vk::Pipeline::compute(
-        vk, spv(std::begin(ism_vpl_comp), std::end(ism_vpl_comp)),
-        {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, tex}, {5, ssbo}, {6, ssbo}});
+    using gi::vk::cppBlock;
+    auto make = [&](gi::vk::ComputeDesc d, std::optional<gi::vk::CppBlock> push = {}) {
+      d.blocks.pushConstants = std::move(push);
+      return gi::vk::Pipeline::compute(vk, d);
+    };
+    const auto splatPush = cppBlock<SplatPush>(
+        "SplatPush", {GI_BLOCK_MEMBER(SplatPush, base), GI_BLOCK_MEMBER(SplatPush, firstTile)});
+    const auto irsmPush = cppBlock<IrsmPush>("IrsmPush", {GI_BLOCK_MEMBER(IrsmPush, base)});
+    vpl_ = make(shader("ism_vpl.comp", ism_vpl_comp));
     if (c.classic) {
       auto views = [&](bool ortho) {
-        return gi::vk::Pipeline::compute(
-            vk, spv(std::begin(ism_classic_views_comp), std::end(ism_classic_views_comp)),
-            {{1, ubo}, {2, ubo}, {3, ssbo}}, 3 * sizeof(int32_t), {uint32_t(ortho)});
+        return make(shader("ism_classic_views.comp", ism_classic_views_comp, {uint32_t(ortho)}),
+                    cppBlock<ClassicViewsPush>("ClassicViewsPush",
+                                               {GI_BLOCK_MEMBER(ClassicViewsPush, first),
+                                                GI_BLOCK_MEMBER(ClassicViewsPush, count),
+                                                GI_BLOCK_MEMBER(ClassicViewsPush, firstTile)}));
       };
       classicViews_ = views(false);
       if (c.env > 0) envClassicViews_ = views(true);
     }
     if (!c.classic) {
-      splat_ =
-          gi::vk::Pipeline::compute(vk, spv(std::begin(ism_splat_comp), std::end(ism_splat_comp)),
-                                    {{1, ubo}, {2, ubo}, {3, ssbo}, {4, img}}, 2 * sizeof(int32_t),
-                                    {uint32_t(c.splat), uint32_t(wrap ? 1 : 0), 0u});
+      splat_ = make(
+          shader("ism_splat.comp", ism_splat_comp, {uint32_t(c.splat), uint32_t(wrap ? 1 : 0), 0u}),
+          splatPush);
       if (c.env > 0)
-        envSplat_ = gi::vk::Pipeline::compute(
-            vk, spv(std::begin(ism_splat_comp), std::end(ism_splat_comp)),
-            {{1, ubo}, {2, ubo}, {3, ssbo}, {4, img}}, 2 * sizeof(int32_t),
-            {uint32_t(c.splat), uint32_t(wrap ? 1 : 0), 1u});
+        envSplat_ = make(shader("ism_splat.comp", ism_splat_comp,
+                                {uint32_t(c.splat), uint32_t(wrap ? 1 : 0), 1u}),
+                         splatPush);
       if (c.levels > 0)
-        pullPush_ = gi::vk::Pipeline::compute(
-            vk, spv(std::begin(ism_pull_push_comp), std::end(ism_pull_push_comp)),
-            {{1, ubo}, {2, img}}, 3 * sizeof(int32_t), {uint32_t(c.levels)});
+        pullPush_ = make(
+            shader("ism_pull_push.comp", ism_pull_push_comp, {uint32_t(c.levels)}),
+            cppBlock<PullPushPush>("PullPushPush", {GI_BLOCK_MEMBER(PullPushPush, tileBegin),
+                                                    GI_BLOCK_MEMBER(PullPushPush, tileEnd),
+                                                    GI_BLOCK_MEMBER(PullPushPush, firstBlockRow)}));
     }
-    if (c.env > 0)
-      envVpl_ = gi::vk::Pipeline::compute(
-          vk, spv(std::begin(ism_env_vpl_comp), std::end(ism_env_vpl_comp)),
-          {{1, ubo}, {2, tex}, {3, ssbo}, {4, ssbo}});
+    if (c.env > 0) envVpl_ = make(shader("ism_env_vpl.comp", ism_env_vpl_comp));
     if (c.bounces > 1) {
       const uint32_t entries = gi::ism::irsmEntries(c.perIsm), wraps = wrap ? 1 : 0;
       irsm_ = c.classic
-                  ? gi::vk::Pipeline::compute(
-                        vk, spv(std::begin(ism_irsm_classic_comp), std::end(ism_irsm_classic_comp)),
-                        {{1, ubo}, {2, ubo}, {3, ssbo}, {4, ssbo}, {5, tex}, {6, ssbo}, {7, ssbo}},
-                        sizeof(int32_t), {entries, wraps})
-                  : gi::vk::Pipeline::compute(
-                        vk, spv(std::begin(ism_irsm_comp), std::end(ism_irsm_comp)),
-                        {{1, ubo}, {2, ubo}, {3, ssbo}, {4, ssbo}, {5, tex}, {6, ssbo}, {7, ssbo}},
-                        sizeof(int32_t), {entries, wraps});
-      bounce_ =
-          gi::vk::Pipeline::compute(vk, spv(std::begin(ism_bounce_comp), std::end(ism_bounce_comp)),
-                                    {{1, ubo}, {3, ssbo}, {6, ssbo}, {7, ssbo}, {8, ssbo}},
-                                    sizeof(int32_t), {uint32_t(c.vpls), entries, wraps});
+                  ? make(shader("ism_irsm_classic.comp", ism_irsm_classic_comp, {entries, wraps}),
+                         irsmPush)
+                  : make(shader("ism_irsm.comp", ism_irsm_comp, {entries, wraps}), irsmPush);
+      bounce_ = make(shader("ism_bounce.comp", ism_bounce_comp, {uint32_t(c.vpls), entries, wraps}),
+                     cppBlock<BouncePush>("BouncePush", {GI_BLOCK_MEMBER(BouncePush, bounce)}));
     }
-    atlasView_ = c.classic
-                     ? gi::vk::Pipeline::compute(vk,
-                                                 spv(std::begin(ism_classic_atlas_view_comp),
-                                                     std::end(ism_classic_atlas_view_comp)),
-                                                 {{0, tex}, {1, img}})
-                     : gi::vk::Pipeline::compute(
-                           vk, spv(std::begin(ism_atlas_view_comp), std::end(ism_atlas_view_comp)),
-                           {{0, tex}, {1, img}});
+    atlasView_ =
+        c.classic
+            ? make(shader("ism_classic_atlas_view.comp", ism_classic_atlas_view_comp, {}, false))
+            : make(shader("ism_atlas_view.comp", ism_atlas_view_comp, {}, false));
     const std::vector<uint32_t> gatherSpec = {uint32_t(c.perPixel),
                                               uint32_t(c.block),
                                               uint32_t(c.scale),
                                               uint32_t(c.glossy),
                                               glm::floatBitsToUint(c.phong),
                                               uint32_t(c.envPerPixel)};
-    const std::vector<gi::vk::Binding> gatherBindings = {{0, ubo}, {1, ubo}, {2, ubo}, {3, tex},
-                                                         {4, tex}, {5, tex}, {6, img}, {8, ubo}};
-    gather_ =
-        c.classic
-            ? gi::vk::Pipeline::compute(
-                  vk, spv(std::begin(ism_gather_classic_comp), std::end(ism_gather_classic_comp)),
-                  gatherBindings, 0, gatherSpec)
-            : gi::vk::Pipeline::compute(vk,
-                                        spv(std::begin(ism_gather_comp), std::end(ism_gather_comp)),
-                                        gatherBindings, 0, gatherSpec);
+    gather_ = c.classic
+                  ? make(shader("ism_gather_classic.comp", ism_gather_classic_comp, gatherSpec))
+                  : make(shader("ism_gather.comp", ism_gather_comp, gatherSpec));
     // K taps from -K/2 cover each phase of a K-periodic pattern exactly once.
     const int lo = -c.block / 2 - c.blurExtra, hi = c.block - 1 - c.block / 2 + c.blurExtra;
     const std::vector<uint32_t> blurSpec = {uint32_t(lo), uint32_t(hi), uint32_t(c.scale),
                                             uint32_t(c.glossy)};
-    blurX_ =
-        gi::vk::Pipeline::compute(vk, spv(std::begin(ism_blur_x_comp), std::end(ism_blur_x_comp)),
-                                  {{0, ubo}, {1, ubo}, {2, tex}, {3, img}}, 0, blurSpec);
+    blurX_ = make(shader("ism_blur_x.comp", ism_blur_x_comp, blurSpec));
     if (c.scale == 1) {
-      blurY_ = gi::vk::Pipeline::compute(
-          vk, spv(std::begin(ism_blur_y_comp), std::end(ism_blur_y_comp)),
-          {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {5, img}}, 0, blurSpec);
+      blurY_ = make(shader("ism_blur_y.comp", ism_blur_y_comp, blurSpec));
     } else {
-      blurY_ = gi::vk::Pipeline::compute(
-          vk, spv(std::begin(ism_blur_y_low_comp), std::end(ism_blur_y_low_comp)),
-          {{0, ubo}, {1, ubo}, {2, tex}, {3, img}}, 0, blurSpec);
-      upsample_ = gi::vk::Pipeline::compute(
-          vk, spv(std::begin(ism_upsample_comp), std::end(ism_upsample_comp)),
-          {{0, ubo}, {1, ubo}, {2, tex}, {3, tex}, {4, tex}, {7, img}}, 0,
-          {uint32_t(c.scale), uint32_t(c.glossy)});
+      blurY_ = make(shader("ism_blur_y_low.comp", ism_blur_y_low_comp, blurSpec));
+      upsample_ = make(
+          shader("ism_upsample.comp", ism_upsample_comp, {uint32_t(c.scale), uint32_t(c.glossy)}));
     }
     if (!uniforms_)
       uniforms_ =
@@ -340,7 +352,6 @@ class IsmEffect : public gi::Effect {
     const Config c = cfg_;
     const VkBuffer frame = ctx.frameUniforms();
     const VkSampler nearest = ctx.nearestSampler();
-    const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
     const VkBuffer params = uniforms_.handle();
     // The gathering's resolution (gather_scale): the raw and blurred textures.
     const gi::TextureDesc rawDesc{kRawFormat, gi::SizeClass::OutputRelative, 1.0f / float(c.scale)};
@@ -386,15 +397,15 @@ class IsmEffect : public gi::Effect {
               gi::BufferUsage::StorageWrite);
           io->vpls = b.write(io->vpls, gi::BufferUsage::StorageWrite);
         },
-        [this, io, frame, nearest, params, ubo, ssbo](gi::PassContext& pc) {
-          gi::vk::DescriptorWriter w;
-          w.buffer(0, ubo, frame)
-              .buffer(1, ubo, params)
-              .sampled(2, pc.view(io->rsmPos), nearest)
-              .sampled(3, pc.view(io->rsmNormal), nearest)
-              .sampled(4, pc.view(io->rsmFlux), nearest)
-              .buffer(5, ssbo, pc.buffer(io->cdf))
-              .buffer(6, ssbo, pc.buffer(io->vpls));
+        [this, io, frame, nearest, params](gi::PassContext& pc) {
+          gi::vk::DescriptorWriter w(vpl_);
+          w.buffer("Frame", frame)
+              .buffer("ism", params)
+              .texture("rsmPosition", pc.view(io->rsmPos), nearest)
+              .texture("rsmNormal", pc.view(io->rsmNormal), nearest)
+              .texture("rsmFlux", pc.view(io->rsmFlux), nearest)
+              .buffer("Cdf", pc.buffer(io->cdf))
+              .buffer("Vpls", pc.buffer(io->vpls));
           pc.dispatch(vpl_, w, {1, 1}, 1, 1);
         });
 
@@ -468,9 +479,9 @@ class IsmEffect : public gi::Effect {
               gi::TextureUsage::StorageWrite);
         },
         [this, io, nearest](gi::PassContext& pc) {
-          gi::vk::DescriptorWriter w;
-          w.sampled(0, pc.view(io->atlas, gi::Subresource::mipLevel(0)), nearest)
-              .storageImage(1, pc.view(io->atlasView));
+          gi::vk::DescriptorWriter w(atlasView_);
+          w.texture("atlas", pc.view(io->atlas, gi::Subresource::mipLevel(0)), nearest)
+              .image("view", pc.view(io->atlasView));
           pc.dispatch(atlasView_, w, pc.extent(io->atlasView), kGroupX, kGroupY);
         });
     bb.put(kAtlasView, io->atlasView);
@@ -486,16 +497,16 @@ class IsmEffect : public gi::Effect {
           if (c.env > 0) io->envVpls = b.read(io->envVpls, gi::BufferUsage::Uniform);
           io->raw = b.write(b.create("ism_raw", rawDesc), gi::TextureUsage::StorageWrite);
         },
-        [this, io, c, frame, nearest, params, ubo](gi::PassContext& pc) {
-          gi::vk::DescriptorWriter w;
-          w.buffer(0, ubo, frame)
-              .buffer(1, ubo, params)
-              .buffer(2, ubo, pc.buffer(io->vpls))
-              .sampled(3, pc.view(io->depth), nearest)
-              .sampled(4, pc.view(io->gbuffer), nearest)
-              .sampled(5, pc.view(io->atlas, gi::Subresource::mipLevel(0)), nearest)
-              .storageImage(6, pc.view(io->raw))
-              .buffer(8, ubo, c.env > 0 ? pc.buffer(io->envVpls) : envBuffer_.handle());
+        [this, io, c, frame, nearest, params](gi::PassContext& pc) {
+          gi::vk::DescriptorWriter w(gather_);
+          w.buffer("Frame", frame)
+              .buffer("ism", params)
+              .buffer("Vpls", pc.buffer(io->vpls))
+              .texture("gDepth", pc.view(io->depth), nearest)
+              .texture("giGBuffer", pc.view(io->gbuffer), nearest)
+              .texture("maps", pc.view(io->atlas, gi::Subresource::mipLevel(0)), nearest)
+              .image("outRaw", pc.view(io->raw))
+              .buffer("EnvVpls", c.env > 0 ? pc.buffer(io->envVpls) : envBuffer_.handle());
           pc.descriptors().bind(pc.cmd(), gather_, w);
           const VkExtent2D e = pc.extent(io->raw);
           const uint32_t k = uint32_t(c.block);
@@ -518,39 +529,39 @@ class IsmEffect : public gi::Effect {
           io->indirect = b.write(b.create(res::kIndirect, gi::TextureDesc{kOutFormat}),
                                  gi::TextureUsage::StorageWrite);
         },
-        [this, io, c, frame, nearest, params, ubo](gi::PassContext& pc) {
+        [this, io, c, frame, nearest, params](gi::PassContext& pc) {
           const VkExtent2D e = pc.extent(io->indirect), low = pc.extent(io->half);
-          gi::vk::DescriptorWriter x;
-          x.buffer(0, ubo, frame)
-              .buffer(1, ubo, params)
-              .sampled(2, pc.view(io->raw), nearest)
-              .storageImage(3, pc.view(io->half));
+          gi::vk::DescriptorWriter x(blurX_);
+          x.buffer("Frame", frame)
+              .buffer("ism", params)
+              .texture("inRaw", pc.view(io->raw), nearest)
+              .image("outRaw", pc.view(io->half));
           pc.dispatch(blurX_, x, low, kGroupX, kGroupY);
           gi::vk::storageWriteToSampledRead(pc.cmd(), pc.image(io->half));
           if (c.scale > 1) {  // y at the gathering's resolution, then upsampled and reflected
-            gi::vk::DescriptorWriter y;
-            y.buffer(0, ubo, frame)
-                .buffer(1, ubo, params)
-                .sampled(2, pc.view(io->half), nearest, VK_IMAGE_LAYOUT_GENERAL)
-                .storageImage(3, pc.view(io->low));
+            gi::vk::DescriptorWriter y(blurY_);
+            y.buffer("Frame", frame)
+                .buffer("ism", params)
+                .texture("inRaw", pc.view(io->half), nearest, VK_IMAGE_LAYOUT_GENERAL)
+                .image("outRaw", pc.view(io->low));
             pc.dispatch(blurY_, y, low, kGroupX, kGroupY);
             gi::vk::storageWriteToSampledRead(pc.cmd(), pc.image(io->low));
-            gi::vk::DescriptorWriter u;
-            u.buffer(0, ubo, frame)
-                .buffer(1, ubo, params)
-                .sampled(2, pc.view(io->low), nearest, VK_IMAGE_LAYOUT_GENERAL)
-                .sampled(3, pc.view(io->depth), nearest)
-                .sampled(4, pc.view(io->gbuffer), nearest)
-                .storageImage(7, pc.view(io->indirect));
+            gi::vk::DescriptorWriter u(upsample_);
+            u.buffer("Frame", frame)
+                .buffer("ism", params)
+                .texture("lowRaw", pc.view(io->low), nearest, VK_IMAGE_LAYOUT_GENERAL)
+                .texture("gDepth", pc.view(io->depth), nearest)
+                .texture("giGBuffer", pc.view(io->gbuffer), nearest)
+                .image("outIndirect", pc.view(io->indirect));
             pc.dispatch(upsample_, u, e, kGroupX, kGroupY);
             return;
           }
-          gi::vk::DescriptorWriter y;
-          y.buffer(0, ubo, frame)
-              .buffer(1, ubo, params)
-              .sampled(2, pc.view(io->half), nearest, VK_IMAGE_LAYOUT_GENERAL)
-              .sampled(3, pc.view(io->gbuffer), nearest)
-              .storageImage(5, pc.view(io->indirect));
+          gi::vk::DescriptorWriter y(blurY_);
+          y.buffer("Frame", frame)
+              .buffer("ism", params)
+              .texture("inRaw", pc.view(io->half), nearest, VK_IMAGE_LAYOUT_GENERAL)
+              .texture("giGBuffer", pc.view(io->gbuffer), nearest)
+              .image("outIndirect", pc.view(io->indirect));
           pc.dispatch(blurY_, y, e, kGroupX, kGroupY);
         });
     bb.put(res::kIndirect, io->indirect);
@@ -574,16 +585,13 @@ class IsmEffect : public gi::Effect {
   template <class IoT>
   void splatTiles(gi::PassContext& pc, const gi::vk::Pipeline& pipeline, gi::BufferHandle vpls,
                   const IoT& io, int first, int firstTile, int count) {
-    const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    const std::array<int32_t, 2> range = {first, firstTile};
-    vkCmdPushConstants(pc.cmd(), pipeline.layout(), VK_SHADER_STAGE_ALL, 0, sizeof range,
-                       range.data());
-    gi::vk::DescriptorWriter w;
-    w.buffer(1, ubo, uniforms_.handle())
-        .buffer(2, ubo, pc.buffer(vpls))
-        .buffer(3, ssbo, pc.buffer(io.points))
-        .storageImage(4, pc.view(io.atlas, gi::Subresource::mipLevel(0)));
-    pc.dispatch(pipeline, w, {uint32_t(cfg_.perIsm), uint32_t(count)}, 256, 1);
+    gi::vk::DescriptorWriter w(pipeline);
+    w.buffer("ism", uniforms_.handle())
+        .buffer("Vpls", pc.buffer(vpls))
+        .buffer("Points", pc.buffer(io.points))
+        .image("atlas", pc.view(io.atlas, gi::Subresource::mipLevel(0)));
+    pc.dispatch(pipeline, w, {uint32_t(cfg_.perIsm), uint32_t(count)}, 256, 1,
+                SplatPush{first, firstTile});
   }
 
   // Pull-push over tiles [first, end) (one bounce's VPLs, or the environment VPLs).
@@ -602,13 +610,10 @@ class IsmEffect : public gi::Effect {
           // Only the 64-texel block rows that hold the range's tile rows.
           const int rowBegin = first / c.perRow * c.res / 64;
           const int rowEnd = ((end - 1) / c.perRow + 1) * c.res;  // texel row past the range
-          const std::array<int32_t, 3> tiles = {first, end, rowBegin};
-          vkCmdPushConstants(pc.cmd(), pullPush_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof tiles,
-                             tiles.data());
-          gi::vk::DescriptorWriter w;
-          w.buffer(1, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms_.handle())
-              .storageImage(2, pc.view(io->atlas));
+          gi::vk::DescriptorWriter w(pullPush_);
+          w.buffer("ism", uniforms_.handle()).image("atlas", pc.view(io->atlas));
           pc.descriptors().bind(pc.cmd(), pullPush_, w);
+          pullPush_.push(pc.cmd(), PullPushPush{first, end, rowBegin});
           const VkExtent2D e = pc.extent(io->atlas);
           vkCmdDispatch(pc.cmd(), (e.width + 63) / 64, uint32_t((rowEnd + 63) / 64 - rowBegin), 1);
         });
@@ -622,7 +627,6 @@ class IsmEffect : public gi::Effect {
   void addEnvironmentVpls(gi::FrameGraph& graph, gi::EffectContext& ctx, const IoPtr& io) {
     const Config c = cfg_;
     gi::Blackboard& bb = graph.blackboard();
-    const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
     io->envVpls = graph.importBuffer("ism_env_vpls", envBuffer_.handle(), envBuffer_.size());
     graph.addPass(
         "ism_env_vpl",
@@ -632,12 +636,12 @@ class IsmEffect : public gi::Effect {
               b.read(bb.buffer(res::kEnvironmentSampling), gi::BufferUsage::StorageRead);
           io->envVpls = b.write(io->envVpls, gi::BufferUsage::StorageWrite);
         },
-        [this, io, c, ubo, ssbo](gi::PassContext& pc) {
-          gi::vk::DescriptorWriter w;
-          w.buffer(1, ubo, uniforms_.handle())
-              .sampled(2, pc.view(io->envMap), nearest_)
-              .buffer(3, ssbo, pc.buffer(io->envSampling))
-              .buffer(4, ssbo, pc.buffer(io->envVpls));
+        [this, io, c](gi::PassContext& pc) {
+          gi::vk::DescriptorWriter w(envVpl_);
+          w.buffer("ism", uniforms_.handle())
+              .texture("giEnvironmentMap", pc.view(io->envMap), nearest_)
+              .buffer("giEnvironment", pc.buffer(io->envSampling))
+              .buffer("EnvVpls", pc.buffer(io->envVpls));
           pc.dispatch(envVpl_, w, {uint32_t(c.envPadded), 1}, 64, 1);
         });
     if (c.classic) {
@@ -715,15 +719,12 @@ class IsmEffect : public gi::Effect {
         },
         [this, io, r, mine](gi::PassContext& pc) {
           const gi::vk::Pipeline& p = r.environment ? envClassicViews_ : classicViews_;
-          const std::array<int32_t, 3> range = {r.first, r.count, r.firstTile};
-          vkCmdPushConstants(pc.cmd(), p.layout(), VK_SHADER_STAGE_ALL, 0, sizeof range,
-                             range.data());
-          gi::vk::DescriptorWriter w;
-          w.buffer(1, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms_.handle())
-              .buffer(2, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
-                      pc.buffer(r.environment ? io->envVpls : io->vpls))
-              .buffer(3, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, pc.buffer(*mine));
-          pc.dispatch(p, w, {uint32_t(r.count), 1}, 64, 1);
+          gi::vk::DescriptorWriter w(p);
+          w.buffer("ism", uniforms_.handle())
+              .buffer("Vpls", pc.buffer(r.environment ? io->envVpls : io->vpls))
+              .buffer("Views", pc.buffer(*mine));
+          pc.dispatch(p, w, {uint32_t(r.count), 1}, 64, 1,
+                      ClassicViewsPush{r.first, r.count, r.firstTile});
         });
     graph.addPass(
         prefix + "_classic_sm" + r.suffix,
@@ -750,7 +751,6 @@ class IsmEffect : public gi::Effect {
     const Config c = cfg_;
     const std::string n = std::to_string(bounce + 1);
     const uint32_t entries = gi::ism::irsmEntries(c.perIsm), cellsPerVpl = (entries + 255) / 256;
-    const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
     // This bounce's own IRSM buffers (a member of io would name the last bounce's by the time
     // the passes run: every pass is set up first).
     struct Irsm {
@@ -776,17 +776,16 @@ class IsmEffect : public gi::Effect {
           if (c.classic) {  // no splat pass sets the point count
             uploadPointCount(pc, io->points);
           }
-          const int32_t base = (bounce - 1) * c.vpls;
-          vkCmdPushConstants(pc.cmd(), irsm_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof base, &base);
-          gi::vk::DescriptorWriter w;
-          w.buffer(1, ubo, uniforms_.handle())
-              .buffer(2, ubo, pc.buffer(io->vpls))
-              .buffer(3, ssbo, pc.buffer(io->points))
-              .buffer(4, ssbo, materials)
-              .sampled(5, pc.view(io->atlas, gi::Subresource::mipLevel(0)), nearest_)
-              .buffer(6, ssbo, pc.buffer(own->irsm))
-              .buffer(7, ssbo, pc.buffer(own->cells));
-          pc.dispatch(irsm_, w, {entries, uint32_t(c.vpls)}, 256, 1);
+          gi::vk::DescriptorWriter w(irsm_);
+          w.buffer("ism", uniforms_.handle())
+              .buffer("Vpls", pc.buffer(io->vpls))
+              .buffer("Points", pc.buffer(io->points))
+              .buffer("Materials", materials)
+              .texture("maps", pc.view(io->atlas, gi::Subresource::mipLevel(0)), nearest_)
+              .buffer("Irsm", pc.buffer(own->irsm))
+              .buffer("Cells", pc.buffer(own->cells));
+          pc.dispatch(irsm_, w, {entries, uint32_t(c.vpls)}, 256, 1,
+                      IrsmPush{(bounce - 1) * c.vpls});
         });
     graph.addPass(
         "ism_bounce" + n,
@@ -800,15 +799,13 @@ class IsmEffect : public gi::Effect {
           io->vpls = b.write(io->vpls, gi::BufferUsage::StorageWrite);
         },
         [this, io, own, bounce](gi::PassContext& pc) {
-          const int32_t b = bounce;
-          vkCmdPushConstants(pc.cmd(), bounce_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof b, &b);
-          gi::vk::DescriptorWriter w;
-          w.buffer(1, ubo, uniforms_.handle())
-              .buffer(3, ssbo, pc.buffer(io->points))
-              .buffer(6, ssbo, pc.buffer(own->irsm))
-              .buffer(7, ssbo, pc.buffer(own->cells))
-              .buffer(8, ssbo, pc.buffer(io->vpls));
-          pc.dispatch(bounce_, w, {1, 1}, 1, 1);
+          gi::vk::DescriptorWriter w(bounce_);
+          w.buffer("ism", uniforms_.handle())
+              .buffer("Points", pc.buffer(io->points))
+              .buffer("Irsm", pc.buffer(own->irsm))
+              .buffer("Cdf", pc.buffer(own->cells))
+              .buffer("VplsOut", pc.buffer(io->vpls));
+          pc.dispatch(bounce_, w, {1, 1}, 1, 1, BouncePush{bounce});
         });
   }
 
