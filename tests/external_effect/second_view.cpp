@@ -54,19 +54,9 @@ class SecondViewEffect : public gi::Effect {
   void prepare(gi::EffectContext& ctx, const gi::SettingValues&) override {
     if (!view_) view_ = ctx.createView();
     if (!light_.handle()) {
-      const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-                 tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
       light_ = gi::vk::Pipeline::compute(
-          ctx.vulkan(), {std::begin(second_view_light_comp), std::end(second_view_light_comp)},
-          {{0, ubo},
-           {1, tex},
-           {2, tex},
-           {3, ubo},
-           {4, ubo},
-           {5, tex},
-           {6, tex},
-           {7, ssbo},
-           {8, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE}});
+          ctx.vulkan(), {"second_view: second_view_light.comp",
+                         {std::begin(second_view_light_comp), std::end(second_view_light_comp)}});
     }
   }
   void update(gi::EffectContext& ctx, const gi::SettingValues& settings) override {
@@ -176,19 +166,17 @@ class SecondViewEffect : public gi::Effect {
         },
         [this, io, frame = ctx.frameUniforms(),
          nearest = ctx.nearestSampler()](gi::PassContext& pc) {
-          gi::vk::DescriptorWriter w;
-          w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame)
-              .sampled(1, pc.view(io->depth), nearest)
-              .sampled(2, pc.view(io->gbuffer), nearest)
-              .buffer(3, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, pc.buffer(io->lights))
-              .buffer(4, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, pc.buffer(io->shadowViews))
-              .sampled(5, pc.view(io->shadowMaps), nearest)
-              .sampled(6, pc.view(io->environment), nearest)
-              .buffer(7, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, pc.buffer(io->sampling))
-              .storageImage(8, pc.view(io->out));
-          pc.descriptors().bind(pc.cmd(), light_, w);
-          const VkExtent2D e = pc.extent(io->out);
-          vkCmdDispatch(pc.cmd(), (e.width + 15) / 16, (e.height + 15) / 16, 1);
+          gi::vk::DescriptorWriter w(light_);
+          w.buffer("Frame", frame)
+              .texture("gDepth", pc.view(io->depth), nearest)
+              .texture("giGBuffer", pc.view(io->gbuffer), nearest)
+              .buffer("Lights", pc.buffer(io->lights))
+              .buffer("ShadowViews", pc.buffer(io->shadowViews))
+              .texture("shadowMaps", pc.view(io->shadowMaps), nearest)
+              .texture("giEnvironmentMap", pc.view(io->environment), nearest)
+              .buffer("giEnvironment", pc.buffer(io->sampling))
+              .image("outIrradiance", pc.view(io->out));
+          pc.dispatch(light_, w, pc.extent(io->out), 16, 16);
         });
     bb.put("second_view_irradiance", io->out);
   }

@@ -32,12 +32,11 @@ class VignetteEffect : public gi::Effect {
   }
 
   void prepare(gi::EffectContext& ctx, const gi::SettingValues&) override {
-    const std::vector<uint32_t> spirv(std::begin(vignette_comp), std::end(vignette_comp));
-    pipeline_ = gi::vk::Pipeline::compute(ctx.vulkan(), spirv,
-                                          {{0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
-                                           {1, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER},
-                                           {2, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE}},
-                                          sizeof(Params));
+    gi::vk::ComputeDesc desc{"vignette: vignette.comp",
+                             {std::begin(vignette_comp), std::end(vignette_comp)}};
+    desc.blocks.pushConstants = gi::vk::cppBlock<Params>(
+        "Params", {GI_BLOCK_MEMBER(Params, strength), GI_BLOCK_MEMBER(Params, radius)});
+    pipeline_ = gi::vk::Pipeline::compute(ctx.vulkan(), desc);
   }
 
   void addPasses(gi::FrameGraph& graph, gi::EffectContext& ctx,
@@ -58,16 +57,12 @@ class VignetteEffect : public gi::Effect {
         // uniform-only changes apply without a graph rebuild.
         [this, io, values = &settings, frame = ctx.frameUniforms(),
          sampler = ctx.nearestSampler()](gi::PassContext& pc) {
-          gi::vk::DescriptorWriter writer;
-          writer.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame)
-              .sampled(1, pc.view(io->in), sampler)
-              .storageImage(2, pc.view(io->out));
-          pc.descriptors().bind(pc.cmd(), pipeline_, writer);
+          gi::vk::DescriptorWriter writer(pipeline_);
+          writer.buffer("Frame", frame)
+              .texture("litColor", pc.view(io->in), sampler)
+              .image("outColor", pc.view(io->out));
           const Params params{float(values->number("strength")), float(values->number("radius"))};
-          const VkExtent2D size = pc.extent(io->out);
-          vkCmdPushConstants(pc.cmd(), pipeline_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof params,
-                             &params);
-          vkCmdDispatch(pc.cmd(), (size.width + 7) / 8, (size.height + 7) / 8, 1);
+          pc.dispatch(pipeline_, writer, pc.extent(io->out), 8, 8, params);
         });
     bb.put("vignette", io->out);           // the debug view (--view vignette)
     bb.put(gi::resources::kLit, io->out);  // what tonemapping reads from now on

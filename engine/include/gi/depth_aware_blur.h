@@ -44,6 +44,9 @@ class DepthAwareBlur {
                         std::function<float()> tolerance) const;
 
  private:
+  struct Push {  // depth_aware_blur_pass.glsl's and depth_aware_upsample.comp's push constants
+    float tolerance;
+  };
   vk::Pipeline x_, y_, upsample_;
   int radius_ = 0, scale_ = 1;
 };

@@ -21,25 +21,20 @@ void DepthAwareBlur::prepare(EffectContext& ctx, int radius, int scale) {
   if (radius_ == 0 && scale_ == 1)
     throw Error(ErrorKind::Usage, {},
                 "depth-aware blur: radius 0 at full resolution has nothing to do");
-  const std::vector<vk::Binding> bindings = {{0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER},
-                                             {1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE}};
+  auto make = [&](const char* shader, std::vector<uint32_t> spec) {
+    vk::ComputeDesc d{std::string("depth-aware blur: ") + shader, vk::loadSpirv(shader),
+                      std::move(spec)};
+    d.blocks.pushConstants =
+        vk::cppBlock<Push>("DepthAwareBlur::Push", {GI_BLOCK_MEMBER(Push, tolerance)});
+    return vk::Pipeline::compute(vk, d);
+  };
   if (radius_ > 0) {
-    const std::vector<uint32_t> spec = {uint32_t(radius_)};
-    x_ = vk::Pipeline::compute(vk, vk::loadSpirv("depth_aware_blur_x.comp"), bindings,
-                               sizeof(float), spec);
+    x_ = make("depth_aware_blur_x.comp", {uint32_t(radius_)});
     // Upsampled later: the y pass keeps the packed texel (its 1/z and slopes) for the upsample.
-    y_ = vk::Pipeline::compute(
-        vk,
-        vk::loadSpirv(scale_ > 1 ? "depth_aware_blur_y_packed.comp" : "depth_aware_blur_y.comp"),
-        bindings, sizeof(float), spec);
+    y_ = make(scale_ > 1 ? "depth_aware_blur_y_packed.comp" : "depth_aware_blur_y.comp",
+              {uint32_t(radius_)});
   }
-  if (scale_ > 1)
-    upsample_ = vk::Pipeline::compute(vk, vk::loadSpirv("depth_aware_upsample.comp"),
-                                      {{0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER},
-                                       {1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE},
-                                       {2, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER},
-                                       {3, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER}},
-                                      sizeof(float), {uint32_t(scale_)});
+  if (scale_ > 1) upsample_ = make("depth_aware_upsample.comp", {uint32_t(scale_)});
 }
 
 TextureHandle DepthAwareBlur::addPass(FrameGraph& graph, EffectContext& ctx,
@@ -67,13 +62,12 @@ TextureHandle DepthAwareBlur::addPass(FrameGraph& graph, EffectContext& ctx,
         },
         [this, io, tolerance, nearest](PassContext& pc) {
           const VkExtent2D e = pc.extent(io->out);
-          const float tol = tolerance();
+          const Push push{tolerance()};
           auto axis = [&](const vk::Pipeline& p, VkImageView in, VkImageLayout inLayout,
                           VkImageView out) {
-            vk::DescriptorWriter w;
-            w.sampled(0, in, nearest, inLayout).storageImage(1, out);
-            vkCmdPushConstants(pc.cmd(), p.layout(), VK_SHADER_STAGE_ALL, 0, sizeof tol, &tol);
-            pc.dispatch(p, w, e, kGroupX, kGroupY);
+            vk::DescriptorWriter w(p);
+            w.texture("inPacked", in, nearest, inLayout).image("outValue", out);
+            pc.dispatch(p, w, e, kGroupX, kGroupY, push);
           };
           axis(x_, pc.view(io->packed), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
                pc.view(io->half));
@@ -97,14 +91,12 @@ TextureHandle DepthAwareBlur::addPass(FrameGraph& graph, EffectContext& ctx,
       },
       [this, up, tolerance = std::move(tolerance), nearest,
        frame = ctx.frameUniforms()](PassContext& pc) {
-        const float tol = tolerance();
-        vk::DescriptorWriter w;
-        w.sampled(0, pc.view(up->packed), nearest)
-            .storageImage(1, pc.view(up->out))
-            .sampled(2, pc.view(up->depth), nearest)
-            .buffer(3, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame);
-        vkCmdPushConstants(pc.cmd(), upsample_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof tol, &tol);
-        pc.dispatch(upsample_, w, pc.extent(up->out), kGroupX, kGroupY);
+        vk::DescriptorWriter w(upsample_);
+        w.texture("inPacked", pc.view(up->packed), nearest)
+            .image("outValue", pc.view(up->out))
+            .texture("gDepth", pc.view(up->depth), nearest)
+            .buffer("Frame", frame);
+        pc.dispatch(upsample_, w, pc.extent(up->out), kGroupX, kGroupY, Push{tolerance()});
       });
   return up->out;
 }

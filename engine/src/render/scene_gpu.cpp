@@ -39,6 +39,9 @@ struct DrawPush {
   uint32_t instance;
 };
 static_assert(sizeof(DrawPush) == 116 && sizeof(DrawPush) <= 128, "guaranteed push range");
+struct DepthPush {  // scene_depth.vert's: the model matrix alone
+  glm::mat4 model;
+};
 
 // material.glsl's uniform block, one 256-byte slot per material (the largest offset alignment
 // Vulkan allows), bound with the material's descriptor set.
@@ -299,19 +302,21 @@ void SceneGpu::upload() {
 }
 
 void SceneGpu::createPipelines() {
-  const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-             tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+  // Descriptor layouts come from the shaders; the per-draw push constants are checked against
+  // DrawPush (the depth shaders take only its model matrix: DepthPush).
+  const CppBlock drawPush = cppBlock<DrawPush>(
+      "DrawPush", {GI_BLOCK_MEMBER(DrawPush, model), GI_BLOCK_MEMBER(DrawPush, normalMatrix),
+                   GI_BLOCK_MEMBER(DrawPush, instance)});
+  const CppBlock depthPush = cppBlock<DepthPush>("DepthPush", {GI_BLOCK_MEMBER(DepthPush, model)});
   const std::vector<VkVertexInputAttributeDescription> fullVertex = {
       {0, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, position)},
       {1, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, normal)},
       {2, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(Vertex, uv)}};
   GraphicsDesc g;
+  g.name = "scene: gbuffer.vert + gbuffer.frag";
   g.vertex = loadSpirv("gbuffer.vert");
   g.fragment = loadSpirv("gbuffer.frag");
-  // Shared set layout of the scene draws: 0 the view's uniforms (FrameUniforms or DrawView),
-  // 1 instances, 2 the material's uniform slot, 3 its base-colour texture (depth: 0 only).
-  g.bindings = {{0, ubo}, {1, ssbo}, {2, ubo}, {3, tex}};
-  g.pushConstantBytes = sizeof(DrawPush);
+  g.blocks.pushConstants = drawPush;
   g.vertexLayout.stride = sizeof(Vertex);
   g.vertexLayout.attributes = fullVertex;
   g.colorFormats = sceneColorFormats(SceneOutputs::GBuffer);
@@ -319,10 +324,10 @@ void SceneGpu::createPipelines() {
   gbufferPipeline_ = Pipeline::graphics(ctx_, g);
 
   GraphicsDesc d;
+  d.name = "scene: scene_depth.vert + scene_depth.frag";
   d.vertex = loadSpirv("scene_depth.vert");
   d.fragment = loadSpirv("scene_depth.frag");
-  d.bindings = {{0, ubo}};
-  d.pushConstantBytes = sizeof(glm::mat4);
+  d.blocks.pushConstants = depthPush;
   d.vertexLayout.stride = sizeof(Vertex);
   d.vertexLayout.attributes = {fullVertex[0]};
   d.depthFormat = kSceneDepthFormat;
@@ -330,15 +335,15 @@ void SceneGpu::createPipelines() {
 
   // Depth peeling: the depth draw whose fragments not behind the previous layer are discarded.
   GraphicsDesc peel = d;
+  peel.name = "scene: scene_depth.vert + scene_depth_peel.frag";
   peel.fragment = loadSpirv("scene_depth_peel.frag");
-  peel.bindings = {{0, ubo}, {1, tex}};
   peelPipeline_ = Pipeline::graphics(ctx_, peel);
   nearestClamp_ = Sampler(ctx_, VK_FILTER_NEAREST, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE);
 
   GraphicsDesc r = g;
+  r.name = "scene: scene_rsm.vert + scene_rsm.frag";
   r.vertex = loadSpirv("scene_rsm.vert");
   r.fragment = loadSpirv("scene_rsm.frag");
-  r.bindings = {{0, ubo}, {1, ssbo}, {2, ubo}, {3, tex}};
   r.colorFormats = sceneColorFormats(SceneOutputs::ReflectiveShadowMap);
   rsmPipeline_ = Pipeline::graphics(ctx_, r);
 }
@@ -597,13 +602,17 @@ void SceneGpu::bindMaterial(PassContext& pc, const Pipeline& p, uint32_t materia
                             VkBuffer uniforms, VkDeviceSize offset, VkDeviceSize range) {
   const Material& m = materials_[material];
   const bool textured = m.baseColorTexture >= 0 && m.baseColorTexture < int(textures_.size());
-  DescriptorWriter w;
-  w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniforms, offset, range)
-      .buffer(1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, instanceBuffer_.handle())
-      .buffer(2, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, materialUniforms_.handle(),
-              material * kMaterialSlotBytes, sizeof(MaterialUniforms))
-      .sampled(3, textured ? textures_[m.baseColorTexture].view() : whiteTexture_.view(),
+  // The view's uniforms are "Frame" (the main view's FrameUniforms) or "View" (a DrawView);
+  // the instances are read only by the G-buffer's vertex shader.
+  const ShaderInterface& shader = p.shaderInterface();
+  DescriptorWriter w(p);
+  w.buffer(shader.find("Frame") ? "Frame" : "View", uniforms, offset, range)
+      .buffer("MaterialBlock", materialUniforms_.handle(), material * kMaterialSlotBytes,
+              sizeof(MaterialUniforms))
+      .texture("baseColorTexture",
+               textured ? textures_[m.baseColorTexture].view() : whiteTexture_.view(),
                linearRepeat_.handle());
+  if (shader.find("Instances")) w.buffer("Instances", instanceBuffer_.handle());
   pc.descriptors().bind(pc.cmd(), p, w);
 }
 
@@ -614,8 +623,8 @@ void SceneGpu::pushDraw(VkCommandBuffer cmd, const Pipeline& p, const SceneDrawI
   push.model = inst.model;
   for (int c = 0; c < 3; ++c) push.normalMatrix[c] = inst.normalMatrix[c];
   push.instance = d.instance;
-  vkCmdPushConstants(cmd, p.layout(), VK_SHADER_STAGE_ALL, 0,
-                     modelOnly ? uint32_t(sizeof(glm::mat4)) : uint32_t(sizeof push), &push);
+  static_assert(offsetof(DrawPush, model) == offsetof(DepthPush, model));
+  p.pushBytes(cmd, &push, modelOnly ? sizeof(DepthPush) : sizeof push);
 }
 
 void SceneGpu::drawGBuffer(PassContext& pc, const SceneTargets& t, VkBuffer viewUniforms,
@@ -662,8 +671,8 @@ void SceneGpu::drawDepth(PassContext& pc, const SceneTargets& t, std::span<const
   for (const SceneView& v : views) {
     const VkDescriptorBufferInfo slot = viewSlot(v, nullptr, t.extent);
     setViewport(c, v, t.extent);
-    DescriptorWriter w;
-    w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, slot.buffer, slot.offset, slot.range);
+    DescriptorWriter w(depthPipeline_);
+    w.buffer("View", slot.buffer, slot.offset, slot.range);
     pc.descriptors().bind(c, depthPipeline_, w);
     const glm::mat4 clip = v.proj * v.view;
     const glm::mat4* cull = v.projection == Projection::Paraboloid ? nullptr : &clip;
@@ -687,9 +696,8 @@ void SceneGpu::drawDepthFromBuffer(PassContext& pc, const SceneTargets& t, VkBuf
     SceneView placed;
     placed.viewport = viewports[i];
     setViewport(c, placed, t.extent);
-    DescriptorWriter w;
-    w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, views, VkDeviceSize(i) * kDrawViewStride,
-             sizeof(DrawViewUniforms));
+    DescriptorWriter w(depthPipeline_);
+    w.buffer("View", views, VkDeviceSize(i) * kDrawViewStride, sizeof(DrawViewUniforms));
     pc.descriptors().bind(c, depthPipeline_, w);
     counts_.drawn += draws_.size();  // views computed on the GPU: nothing to cull here
     for (const SceneDrawItem& d : draws_) {
@@ -710,9 +718,9 @@ void SceneGpu::drawDepthPeeled(PassContext& pc, const SceneTargets& t,
   for (const SceneView& v : views) {
     const VkDescriptorBufferInfo slot = viewSlot(v, nullptr, t.extent);
     setViewport(c, v, t.extent);
-    DescriptorWriter w;
-    w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, slot.buffer, slot.offset, slot.range)
-        .sampled(1, previous, nearestClamp_.handle());
+    DescriptorWriter w(peelPipeline_);
+    w.buffer("View", slot.buffer, slot.offset, slot.range)
+        .texture("previousDepth", previous, nearestClamp_.handle());
     pc.descriptors().bind(c, peelPipeline_, w);
     const glm::mat4 clip = v.proj * v.view;
     const glm::mat4* cull = v.projection == Projection::Paraboloid ? nullptr : &clip;

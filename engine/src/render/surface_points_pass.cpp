@@ -50,15 +50,16 @@ SurfacePointsPass::SurfacePointsPass(vk::Context& ctx, const Scene& scene, uint3
   points_ =
       vk::createDeviceBuffer(ctx, zeros.data(), zeros.size() * sizeof(glm::vec4),
                              VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
-  const auto ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-  update_ = vk::Pipeline::compute(ctx, vk::loadSpirv("surface_points.comp"),
-                                  {{0, ssbo}, {1, ssbo}, {2, ssbo}, {3, ssbo}, {4, ssbo}}, 8);
-  view_ = vk::Pipeline::compute(ctx, vk::loadSpirv("points_view.comp"),
-                                {{0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
-                                 {1, ssbo},
-                                 {2, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER},
-                                 {3, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE}},
-                                8);
+  vk::ComputeDesc update{"surface points: surface_points.comp",
+                         vk::loadSpirv("surface_points.comp")};
+  update.blocks.pushConstants = vk::cppBlock<UpdatePush>(
+      "UpdatePush",
+      {GI_BLOCK_MEMBER(UpdatePush, count), GI_BLOCK_MEMBER(UpdatePush, areaPerPoint)});
+  update_ = vk::Pipeline::compute(ctx, update);
+  vk::ComputeDesc view{"surface points: points_view.comp", vk::loadSpirv("points_view.comp")};
+  view.blocks.pushConstants = vk::cppBlock<ViewPush>(
+      "ViewPush", {GI_BLOCK_MEMBER(ViewPush, count), GI_BLOCK_MEMBER(ViewPush, clear)});
+  view_ = vk::Pipeline::compute(ctx, view);
 }
 
 void SurfacePointsPass::addPasses(FrameGraph& graph, BufferHandle vertices, const Buffers& in) {
@@ -76,18 +77,15 @@ void SurfacePointsPass::addPasses(FrameGraph& graph, BufferHandle vertices, cons
         // The buffer is imported (persistent): an unchanged pose leaves valid points in it.
         const uint64_t version = in.poseVersion ? *in.poseVersion : 0;
         if (evaluated_ && version != 0 && version == evaluatedVersion_) return;
-        vk::DescriptorWriter w;
-        w.buffer(0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, samples_.handle())
-            .buffer(1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, in.instances)
-            .buffer(2, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, in.indices)
-            .buffer(3, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, in.vertices)
-            .buffer(4, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, points_.handle());
+        vk::DescriptorWriter w(update_);
+        w.buffer("Samples", samples_.handle())
+            .buffer("Instances", in.instances)
+            .buffer("Indices", in.indices)
+            .buffer("Vertices", in.vertices)
+            .buffer("Points", points_.handle());
         pc.descriptors().bind(pc.cmd(), update_, w);
-        struct {
-          uint32_t count;
-          float areaPerPoint;
-        } push{count(), count() ? float(set_.totalArea / count()) : 0.0f};
-        vkCmdPushConstants(pc.cmd(), update_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof push, &push);
+        update_.push(pc.cmd(),
+                     UpdatePush{count(), count() ? float(set_.totalArea / count()) : 0.0f});
         dispatch256(pc.cmd(), count());
         evaluated_ = true;
         evaluatedVersion_ = version;
@@ -109,15 +107,14 @@ void SurfacePointsPass::addPasses(FrameGraph& graph, BufferHandle vertices, cons
         view->image = b.write(b.create(resources::kPointsView, desc), TextureUsage::StorageWrite);
       },
       [this, in, view](PassContext& pc) {
-        vk::DescriptorWriter w;
-        w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, in.frameUniforms)
-            .buffer(1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, pc.buffer(view->points))
-            .sampled(2, pc.view(view->depth), in.nearest)
-            .storageImage(3, pc.view(view->image));
+        vk::DescriptorWriter w(view_);
+        w.buffer("Frame", in.frameUniforms)
+            .buffer("Points", pc.buffer(view->points))
+            .texture("depthTex", pc.view(view->depth), in.nearest)
+            .image("outImage", pc.view(view->image));
         pc.descriptors().bind(pc.cmd(), view_, w);
         const VkExtent2D e = pc.extent(view->image);
-        const uint32_t clear[2] = {0u, 1u};
-        vkCmdPushConstants(pc.cmd(), view_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof clear, clear);
+        view_.push(pc.cmd(), ViewPush{0u, 1u});
         dispatch256(pc.cmd(), uint64_t(e.width) * e.height);
         // The splats overwrite cleared texels: order the two dispatches.
         VkMemoryBarrier2 barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER_2};
@@ -127,8 +124,7 @@ void SurfacePointsPass::addPasses(FrameGraph& graph, BufferHandle vertices, cons
         dep.memoryBarrierCount = 1;
         dep.pMemoryBarriers = &barrier;
         vkCmdPipelineBarrier2(pc.cmd(), &dep);
-        const uint32_t splat[2] = {count(), 0u};
-        vkCmdPushConstants(pc.cmd(), view_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof splat, splat);
+        view_.push(pc.cmd(), ViewPush{count(), 0u});
         dispatch256(pc.cmd(), count());
       });
   bb.put(resources::kPointsView, view->image);

@@ -48,6 +48,13 @@ class SurfacePointsPass {
   uint64_t evaluations() const { return evaluations_; }
 
  private:
+  struct UpdatePush {  // surface_points.comp's push constants
+    uint32_t count;
+    float areaPerPoint;
+  };
+  struct ViewPush {  // points_view.comp's
+    uint32_t count, clear;
+  };
   SurfacePointSet set_;
   vk::Buffer samples_, points_;
   vk::Pipeline update_, view_;

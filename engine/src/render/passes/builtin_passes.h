@@ -47,7 +47,8 @@ inline constexpr uint32_t kScreenGroupX = 32, kScreenGroupY = 16;
 // The shape tonemap and floor share: a compute shader with (0) the frame uniforms, (1) one
 // sampled input and (2) one storage output, dispatched over the output in groupX x groupY
 // workgroups (image_filter.cpp).
-vk::Pipeline makeImageFilterPipeline(vk::Context& ctx, const std::string& spirvName);
+vk::Pipeline makeImageFilterPipeline(vk::Context& ctx, const std::string& spirvName,
+                                     std::vector<uint32_t> specialization = {});
 void recordImageFilter(PassContext& pc, const vk::Pipeline& pipeline, VkBuffer frame,
                        VkSampler sampler, TextureHandle in, TextureHandle out, uint32_t groupX,
                        uint32_t groupY);

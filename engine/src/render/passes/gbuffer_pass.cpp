@@ -77,11 +77,7 @@ class GBufferPass final : public Effect {
   // Built when a channel is first unpacked: most frames unpack none.
   const vk::Pipeline& decoder(uint32_t channel) {
     if (!decode_[channel].handle())
-      decode_[channel] = vk::Pipeline::compute(s_.ctx, vk::loadSpirv("gbuffer_decode.comp"),
-                                               {{0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER},
-                                                {1, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER},
-                                                {2, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE}},
-                                               0, {channel});
+      decode_[channel] = makeImageFilterPipeline(s_.ctx, "gbuffer_decode.comp", {channel});
     return decode_[channel];
   }
 

@@ -79,16 +79,16 @@ class LightingPass final : public Effect {
               {inputMode(io->fallback[0], io->ao), inputMode(io->fallback[1], io->ambient),
                inputMode(io->fallback[2], io->indirect), inputMode(io->fallback[3], io->contact),
                inputMode(io->fallback[4], io->direct)});
-          vk::DescriptorWriter w;
-          w.buffer(0, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, frame);
-          io->surface.bind(w, pc, 1, nearest);
-          w.storageImage(6, pc.view(io->lit))
-              .sampled(7, pc.view(io->ao), linear)
-              .sampled(8, pc.view(io->ambient), linear)
-              .sampled(9, pc.view(io->indirect), linear)
-              .sampled(10, pc.view(io->environment), s_.scene.linearRepeat())
-              .sampled(11, pc.view(io->contact), linear)
-              .sampled(12, pc.view(io->direct), linear);
+          vk::DescriptorWriter w(pipeline);
+          w.buffer("Frame", frame);
+          io->surface.bind(w, pc, nearest);
+          w.image("outLit", pc.view(io->lit))
+              .texture("aoTexture", pc.view(io->ao), linear)
+              .texture("ambientTexture", pc.view(io->ambient), linear)
+              .texture("indirectTexture", pc.view(io->indirect), linear)
+              .texture("environmentMap", pc.view(io->environment), s_.scene.linearRepeat())
+              .texture("contactTexture", pc.view(io->contact), linear)
+              .texture("directTexture", pc.view(io->direct), linear);
           pc.dispatch(pipeline, w, e, kScreenGroupX, kScreenGroupY);
         });
     bb.put(res::kLit, io->lit);
@@ -119,16 +119,10 @@ class LightingPass final : public Effect {
                       inputs[4]};
     auto found = pipelines_.find(key);
     if (found != pipelines_.end()) return found->second;
-    const auto ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER,
-               tex = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-               img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-    std::vector<vk::Binding> bindings = LitSurfaceInputs::layout(1);  // 1..5
-    bindings.insert(
-        bindings.end(),
-        {{0, ubo}, {6, img}, {7, tex}, {8, tex}, {9, tex}, {10, tex}, {11, tex}, {12, tex}});
     return pipelines_
-        .emplace(key, vk::Pipeline::compute(s_.ctx, vk::loadSpirv("lighting.comp"), bindings, 0,
-                                            {key.begin(), key.end()}))
+        .emplace(key, vk::Pipeline::compute(s_.ctx, {"lighting: lighting.comp",
+                                                     vk::loadSpirv("lighting.comp"),
+                                                     {key.begin(), key.end()}}))
         .first->second;
   }
 

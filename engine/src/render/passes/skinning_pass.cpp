@@ -17,10 +17,12 @@ class SkinningPass final : public Effect {
   std::vector<SettingDesc> settings() const override { return {}; }
   void prepare(EffectContext& ctx, const SettingValues&) override {
     if (s_.scene.deformed().empty() || pipeline_.handle()) return;
-    const auto ssbo = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    pipeline_ =
-        vk::Pipeline::compute(ctx.vulkan(), vk::loadSpirv("skinning.comp"),
-                              {{0, ssbo}, {1, ssbo}, {2, ssbo}, {3, ssbo}, {4, ssbo}}, 5 * 4);
+    vk::ComputeDesc d{"skinning: skinning.comp", vk::loadSpirv("skinning.comp")};
+    d.blocks.pushConstants = vk::cppBlock<Push>(
+        "Push", {GI_BLOCK_MEMBER(Push, srcFirst), GI_BLOCK_MEMBER(Push, dstFirst),
+                 GI_BLOCK_MEMBER(Push, count), GI_BLOCK_MEMBER(Push, jointFirst),
+                 GI_BLOCK_MEMBER(Push, jointCount)});
+    pipeline_ = vk::Pipeline::compute(ctx.vulkan(), d);
   }
   void addPasses(FrameGraph& graph, EffectContext&, const SettingValues&) override {
     if (s_.scene.deformed().empty()) return;
@@ -37,23 +39,25 @@ class SkinningPass final : public Effect {
  private:
   void record(PassContext& pc) {
     SceneGpu& sc = s_.scene;
-    vk::DescriptorWriter w;
-    w.buffer(0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, sc.restBuffer().handle())
-        .buffer(1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, sc.jointIndexBuffer().handle())
-        .buffer(2, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, sc.jointWeightBuffer().handle())
-        .buffer(3, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, sc.jointBuffer().handle())
-        .buffer(4, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, sc.vertexBuffer().handle());
+    vk::DescriptorWriter w(pipeline_);
+    w.buffer("Rest", sc.restBuffer().handle())
+        .buffer("Skin", sc.jointIndexBuffer().handle())
+        .buffer("Weights", sc.jointWeightBuffer().handle())
+        .buffer("Joints", sc.jointBuffer().handle())
+        .buffer("Out", sc.vertexBuffer().handle());
     pc.descriptors().bind(pc.cmd(), pipeline_, w);
     s_.skinnedThisFrame = 0;
     for (SceneGpu::Deformed& d : sc.deformed()) {
       if (!d.dirty) continue;
-      const uint32_t push[5] = {d.srcFirst, d.dstFirst, d.count, d.jointFirst, d.jointCount};
-      vkCmdPushConstants(pc.cmd(), pipeline_.layout(), VK_SHADER_STAGE_ALL, 0, sizeof(push), push);
+      pipeline_.push(pc.cmd(), Push{d.srcFirst, d.dstFirst, d.count, d.jointFirst, d.jointCount});
       vkCmdDispatch(pc.cmd(), (d.count + 255) / 256, 1, 1);  // local_size_x 256
       d.dirty = false;
       s_.skinnedThisFrame += d.count;
     }
   }
+  struct Push {  // skinning.comp's push constants
+    uint32_t srcFirst, dstFirst, count, jointFirst, jointCount;
+  };
   EngineState& s_;
   vk::Pipeline pipeline_;
 };
