@@ -164,6 +164,37 @@ TEST(Settings, AccessorsRefuseTheWrongType) {
   expectError([&] { s.vector("radius"); }, ErrorKind::Schema, {"fx.radius", "float"});
 }
 
+// Typed handles: found once by name, read without a string look-up, following every change
+// made through set(); a copy of the values reads through the same handle.
+TEST(Settings, TypedHandlesReadTheCurrentValue) {
+  SettingValues s = fresh();
+  const Setting<double> radius = s.handle<double>("radius");
+  const Setting<int> samples = s.handle<int>("samples"), filter = s.handle<int>("filter");
+  const Setting<bool> enabled = s.handle<bool>("enabled");
+  EXPECT_EQ(s[radius], 0.5);
+  EXPECT_EQ(s[samples], 8);
+  EXPECT_EQ(s[filter], 1);
+  EXPECT_TRUE(s[enabled]);
+  s.set("radius", 2.25, "t");
+  s.setFromString("samples", "33", "t");
+  s.set("filter", "gauss", "t");
+  s.set("enabled", false, "t");
+  const SettingValues copy = s;
+  for (const SettingValues* v : {static_cast<const SettingValues*>(&s), &copy}) {
+    EXPECT_EQ((*v)[radius], 2.25);
+    EXPECT_EQ((*v)[samples], 33);
+    EXPECT_EQ((*v)[filter], 2);
+    EXPECT_FALSE((*v)[enabled]);
+  }
+  expectError([&] { s.handle<double>("radius2"); }, ErrorKind::Schema, {"fx.radius2", "unknown"});
+  expectError([&] { s.handle<bool>("samples"); }, ErrorKind::Schema, {"fx.samples", "a bool"});
+  expectError([&] { s.handle<int>("radius"); }, ErrorKind::Schema, {"fx.radius", "an int"});
+  expectError([&] { s.handle<double>("offset"); }, ErrorKind::Schema, {"fx.offset", "a number"});
+  // A handle of a longer declaration used on a shorter one is refused, not read out of range.
+  const SettingValues one("fx", {allTypes()[0]});
+  expectError([&] { one[s.handle<double>("radius")]; }, ErrorKind::Schema, {"another declaration"});
+}
+
 TEST(Settings, GraphDiffersComparesVectorsAndEnums) {
   SettingValues a = fresh(), b = fresh();
   b.set("offset", json::array({0, 1, -1}), "t");  // offset is uniform-only

@@ -18,6 +18,7 @@
 #include "alchemy_kernel.h"
 #include "gi/effect.h"
 #include "gi/effect_registry.h"
+#include "gi/uniform_block.h"
 #include "gi/vk/pipeline.h"
 #include "gi/vk/resources.h"
 
@@ -116,6 +117,12 @@ class AlchemyEffect : public gi::Effect {
   }
 
   void prepare(gi::EffectContext& ctx, const gi::SettingValues& s) override {
+    h_.radius = s.handle<double>("radius");
+    h_.bias = s.handle<double>("bias");
+    h_.intensity = s.handle<double>("intensity");
+    h_.contrast = s.handle<double>("contrast");
+    h_.epsilon = s.handle<double>("epsilon");
+    h_.samples = s.handle<int>("samples");
     gi::vk::Context& vk = ctx.vulkan();
     vk.requireWorkgroup(kGroupX, kGroupY, "alchemy");
     using gi::alchemy::Uniforms;
@@ -143,9 +150,7 @@ class AlchemyEffect : public gi::Effect {
           vk,
           {"alchemy: alchemy_blur_y.comp", words(alchemy_blur_y_comp), {uint32_t(blur)}, params});
     }
-    if (!uniforms_)
-      uniforms_ = gi::vk::Buffer(vk, sizeof(gi::alchemy::Uniforms),
-                                 VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true);
+    uniforms_.create(vk);
     if (band > 0 && !view_) view_ = ctx.createView();
   }
 
@@ -265,27 +270,26 @@ class AlchemyEffect : public gi::Effect {
   }
 
  private:
-  // Host-visible and written while recording: the renderer waits for each frame before it
-  // records the next, so the GPU is not reading it. Rewritten only when a setting changed.
   void upload(const gi::SettingValues& s) {
-    const double radius = s.number("radius");
+    const double radius = s[h_.radius];
     const std::array<double, 6> key = {radius,
-                                       s.number("bias"),
-                                       s.number("intensity"),
-                                       s.number("contrast"),
-                                       gi::alchemy::absoluteEpsilon(s.number("epsilon"), radius),
-                                       double(s.integer("samples"))};
-    if (key == uploaded_) return;
-    const gi::alchemy::Uniforms u =
-        gi::alchemy::makeUniforms(key[0], key[1], key[2], key[3], key[4], int(key[5]));
-    uniforms_.write(&u, sizeof u);
-    uploaded_ = key;
+                                       s[h_.bias],
+                                       s[h_.intensity],
+                                       s[h_.contrast],
+                                       gi::alchemy::absoluteEpsilon(s[h_.epsilon], radius),
+                                       double(s[h_.samples])};
+    uniforms_.update(key, [&] {
+      return gi::alchemy::makeUniforms(key[0], key[1], key[2], key[3], key[4], int(key[5]));
+    });
   }
 
   gi::vk::Pipeline ao_, blurX_, blurY_;
-  gi::vk::Buffer uniforms_;
-  std::shared_ptr<gi::ViewUniforms> view_;         // the guard-band view (guard_band > 0)
-  std::optional<std::array<double, 6>> uploaded_;  // the settings uniforms_ holds
+  struct Handles {  // typed settings, found by name once in prepare()
+    gi::Setting<double> radius, bias, intensity, contrast, epsilon;
+    gi::Setting<int> samples;
+  } h_;
+  gi::UniformBlock<gi::alchemy::Uniforms> uniforms_;  // rewritten only when a setting changed
+  std::shared_ptr<gi::ViewUniforms> view_;            // the guard-band view (guard_band > 0)
 };
 
 }  // namespace

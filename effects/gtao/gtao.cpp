@@ -12,6 +12,7 @@
 #include "gi/depth_aware_blur.h"
 #include "gi/effect.h"
 #include "gi/effect_registry.h"
+#include "gi/uniform_block.h"
 #include "gi/vk/pipeline.h"
 #include "gi/vk/resources.h"
 #include "gtao.comp.h"  // const uint32_t gtao_comp[]
@@ -91,6 +92,11 @@ class GtaoEffect : public gi::Effect {
   }
 
   void prepare(gi::EffectContext& ctx, const gi::SettingValues& s) override {
+    h_.radius = s.handle<double>("radius");
+    h_.falloff = s.handle<double>("falloff");
+    h_.thickness = s.handle<double>("thickness");
+    h_.interleave = s.handle<bool>("interleave");
+    h_.slices = s.handle<int>("slices");
     gi::vk::Context& vk = ctx.vulkan();
     vk.requireWorkgroup(kGroupX, kGroupY, "gtao");
     using gi::gtao::Uniforms;
@@ -112,9 +118,7 @@ class GtaoEffect : public gi::Effect {
     // runs again); at a reduced resolution the blur also upsamples, even with radius 0.
     if (s.integer("blur_radius") > 0 || s.integer("downsample") > 1)
       blur_.prepare(ctx, s.integer("blur_radius"), s.integer("downsample"));
-    if (!uniforms_)
-      uniforms_ =
-          gi::vk::Buffer(vk, sizeof(gi::gtao::Uniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true);
+    uniforms_.create(vk);
     if (!unusedBent_) {
       gi::vk::ImageDesc d;
       d.format = kBentFormat;
@@ -173,25 +177,21 @@ class GtaoEffect : public gi::Effect {
 
     io->ao = io->raw;
     if (blurred)
-      io->ao = blur_.addPass(graph, ctx, "gtao_blur", io->raw, res::kAO, [values = &settings] {
-        return float(gi::gtao::kBlurDepthTolerance * values->number("radius"));
-      });
+      io->ao = blur_.addPass(graph, ctx, "gtao_blur", io->raw, res::kAO,
+                             [values = &settings, radius = h_.radius] {
+                               return float(gi::gtao::kBlurDepthTolerance * (*values)[radius]);
+                             });
     bb.put(res::kAO, io->ao);
     bb.put(kBentNormal, bentNormals ? io->bent : bb.texture(res::kNormal));
   }
 
  private:
-  // Host-visible and written while recording: the renderer waits for each frame before it
-  // records the next, so the GPU is not reading it. Rewritten only when a setting changed.
   void upload(const gi::SettingValues& s) {
-    const std::array<double, 5> key = {s.number("radius"), s.number("falloff"),
-                                       s.number("thickness"), s.flag("interleave") ? 1.0 : 0.0,
-                                       double(s.integer("slices"))};
-    if (key == uploaded_) return;
-    const gi::gtao::Uniforms u =
-        gi::gtao::makeUniforms(key[0], key[1], key[2], key[3] != 0.0, int(key[4]));
-    uniforms_.write(&u, sizeof u);
-    uploaded_ = key;
+    const std::array<double, 5> key = {s[h_.radius], s[h_.falloff], s[h_.thickness],
+                                       s[h_.interleave] ? 1.0 : 0.0, double(s[h_.slices])};
+    uniforms_.update(key, [&] {
+      return gi::gtao::makeUniforms(key[0], key[1], key[2], key[3] != 0.0, int(key[4]));
+    });
   }
 
   // Bent normals off: the shader never stores to binding 6 (specialized away), but the binding
@@ -218,10 +218,14 @@ class GtaoEffect : public gi::Effect {
 
   gi::vk::Pipeline gtao_;
   gi::DepthAwareBlur blur_;
-  gi::vk::Buffer uniforms_;
+  struct Handles {  // typed settings, found by name once in prepare()
+    gi::Setting<double> radius, falloff, thickness;
+    gi::Setting<int> slices;
+    gi::Setting<bool> interleave;
+  } h_;
+  gi::UniformBlock<gi::gtao::Uniforms> uniforms_;  // rewritten only when a setting changed
   gi::vk::Image unusedBent_;
   bool unusedBentReady_ = false;
-  std::optional<std::array<double, 5>> uploaded_;  // the settings uniforms_ holds
 };
 
 }  // namespace

@@ -11,6 +11,7 @@
 #include "gi/depth_aware_blur.h"
 #include "gi/effect.h"
 #include "gi/effect_registry.h"
+#include "gi/uniform_block.h"
 #include "gi/vk/pipeline.h"
 #include "gi/vk/resources.h"
 #include "hbao.comp.h"  // const uint32_t hbao_comp[]
@@ -69,6 +70,10 @@ class HbaoEffect : public gi::Effect {
   }
 
   void prepare(gi::EffectContext& ctx, const gi::SettingValues& s) override {
+    h_.radius = s.handle<double>("radius");
+    h_.angle_bias = s.handle<double>("angle_bias");
+    h_.interleave = s.handle<bool>("interleave");
+    h_.directions = s.handle<int>("directions");
     gi::vk::Context& vk = ctx.vulkan();
     vk.requireWorkgroup(kGroupX, kGroupY, "hbao");
     using gi::hbao::Uniforms;
@@ -85,9 +90,7 @@ class HbaoEffect : public gi::Effect {
     hbao_ = gi::vk::Pipeline::compute(vk, desc);
     // The blur radius is compiled into the blur (changesGraph: prepare runs again).
     if (s.integer("blur_radius") > 0) blur_.prepare(ctx, s.integer("blur_radius"));
-    if (!uniforms_)
-      uniforms_ =
-          gi::vk::Buffer(vk, sizeof(gi::hbao::Uniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true);
+    uniforms_.create(vk);
   }
 
   void addPasses(gi::FrameGraph& graph, gi::EffectContext& ctx,
@@ -125,29 +128,29 @@ class HbaoEffect : public gi::Effect {
 
     io->ao = io->raw;
     if (blurRadius > 0)
-      io->ao = blur_.addPass(graph, ctx, "hbao_blur", io->raw, res::kAO, [values = &settings] {
-        return float(gi::hbao::kBlurDepthTolerance * values->number("radius"));
-      });
+      io->ao = blur_.addPass(graph, ctx, "hbao_blur", io->raw, res::kAO,
+                             [values = &settings, radius = h_.radius] {
+                               return float(gi::hbao::kBlurDepthTolerance * (*values)[radius]);
+                             });
     bb.put(res::kAO, io->ao);
   }
 
  private:
-  // Host-visible and written while recording: the renderer waits for each frame before it
-  // records the next, so the GPU is not reading it. Rewritten only when a setting changed.
   void upload(const gi::SettingValues& s) {
-    const std::array<double, 4> key = {s.number("radius"), s.number("angle_bias"),
-                                       s.flag("interleave") ? 1.0 : 0.0,
-                                       double(s.integer("directions"))};
-    if (key == uploaded_) return;
-    const gi::hbao::Uniforms u = gi::hbao::makeUniforms(key[0], key[1], key[2] != 0.0, int(key[3]));
-    uniforms_.write(&u, sizeof u);
-    uploaded_ = key;
+    const std::array<double, 4> key = {s[h_.radius], s[h_.angle_bias], s[h_.interleave] ? 1.0 : 0.0,
+                                       double(s[h_.directions])};
+    uniforms_.update(
+        key, [&] { return gi::hbao::makeUniforms(key[0], key[1], key[2] != 0.0, int(key[3])); });
   }
 
   gi::vk::Pipeline hbao_;
   gi::DepthAwareBlur blur_;
-  gi::vk::Buffer uniforms_;
-  std::optional<std::array<double, 4>> uploaded_;  // the settings uniforms_ holds
+  struct Handles {  // typed settings, found by name once in prepare()
+    gi::Setting<double> radius, angle_bias;
+    gi::Setting<int> directions;
+    gi::Setting<bool> interleave;
+  } h_;
+  gi::UniformBlock<gi::hbao::Uniforms> uniforms_;  // rewritten only when a setting changed
 };
 
 }  // namespace

@@ -15,6 +15,7 @@
 #include "gi/effect.h"
 #include "gi/effect_registry.h"
 #include "gi/lit_surface.h"
+#include "gi/uniform_block.h"
 #include "gi/vk/pipeline.h"
 #include "gi/vk/resources.h"
 #include "obscurance.comp.h"         // const uint32_t obscurance_comp[]
@@ -116,6 +117,11 @@ class ObscuranceEffect : public gi::Effect {
   }
 
   void prepare(gi::EffectContext& ctx, const gi::SettingValues& s) override {
+    h_.radius = s.handle<double>("radius");
+    h_.bias = s.handle<double>("bias");
+    h_.membership = s.handle<int>("membership");
+    h_.samples = s.handle<int>("samples");
+    h_.interleave = s.handle<bool>("interleave");
     gi::vk::Context& vk = ctx.vulkan();
     vk.requireWorkgroup(kGroupX, kGroupY, "obscurance");
     using obs::Uniforms;
@@ -154,10 +160,8 @@ class ObscuranceEffect : public gi::Effect {
                                             words(std::begin(obscurance_resolve_comp),
                                                   std::end(obscurance_resolve_comp)),
                                             filterSpec, params});
-    if (!uniforms_)
-      uniforms_ =
-          gi::vk::Buffer(vk, sizeof(obs::Uniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true);
-    uploaded_.reset();  // the sample count may have changed
+    uniforms_.create(vk);
+    uniforms_.invalidate();  // the sample count may have changed
   }
 
   void addPasses(gi::FrameGraph& graph, gi::EffectContext& ctx,
@@ -261,23 +265,24 @@ class ObscuranceEffect : public gi::Effect {
   }
 
  private:
-  // Host-visible and written while recording (the renderer waits for each frame before it
-  // records the next). The sample set is rebuilt only when a setting it depends on changed.
+  // The sample set is rebuilt only when a setting it depends on changed.
   void upload(const gi::SettingValues& s) {
-    const std::array<double, 5> key = {
-        s.number("radius"), s.number("bias"), double(s.integer("membership")),
-        double(s.integer("samples")), s.flag("interleave") ? 1.0 : 0.0};
-    if (key == uploaded_) return;
-    const obs::Uniforms u =
-        obs::makeUniforms(key[0], key[1], obs::Membership(int(key[2])), int(key[3]), key[4] != 0.0);
-    uniforms_.write(&u, sizeof u);
-    uploaded_ = key;
+    const std::array<double, 5> key = {s[h_.radius], s[h_.bias], double(s[h_.membership]),
+                                       double(s[h_.samples]), s[h_.interleave] ? 1.0 : 0.0};
+    uniforms_.update(key, [&] {
+      return obs::makeUniforms(key[0], key[1], obs::Membership(int(key[2])), int(key[3]),
+                               key[4] != 0.0);
+    });
   }
 
   gi::vk::Pipeline main_, filterX_, resolve_, radiancePipeline_;
   bool filter_ = true, radiance_ = false;
-  gi::vk::Buffer uniforms_;
-  std::optional<std::array<double, 5>> uploaded_;  // the settings uniforms_ holds
+  struct Handles {  // typed settings, found by name once in prepare()
+    gi::Setting<double> radius, bias;
+    gi::Setting<int> membership, samples;
+    gi::Setting<bool> interleave;
+  } h_;
+  gi::UniformBlock<obs::Uniforms> uniforms_;  // rewritten only when a setting changed
 };
 
 }  // namespace

@@ -11,6 +11,7 @@
 #include "gi/depth_aware_blur.h"
 #include "gi/effect.h"
 #include "gi/effect_registry.h"
+#include "gi/uniform_block.h"
 #include "gi/vk/pipeline.h"
 #include "gi/vk/resources.h"
 #include "ssao.comp.h"  // const uint32_t ssao_comp[]
@@ -86,9 +87,12 @@ class SsaoEffect : public gi::Effect {
     ssao_ = gi::vk::Pipeline::compute(vk, desc);
     // The blur radius is compiled into the blur (changesGraph: prepare runs again).
     if (settings.integer("blur_radius") > 0) blur_.prepare(ctx, settings.integer("blur_radius"));
-    if (!uniforms_)
-      uniforms_ =
-          gi::vk::Buffer(vk, sizeof(gi::ssao::Uniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true);
+    uniforms_.create(vk);
+    radius_ = settings.handle<double>("radius");
+    bias_ = settings.handle<double>("bias");
+    intensity_ = settings.handle<double>("intensity");
+    samples_ = settings.handle<int>("samples");
+    interleave_ = settings.handle<bool>("interleave");
   }
 
   void addPasses(gi::FrameGraph& graph, gi::EffectContext& ctx,
@@ -128,31 +132,29 @@ class SsaoEffect : public gi::Effect {
 
     gi::TextureHandle ao = io->raw;
     if (blurRadius > 0)
-      ao = blur_.addPass(graph, ctx, "ssao_blur", io->raw, res::kAO, [values = &settings] {
-        return float(gi::ssao::kBlurDepthTolerance * values->number("radius"));
-      });
+      ao = blur_.addPass(graph, ctx, "ssao_blur", io->raw, res::kAO,
+                         [values = &settings, radius = radius_] {
+                           return float(gi::ssao::kBlurDepthTolerance * (*values)[radius]);
+                         });
     bb.put(res::kAO, ao);
   }
 
  private:
-  // Host-visible and written while recording: the renderer waits for each frame before it
-  // records the next, so the GPU is not reading it. (Frames in flight would need one per frame.)
   // The kernel and rotations are rebuilt only when a setting changed since the last upload.
   void upload(const gi::SettingValues& s) {
-    const std::array<double, 5> key = {s.number("radius"), s.number("bias"), s.number("intensity"),
-                                       double(s.integer("samples")),
-                                       s.flag("interleave") ? 1.0 : 0.0};
-    if (key == uploaded_) return;
-    const gi::ssao::Uniforms u =
-        gi::ssao::makeUniforms(key[0], key[1], key[2], int(key[3]), key[4] != 0.0);
-    uniforms_.write(&u, sizeof u);
-    uploaded_ = key;
+    const std::array<double, 5> key = {s[radius_], s[bias_], s[intensity_], double(s[samples_]),
+                                       s[interleave_] ? 1.0 : 0.0};
+    uniforms_.update(key, [&] {
+      return gi::ssao::makeUniforms(key[0], key[1], key[2], int(key[3]), key[4] != 0.0);
+    });
   }
 
   gi::vk::Pipeline ssao_;
   gi::DepthAwareBlur blur_;
-  gi::vk::Buffer uniforms_;
-  std::optional<std::array<double, 5>> uploaded_;  // the settings uniforms_ holds
+  gi::UniformBlock<gi::ssao::Uniforms> uniforms_;
+  gi::Setting<double> radius_, bias_, intensity_;  // typed handles, made in prepare()
+  gi::Setting<int> samples_;
+  gi::Setting<bool> interleave_;
 };
 
 }  // namespace

@@ -23,7 +23,8 @@
 // 9: DepthAwareBlur gained its reduced-resolution upsample (its layout grew).
 // 10: the packed G-buffer ("gbuffer", gbuffer.glsl); LitSurfaceInputs reads depth + gbuffer.
 // 11: GpuScene::drawGBuffer takes an optional culling matrix.
-// 12: vk::Pipeline holds its shader's reflected interface (bindings by name, checked blocks).
+// 12: vk::Pipeline holds its shader's reflected interface (bindings by name, checked blocks);
+//     SettingValues stores values per declaration index (typed Setting<T> handles).
 #define GI_EFFECT_ABI_VERSION 12u
 
 namespace gi {

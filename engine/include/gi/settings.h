@@ -4,9 +4,12 @@
 #pragma once
 
 #include <array>
+#include <cmath>
+#include <cstddef>
 #include <initializer_list>
 #include <map>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -56,6 +59,15 @@ struct SettingDesc {
 void validateSettingDescs(const std::string& owner, const std::vector<SettingDesc>& descs);
 
 // The current values of one owner's settings (an effect, or "engine").
+// A setting found once by name (its place in the effect's declaration) and then read without a
+// string look-up: make it with SettingValues::handle<T>(name) in prepare(), read it with
+// values[handle] every frame. T: double (Float, Int, Bool, Enum index), int (Int, Enum index)
+// or bool (Bool).
+template <class T>
+struct Setting {
+  size_t index = size_t(-1);
+};
+
 class SettingValues {
  public:
   SettingValues() = default;
@@ -76,6 +88,29 @@ class SettingValues {
   bool flag(const std::string& key) const;
   const std::string& option(const std::string& key) const;     // Enum only: the name
   std::array<double, 3> vector(const std::string& key) const;  // Vec3/Color only
+  // A typed handle to `key` (throws for an unknown key or a type T cannot hold).
+  template <class T>
+  Setting<T> handle(const std::string& key) const {
+    if constexpr (std::is_same_v<T, bool>)
+      typed(key, {SettingType::Bool}, "a bool");
+    else if constexpr (std::is_same_v<T, int>)
+      typed(key, {SettingType::Int, SettingType::Enum}, "an int");
+    else
+      typed(key, {SettingType::Bool, SettingType::Int, SettingType::Float, SettingType::Enum},
+            "a number");
+    return {index(key)};
+  }
+  template <class T>
+  T operator[](Setting<T> h) const {
+    handleDesc(h.index, "typed");
+    const double v = values_[h.index][0];
+    if constexpr (std::is_same_v<T, bool>)
+      return v != 0.0;
+    else if constexpr (std::is_same_v<T, int>)
+      return int(std::lround(v));
+    else
+      return v;
+  }
   const std::string& owner() const { return owner_; }
   const std::vector<SettingDesc>& descs() const { return descs_; }
   const SettingDesc& desc(const std::string& key) const;
@@ -87,9 +122,11 @@ class SettingValues {
  private:
   const SettingDesc& typed(const std::string& key, std::initializer_list<SettingType> types,
                            const char* what) const;
+  size_t index(const std::string& key) const;  // throws for an unknown key
+  const SettingDesc& handleDesc(size_t index, const char* type) const;
   std::string owner_;
   std::vector<SettingDesc> descs_;
-  std::map<std::string, std::array<double, 3>> values_;  // scalars (and enum index) in [0]
+  std::vector<std::array<double, 3>> values_;  // per desc; scalars (and enum index) in [0]
 };
 
 const char* settingTypeName(SettingType type);

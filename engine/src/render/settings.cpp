@@ -201,12 +201,24 @@ void validateSettingDescs(const std::string& owner, const std::vector<SettingDes
 
 SettingValues::SettingValues(std::string owner, std::vector<SettingDesc> descs)
     : owner_(std::move(owner)), descs_(std::move(descs)) {
+  std::set<std::string> names;
   for (const SettingDesc& d : descs_) {
-    if (values_.count(d.name))
+    if (!names.insert(d.name).second)
       throw Error(ErrorKind::Schema, "", owner_ + ": setting '" + d.name + "' declared twice");
-    values_[d.name] =
-        isVector(d.type) ? d.defaultVector : std::array<double, 3>{d.defaultValue, 0.0, 0.0};
+    values_.push_back(isVector(d.type) ? d.defaultVector
+                                       : std::array<double, 3>{d.defaultValue, 0.0, 0.0});
   }
+}
+
+size_t SettingValues::index(const std::string& key) const {
+  return size_t(&desc(key) - descs_.data());
+}
+
+const SettingDesc& SettingValues::handleDesc(size_t index, const char* type) const {
+  if (index >= descs_.size())
+    throw Error(ErrorKind::Schema, "",
+                owner_ + ": a " + type + " setting handle made for another declaration");
+  return descs_[index];
 }
 
 const SettingDesc& SettingValues::desc(const std::string& key) const {
@@ -263,7 +275,7 @@ void SettingValues::set(const std::string& key, const json& value, const std::st
       if (i == d->options.size())
         throw Error(ErrorKind::Schema, origin,
                     where + ": unknown option '" + name + "' (one of: " + optionList(*d) + ")");
-      values_[key] = {double(i), 0.0, 0.0};
+      values_[index(key)] = {double(i), 0.0, 0.0};
       return;
     }
     case SettingType::Vec3:
@@ -283,14 +295,14 @@ void SettingValues::set(const std::string& key, const json& value, const std::st
                       comp + ": expected a finite number in [" + num(d->minValue) + ", " +
                           num(d->maxValue) + "], got " + num(v[i]));
       }
-      values_[key] = v;
+      values_[index(key)] = v;
       return;
     }
   }
   if (!std::isfinite(v[0])) fail(ErrorKind::InvalidData);
   if (d->type != SettingType::Bool && (v[0] < d->minValue || v[0] > d->maxValue))
     fail(ErrorKind::InvalidData);
-  values_[key] = v;
+  values_[index(key)] = v;
 }
 
 namespace {
@@ -340,7 +352,7 @@ void SettingValues::setFromString(const std::string& key, const std::string& tex
 double SettingValues::number(const std::string& key) const {
   typed(key, {SettingType::Bool, SettingType::Int, SettingType::Float, SettingType::Enum},
         "a number (use vector())");
-  return values_.at(key)[0];
+  return values_[index(key)][0];
 }
 int SettingValues::integer(const std::string& key) const {
   return int(std::lround(number(key)));
@@ -350,17 +362,17 @@ bool SettingValues::flag(const std::string& key) const {
 }
 const std::string& SettingValues::option(const std::string& key) const {
   const SettingDesc& d = typed(key, {SettingType::Enum}, "an enum");
-  return d.options.at(size_t(values_.at(key)[0]));
+  return d.options.at(size_t(values_[index(key)][0]));
 }
 std::array<double, 3> SettingValues::vector(const std::string& key) const {
   typed(key, {SettingType::Vec3, SettingType::Color}, "a vec3 or color");
-  return values_.at(key);
+  return values_[index(key)];
 }
 
 json SettingValues::toJson() const {
   json j = json::object();
   for (const SettingDesc& d : descs_) {
-    const std::array<double, 3>& v = values_.at(d.name);
+    const std::array<double, 3>& v = values_[size_t(&d - descs_.data())];
     switch (d.type) {
       case SettingType::Bool:
         j[d.name] = v[0] != 0.0;
@@ -384,10 +396,11 @@ json SettingValues::toJson() const {
 }
 
 bool SettingValues::graphDiffers(const SettingValues& other) const {
-  for (const SettingDesc& d : descs_)
-    if (d.changesGraph && other.values_.count(d.name) &&
-        other.values_.at(d.name) != values_.at(d.name))
-      return true;
+  for (size_t i = 0; i < descs_.size(); ++i) {
+    if (!descs_[i].changesGraph) continue;
+    for (size_t j = 0; j < other.descs_.size(); ++j)
+      if (other.descs_[j].name == descs_[i].name && other.values_[j] != values_[i]) return true;
+  }
   return false;
 }
 
