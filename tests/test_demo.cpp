@@ -428,6 +428,42 @@ TEST(Demo, HotReloadOfAnEffectShader) {
                                   << r.output;
 }
 
+// Hot reload of a shader whose parameter block no longer matches the effect's C++ struct (a
+// member added): the pipeline is refused with the member named, and the built-in shaders run
+// again (the first image, bit for bit).
+TEST(Demo, HotReloadOfAMismatchedParameterBlockIsRefusedNamingTheMember) {
+  REQUIRE_DEMO();
+  const std::string dir = test::makeTempDir("demo_reload_block");
+  const std::string shaders = dir + "/shaders";
+  fs::create_directories(shaders);
+  const std::string original = std::string(GI_SOURCE_DIR) + "/effects/ssao/ssao.comp";
+  fs::copy_file(original, shaders + "/ssao.comp");
+  std::stringstream ss;
+  ss << std::ifstream(original).rdbuf();
+  std::string text = ss.str();
+  const std::string member = "  ivec4 counts;";
+  const size_t at = text.find(member);
+  ASSERT_NE(at, std::string::npos) << "ssao.comp changed: update this test";
+  text.insert(at, "  vec4 extra;\n");
+  std::ofstream(dir + "/extra.comp") << text;
+  const std::string script = writeScript(
+      dir, "pause on\nframes 2\nscreenshot " + dir + "/a.png\ncopy " + dir + "/extra.comp " +
+               shaders + "/ssao.comp\nreload\nframes 2\nscreenshot " + dir + "/b.png\n");
+  auto r = runDemo(" --scene default --effects ssao --set ssao.blur_radius=0 --view ao" + kSize +
+                   " --shader-dir " + shaders + " --script " + script);
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_EQ(r.output.find("validation"), std::string::npos) << r.output;
+  std::string reload;
+  std::istringstream lines(r.output);
+  for (std::string line; std::getline(lines, line);)
+    if (line.rfind("reload:", 0) == 0) reload = line;
+  EXPECT_EQ(reload.rfind("reload: error: ", 0), 0u) << r.output;
+  EXPECT_NE(reload.find("'SsaoParams'"), std::string::npos) << reload;
+  EXPECT_NE(reload.find("member 'extra'"), std::string::npos) << reload;
+  EXPECT_EQ(readPng(dir + "/a.png").pixels, readPng(dir + "/b.png").pixels)
+      << "the built-in shaders must run again";
+}
+
 TEST(Demo, BadScriptFailsWithOneLineBeforeAnyWindow) {
   if (!fs::exists(test::binPath("gi-demo"))) GTEST_SKIP() << "gi-demo not built";
   const std::string dir = test::makeTempDir("demo_bad");
