@@ -214,7 +214,7 @@ int run(const Options& o) {
     renderer.setTime(o.time + rendered * o.timeStep);
     renderer.renderFrame();
     for (const auto& t : renderer.lastTimings()) samples[t.name].push_back(t.ms);
-    if (swapchain) swapchain->present(renderer);
+    if (swapchain) swapchain->present(renderer.outputImage(), renderer.outputExtent());
   }
   if (rendered == 0) std::printf("window closed before the first frame\n");
   if (rendered > 0 && !o.out.empty()) writeImage(o.out, view, renderer);

@@ -7,7 +7,6 @@
 #include <limits>
 
 #include "gi/errors.h"
-#include "gi/renderer.h"
 #include "gi/vk/common.h"
 #include "gi/vk/resources.h"
 
@@ -166,10 +165,6 @@ void Swapchain::create() {
         "vkGetSwapchainImagesKHR");
   for (uint32_t i = 0; i < count; ++i) renderFinished_.push_back(createSemaphore(device));
   outOfDate_ = false;
-}
-
-bool Swapchain::present(const Renderer& renderer) {
-  return present(renderer.outputImage(), renderer.outputExtent());
 }
 
 bool Swapchain::present(VkImage source, VkExtent2D sourceExtent) {

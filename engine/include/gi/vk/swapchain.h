@@ -11,10 +11,6 @@
 
 struct GLFWwindow;  // keeps GLFW out of this header
 
-namespace gi {
-class Renderer;
-}
-
 namespace gi::vk {
 
 class Swapchain {
@@ -31,8 +27,6 @@ class Swapchain {
   // scaled to the window. Leaves `source` in GENERAL; later submissions on the queue wait for
   // the copy. Returns false when nothing was shown (a minimised window has no image to show).
   bool present(VkImage source, VkExtent2D sourceExtent);
-  // The renderer's output image after renderer.renderFrame().
-  bool present(const Renderer& renderer);
 
   VkFormat format() const { return format_; }
   VkExtent2D extent() const { return extent_; }
