@@ -365,20 +365,27 @@ TEST(Demo, AccuracyBeforeAnyFrameOfTheViewSaysToRenderOne) {
 // the last good pipeline keeps giving the same image), changed to a constant AO of 0.5 (every
 // pixel of the AO view is 128), then restored (the first image again, bit for bit); no
 // validation message, and the device memory comes back to its start value.
-TEST(Demo, HotReloadOfAnEffectShader) {
-  REQUIRE_DEMO();
-  const std::string dir = test::makeTempDir("demo_reload");
-  const std::string shaders = dir + "/shaders";
-  fs::create_directories(shaders);
-  const std::string original = std::string(GI_SOURCE_DIR) + "/effects/ssao/ssao.comp";
-  fs::copy_file(original, shaders + "/ssao.comp");
-  std::string text;
-  {
-    std::ifstream in(original);
+// A temporary folder for a hot-reload test: `shaders` (the --shader-dir) holds a copy of
+// ssao.comp, whose text is `text`.
+struct SsaoShaderCopy {
+  std::string dir, shaders, original, text;
+  explicit SsaoShaderCopy(const std::string& name)
+      : dir(test::makeTempDir(name)),
+        shaders(dir + "/shaders"),
+        original(std::string(GI_SOURCE_DIR) + "/effects/ssao/ssao.comp") {
+    fs::create_directories(shaders);
+    fs::copy_file(original, shaders + "/ssao.comp");
     std::stringstream ss;
-    ss << in.rdbuf();
+    ss << std::ifstream(original).rdbuf();
     text = ss.str();
   }
+};
+
+TEST(Demo, HotReloadOfAnEffectShader) {
+  REQUIRE_DEMO();
+  const SsaoShaderCopy copy("demo_reload");
+  const std::string &dir = copy.dir, &shaders = copy.shaders, &original = copy.original,
+                    &text = copy.text;
   std::ofstream(dir + "/broken.comp") << text << "\nthis is not glsl\n";
   const std::string bounds = "  if (p.x >= size.x || p.y >= size.y) return;\n";
   const size_t at = text.find(bounds);
@@ -433,14 +440,9 @@ TEST(Demo, HotReloadOfAnEffectShader) {
 // again (the first image, bit for bit).
 TEST(Demo, HotReloadOfAMismatchedParameterBlockIsRefusedNamingTheMember) {
   REQUIRE_DEMO();
-  const std::string dir = test::makeTempDir("demo_reload_block");
-  const std::string shaders = dir + "/shaders";
-  fs::create_directories(shaders);
-  const std::string original = std::string(GI_SOURCE_DIR) + "/effects/ssao/ssao.comp";
-  fs::copy_file(original, shaders + "/ssao.comp");
-  std::stringstream ss;
-  ss << std::ifstream(original).rdbuf();
-  std::string text = ss.str();
+  const SsaoShaderCopy copy("demo_reload_block");
+  const std::string &dir = copy.dir, &shaders = copy.shaders;
+  std::string text = copy.text;
   const std::string member = "  ivec4 counts;";
   const size_t at = text.find(member);
   ASSERT_NE(at, std::string::npos) << "ssao.comp changed: update this test";
