@@ -349,6 +349,15 @@ TEST_F(ShaderInterfaceGpu, ExplicitBindingsMustCoverTheShader) {
                           28);
   });
   EXPECT_TRUE(contains(m, "binding 2 ('colorTex') is a sampled texture")) << m;
+  // A shader without push constants takes none.
+  const char* plain =
+      "#version 460\nlayout(local_size_x = 1) in;\n"
+      "layout(set = 0, binding = 0, r32f) uniform writeonly image2D o;\n"
+      "void main() { imageStore(o, ivec2(0), vec4(1)); }\n";
+  const vk::Pipeline p = vk::Pipeline::compute(
+      ctx(), {"plain", vk::compileGlsl(plain, VK_SHADER_STAGE_COMPUTE_BIT, "plain.comp")});
+  const std::string none = messageOf([&] { p.push(VK_NULL_HANDLE, 1.0f); });
+  EXPECT_TRUE(contains(none, "plain: the shader has no push constants")) << none;
 }
 
 }  // namespace

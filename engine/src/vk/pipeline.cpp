@@ -75,6 +75,8 @@ void Pipeline::useReflection(const std::string& name, ShaderInterface iface,
 }
 
 void Pipeline::pushBytes(VkCommandBuffer cmd, const void* data, size_t size) const {
+  if (pushRange_ == 0)
+    throw Error(ErrorKind::ShaderInterface, "", name_ + ": the shader has no push constants");
   if (cppPushSize_ && size != cppPushSize_)
     throw Error(ErrorKind::ShaderInterface, "",
                 name_ + ": pushed " + std::to_string(size) +
@@ -155,7 +157,8 @@ Pipeline Pipeline::compute(Context& ctx, const std::vector<uint32_t>& spirv,
   p.ctx_ = &ctx;
   p.bindPoint_ = VK_PIPELINE_BIND_POINT_COMPUTE;
   const std::vector<uint32_t> code = resolveShader(spirv);
-  p.interface_ = reflectShader(code, VK_SHADER_STAGE_COMPUTE_BIT, "compute shader");
+  p.name_ = "compute shader";
+  p.interface_ = reflectShader(code, VK_SHADER_STAGE_COMPUTE_BIT, p.name_);
   checkExplicitBindings(bindings, p.interface_);
   p.createLayout(bindings, pushConstantBytes);
   p.pipeline_ = createCompute(ctx, code, p.layout_, specialization);
@@ -173,6 +176,7 @@ Pipeline Pipeline::graphics(Context& ctx, const GraphicsDesc& d) {
       mergeInterfaces(reflectShader(vertex, VK_SHADER_STAGE_VERTEX_BIT, label + " (vertex)"),
                       reflectShader(fragment, VK_SHADER_STAGE_FRAGMENT_BIT, label + " (fragment)"));
   if (d.name.empty()) {
+    p.name_ = label;
     checkExplicitBindings(d.bindings, iface);
     p.interface_ = std::move(iface);
     p.createLayout(d.bindings, d.pushConstantBytes);
