@@ -95,44 +95,25 @@ class HbaoEffect : public gi::Effect {
 
   void addPasses(gi::FrameGraph& graph, gi::EffectContext& ctx,
                  const gi::SettingValues& settings) override {
-    struct Io {
-      gi::TextureHandle depth, gbuffer, raw, ao;
-    };
-    auto io = std::make_shared<Io>();
-    gi::Blackboard& bb = graph.blackboard();
-    // changesGraph settings: fixed for this graph.
+    // changesGraph: fixed for this graph. Without a blur "ao" is the packed texture itself (its
+    // red channel is the AO).
     const int blurRadius = settings.integer("blur_radius");
-    const VkBuffer frame = ctx.frameUniforms();
-    const VkSampler nearest = ctx.nearestSampler();
-
-    graph.addPass(
-        "hbao",
-        [&](gi::PassBuilder& b) {
-          io->depth = b.read(bb.texture(res::kDepth));
-          io->gbuffer = b.read(bb.texture(res::kGBuffer));
-          io->raw = b.write(b.create(blurRadius > 0 ? "hbao_raw" : res::kAO,
-                                     gi::TextureDesc{gi::DepthAwareBlur::kPackedFormat}),
-                            gi::TextureUsage::StorageWrite);
-        },
-        [this, io, values = &settings, frame, nearest](gi::PassContext& pc) {
-          upload(*values);
-          gi::vk::DescriptorWriter w(hbao_);
-          w.buffer("Frame", frame)
-              .buffer("hbao", uniforms_.handle())
-              .texture("gDepth", pc.view(io->depth), nearest)
-              .texture("giGBuffer", pc.view(io->gbuffer), nearest)
-              .image("outAO", pc.view(io->raw));
-          const VkExtent2D e = pc.extent(io->raw);
-          pc.dispatch(hbao_, w, e, kGroupX, kGroupY);
-        });
-
-    io->ao = io->raw;
+    // `settings` lives as long as the graph and is updated in place: uniform-only settings are
+    // read (and uploaded) when the pass records, every frame.
+    gi::TextureHandle ao =
+        gi::DepthAwareBlur::addProducer(graph, ctx,
+                                        {"hbao", &hbao_, "outAO", kGroupX, kGroupY,
+                                         [this, values = &settings](gi::vk::DescriptorWriter& w) {
+                                           upload(*values);
+                                           w.buffer("hbao", uniforms_.handle());
+                                         }},
+                                        blurRadius > 0 ? "hbao_raw" : res::kAO);
     if (blurRadius > 0)
-      io->ao = blur_.addPass(graph, ctx, "hbao_blur", io->raw, res::kAO,
-                             [values = &settings, radius = h_.radius] {
-                               return float(gi::hbao::kBlurDepthTolerance * (*values)[radius]);
-                             });
-    bb.put(res::kAO, io->ao);
+      ao = blur_.addPass(graph, ctx, "hbao_blur", ao, res::kAO,
+                         [values = &settings, radius = h_.radius] {
+                           return float(gi::hbao::kBlurDepthTolerance * (*values)[radius]);
+                         });
+    graph.blackboard().put(res::kAO, ao);
   }
 
  private:

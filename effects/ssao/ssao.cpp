@@ -97,46 +97,25 @@ class SsaoEffect : public gi::Effect {
 
   void addPasses(gi::FrameGraph& graph, gi::EffectContext& ctx,
                  const gi::SettingValues& settings) override {
-    struct Io {
-      gi::TextureHandle depth, gbuffer, raw;
-    };
-    // Without a blur "ao" is the packed texture itself (its red channel is the AO).
-    auto io = std::make_shared<Io>();
-    gi::Blackboard& bb = graph.blackboard();
-    const int blurRadius = settings.integer("blur_radius");  // changesGraph: fixed per graph
-    const VkBuffer frame = ctx.frameUniforms();
-    const VkSampler nearest = ctx.nearestSampler();
-
-    // The renderer keeps `settings` alive for the graph's life and updates it in place, so
-    // uniform-only settings are read (and uploaded) when the pass is recorded, every frame.
-    graph.addPass(
-        "ssao",
-        [&](gi::PassBuilder& b) {
-          io->depth = b.read(bb.texture(res::kDepth));
-          io->gbuffer = b.read(bb.texture(res::kGBuffer));
-          io->raw = b.write(b.create(blurRadius > 0 ? "ssao_raw" : res::kAO,
-                                     gi::TextureDesc{gi::DepthAwareBlur::kPackedFormat}),
-                            gi::TextureUsage::StorageWrite);
-        },
-        [this, io, values = &settings, frame, nearest](gi::PassContext& pc) {
-          upload(*values);
-          gi::vk::DescriptorWriter w(ssao_);
-          w.buffer("Frame", frame)
-              .buffer("ssao", uniforms_.handle())
-              .texture("gDepth", pc.view(io->depth), nearest)
-              .texture("giGBuffer", pc.view(io->gbuffer), nearest)
-              .image("outAO", pc.view(io->raw));
-          const VkExtent2D e = pc.extent(io->raw);
-          pc.dispatch(ssao_, w, e, kGroupX, kGroupY);
-        });
-
-    gi::TextureHandle ao = io->raw;
+    // changesGraph: fixed for this graph. Without a blur "ao" is the packed texture itself (its
+    // red channel is the AO).
+    const int blurRadius = settings.integer("blur_radius");
+    // `settings` lives as long as the graph and is updated in place: uniform-only settings are
+    // read (and uploaded) when the pass records, every frame.
+    gi::TextureHandle ao =
+        gi::DepthAwareBlur::addProducer(graph, ctx,
+                                        {"ssao", &ssao_, "outAO", kGroupX, kGroupY,
+                                         [this, values = &settings](gi::vk::DescriptorWriter& w) {
+                                           upload(*values);
+                                           w.buffer("ssao", uniforms_.handle());
+                                         }},
+                                        blurRadius > 0 ? "ssao_raw" : res::kAO);
     if (blurRadius > 0)
-      ao = blur_.addPass(graph, ctx, "ssao_blur", io->raw, res::kAO,
+      ao = blur_.addPass(graph, ctx, "ssao_blur", ao, res::kAO,
                          [values = &settings, radius = radius_] {
                            return float(gi::ssao::kBlurDepthTolerance * (*values)[radius]);
                          });
-    bb.put(res::kAO, ao);
+    graph.blackboard().put(res::kAO, ao);
   }
 
  private:

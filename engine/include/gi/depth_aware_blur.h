@@ -43,6 +43,21 @@ class DepthAwareBlur {
                         TextureHandle packed, const std::string& output,
                         std::function<float()> tolerance) const;
 
+  // The pass that writes the packed texels, in the shape most effects share: `pipeline` runs
+  // over every pixel of a new kPackedFormat texture `texture` of the frame's size, its shader
+  // reading the frame uniforms as "Frame" and the G-buffer as "gDepth" and "giGBuffer"
+  // (gbuffer.glsl) and writing the texels to its storage image `image`. `bind` adds the pass's
+  // own resources while it records (read uniform-only settings and upload there).
+  struct Producer {
+    std::string name;  // the pass
+    const vk::Pipeline* pipeline = nullptr;
+    std::string image;
+    uint32_t groupX = 32, groupY = 16;
+    std::function<void(vk::DescriptorWriter&)> bind;
+  };
+  static TextureHandle addProducer(FrameGraph& graph, EffectContext& ctx, Producer producer,
+                                   const std::string& texture);
+
  private:
   struct Push {  // depth_aware_blur_pass.glsl's and depth_aware_upsample.comp's push constants
     float tolerance;

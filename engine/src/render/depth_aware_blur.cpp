@@ -101,4 +101,33 @@ TextureHandle DepthAwareBlur::addPass(FrameGraph& graph, EffectContext& ctx,
   return up->out;
 }
 
+TextureHandle DepthAwareBlur::addProducer(FrameGraph& graph, EffectContext& ctx, Producer producer,
+                                          const std::string& texture) {
+  struct Io {
+    TextureHandle depth, gbuffer, out;
+  };
+  auto io = std::make_shared<Io>();
+  Blackboard& bb = graph.blackboard();
+  const std::string name = producer.name;  // copied before the callback takes `producer`
+  graph.addPass(
+      name,
+      [&](PassBuilder& b) {
+        io->depth = b.read(bb.texture(resources::kDepth));
+        io->gbuffer = b.read(bb.texture(resources::kGBuffer));
+        io->out =
+            b.write(b.create(texture, TextureDesc{kPackedFormat}), TextureUsage::StorageWrite);
+      },
+      [io, p = std::move(producer), frame = ctx.frameUniforms(),
+       nearest = ctx.nearestSampler()](PassContext& pc) {
+        vk::DescriptorWriter w(*p.pipeline);
+        w.buffer("Frame", frame)
+            .texture("gDepth", pc.view(io->depth), nearest)
+            .texture("giGBuffer", pc.view(io->gbuffer), nearest)
+            .image(p.image, pc.view(io->out));
+        if (p.bind) p.bind(w);
+        pc.dispatch(*p.pipeline, w, pc.extent(io->out), p.groupX, p.groupY);
+      });
+  return io->out;
+}
+
 }  // namespace gi
