@@ -11,6 +11,7 @@
 #include <set>
 
 #include "gi/effect.h"
+#include "gi/effect_contract.h"
 #include "gi/environment.h"
 #include "gi/errors.h"
 #include "gi/gbuffer.h"
@@ -325,45 +326,17 @@ struct Renderer::Impl : EffectContext {
 
   // ---- the frame graph ----------------------------------------------------------------------
 
-  // Effects of one stage in the order their declared resources imply: an effect that reads what
-  // another produces runs after it. A resource an effect both reads and writes (it modifies it
-  // in place, like "lit") orders nothing: such effects keep the scene's order among the others.
-  // A cycle is an error naming the effects.
+  // Effects of one stage in the order their declared resources imply (gi/effect_contract.h).
   std::vector<ActiveEffect*> orderedEffects(EffectStage stage) {
     std::vector<ActiveEffect*> list;
+    std::vector<const EffectInfo*> infos;
     for (ActiveEffect& a : effects)
-      if (a.info.stage == stage) list.push_back(&a);
-    auto has = [](const std::vector<std::string>& v, const std::string& x) {
-      return std::find(v.begin(), v.end(), x) != v.end();
-    };
-    auto dependsOn = [&](const ActiveEffect* b, const ActiveEffect* a) {  // b after a?
-      for (const std::string& r : a->info.writes)
-        if (!has(a->info.reads, r) && has(b->info.reads, r)) return true;
-      return false;
-    };
+      if (a.info.stage == stage) {
+        list.push_back(&a);
+        infos.push_back(&a.info);
+      }
     std::vector<ActiveEffect*> out;
-    std::vector<bool> done(list.size(), false);
-    while (out.size() < list.size()) {
-      bool progressed = false;
-      for (size_t i = 0; i < list.size() && !progressed; ++i) {
-        if (done[i]) continue;
-        bool ready = true;
-        for (size_t j = 0; j < list.size() && ready; ++j)
-          if (j != i && !done[j] && dependsOn(list[i], list[j])) ready = false;
-        if (ready) {
-          done[i] = true;
-          out.push_back(list[i]);
-          progressed = true;
-        }
-      }
-      if (!progressed) {
-        std::string names;
-        for (size_t i = 0; i < list.size(); ++i)
-          if (!done[i]) names += (names.empty() ? "" : ", ") + list[i]->info.name;
-        throw Error(ErrorKind::Usage, "",
-                    "effects " + names + " depend on each other's outputs (a cycle)");
-      }
-    }
+    for (size_t i : orderEffects(infos)) out.push_back(list[i]);
     return out;
   }
 
@@ -379,27 +352,9 @@ struct Renderer::Impl : EffectContext {
     Blackboard& bb = graph.blackboard();
     bb.startTracking();
     e.addPasses(graph, *this, values);
-    auto declared = [](const std::vector<std::string>& v, const std::string& x) {
-      return std::find(v.begin(), v.end(), x) != v.end();
-    };
-    for (const std::string& name : bb.lookedUp())
-      if (!declared(info.reads, name) && !declared(info.writes, name))
-        throw Error(ErrorKind::Usage, "",
-                    "effect '" + info.name + "' reads '" + name +
-                        "', which its EffectInfo::reads does not declare");
-    for (const std::string& name : bb.published())
-      if (!declared(info.writes, name))
-        throw Error(ErrorKind::Usage, "",
-                    "effect '" + info.name + "' publishes '" + name +
-                        "', which its EffectInfo::writes does not declare");
-    // An effect may choose to add nothing at all, and to leave an optional lighting input
-    // unpublished (its neutral fallback stands in: e.g. SSDO's contact_shadow when off).
-    if (!bb.published().empty())
-      for (const std::string& name : info.writes)
-        if (!bb.published().count(name) && !isOptionalInput(name))
-          throw Error(ErrorKind::Usage, "",
-                      "effect '" + info.name + "' declares it writes '" + name +
-                          "' but published nothing under that name");
+    // An optional lighting input may stay unpublished: its neutral fallback stands in (e.g.
+    // SSDO's contact_shadow when off).
+    checkEffectResources(info, bb.lookedUp(), bb.published(), isOptionalInput);
   }
 
   void addBuiltin(Effect& e) {
