@@ -4,6 +4,7 @@
 #include <memory>
 
 #include "gi/errors.h"
+#include "gi/image_pass.h"
 #include "gi/vk/resources.h"
 
 namespace gi {
@@ -103,31 +104,19 @@ TextureHandle DepthAwareBlur::addPass(FrameGraph& graph, EffectContext& ctx,
 
 TextureHandle DepthAwareBlur::addProducer(FrameGraph& graph, EffectContext& ctx, Producer producer,
                                           const std::string& texture) {
-  struct Io {
-    TextureHandle depth, gbuffer, out;
-  };
-  auto io = std::make_shared<Io>();
-  Blackboard& bb = graph.blackboard();
-  const std::string name = producer.name;  // copied before the callback takes `producer`
-  graph.addPass(
-      name,
-      [&](PassBuilder& b) {
-        io->depth = b.read(bb.texture(resources::kDepth));
-        io->gbuffer = b.read(bb.texture(resources::kGBuffer));
-        io->out =
-            b.write(b.create(texture, TextureDesc{kPackedFormat}), TextureUsage::StorageWrite);
-      },
-      [io, p = std::move(producer), frame = ctx.frameUniforms(),
-       nearest = ctx.nearestSampler()](PassContext& pc) {
-        vk::DescriptorWriter w(*p.pipeline);
-        w.buffer("Frame", frame)
-            .texture("gDepth", pc.view(io->depth), nearest)
-            .texture("giGBuffer", pc.view(io->gbuffer), nearest)
-            .image(p.image, pc.view(io->out));
-        if (p.bind) p.bind(w);
-        pc.dispatch(*p.pipeline, w, pc.extent(io->out), p.groupX, p.groupY);
-      });
-  return io->out;
+  auto bind = std::move(producer.bind);
+  return addImagePass(graph, ctx,
+                      {producer.name,
+                       producer.pipeline,
+                       {{resources::kDepth, "gDepth"}, {resources::kGBuffer, "giGBuffer"}},
+                       texture,
+                       TextureDesc{kPackedFormat},
+                       producer.image,
+                       producer.groupX,
+                       producer.groupY,
+                       [bind](vk::DescriptorWriter& w, PassContext&) {
+                         if (bind) bind(w);
+                       }});
 }
 
 }  // namespace gi
