@@ -77,10 +77,7 @@ class GtaoEffect : public gi::Effect {
          "Jimenez et al. multi-bounce fit: AO' = max(AO, ((a AO + b) AO + c) AO) from the albedo "
          "(reads the albedo G-buffer)",
          true},
-        {"blur_radius", SettingType::Int, 2, 0, gi::DepthAwareBlur::kMaxRadius,
-         "depth-aware denoise radius in pixels (0: no blur pass; even radii cancel the 4x4 "
-         "interleave pattern exactly)",
-         true},
+        gi::DepthAwareBlur::radiusSetting(2),
         {"interleave", SettingType::Bool, 1, 0, 1,
          "rotate the slices and jitter the steps in a 4x4 pixel pattern for the blur to average",
          false},

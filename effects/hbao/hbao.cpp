@@ -58,10 +58,7 @@ class HbaoEffect : public gi::Effect {
          "degrees added to the tangent angle: horizons below it do not occlude (hides "
          "tessellation and depth-precision self-occlusion)",
          false},
-        {"blur_radius", SettingType::Int, 2, 0, gi::DepthAwareBlur::kMaxRadius,
-         "depth-aware blur radius in pixels (0: no blur pass; even radii cancel the 4x4 "
-         "interleave pattern exactly)",
-         true},
+        gi::DepthAwareBlur::radiusSetting(2),
         {"interleave", SettingType::Bool, 1, 0, 1,
          "rotate the directions and jitter the steps in a 4x4 pixel pattern (per-pixel "
          "randomization) for the blur to average",

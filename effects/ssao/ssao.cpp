@@ -65,10 +65,7 @@ class SsaoEffect : public gi::Effect {
          "an occluder must be this far in front of a tap, as a fraction of the radius", false},
         {"intensity", SettingType::Float, 1.0, 0.0, 4.0,
          "AO = 1 - intensity x occluded fraction (clamped to [0, 1])", false},
-        {"blur_radius", SettingType::Int, 2, 0, gi::DepthAwareBlur::kMaxRadius,
-         "depth-aware blur radius in pixels (0: no blur pass; even radii cancel the 4x4 "
-         "interleave pattern exactly)",
-         true},
+        gi::DepthAwareBlur::radiusSetting(2),
         {"interleave", SettingType::Bool, 1, 0, 1,
          "rotate the kernel in a 4x4 pixel pattern (16 rotations) for the blur to average", false},
     };

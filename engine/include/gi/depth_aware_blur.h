@@ -31,6 +31,10 @@ class DepthAwareBlur {
   static constexpr int kMaxRadius = 8;
   static constexpr int kMaxScale = 4;
 
+  // The "blur_radius" setting of an effect that blurs with this (changesGraph: the radius is
+  // compiled into the blur), 0..kMaxRadius.
+  static SettingDesc radiusSetting(int defaultRadius = 2);
+
   // Builds the pipelines. `radius` (at most kMaxRadius; 0: no blur, only the upsample, which
   // needs scale > 1) and `scale` (1..kMaxScale) are compiled into them.
   void prepare(EffectContext& ctx, int radius, int scale = 1);

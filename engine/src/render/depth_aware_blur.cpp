@@ -102,6 +102,17 @@ TextureHandle DepthAwareBlur::addPass(FrameGraph& graph, EffectContext& ctx,
   return up->out;
 }
 
+SettingDesc DepthAwareBlur::radiusSetting(int defaultRadius) {
+  return {"blur_radius",
+          SettingType::Int,
+          double(defaultRadius),
+          0.0,
+          double(kMaxRadius),
+          "depth-aware blur radius in pixels (0: no blur pass; even radii cancel the 4x4 "
+          "interleave pattern exactly)",
+          true};
+}
+
 TextureHandle DepthAwareBlur::addProducer(FrameGraph& graph, EffectContext& ctx, Producer producer,
                                           const std::string& texture) {
   auto bind = std::move(producer.bind);
