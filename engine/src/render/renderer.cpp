@@ -341,10 +341,8 @@ struct Renderer::Impl : EffectContext {
   }
 
   static bool isOptionalInput(const std::string& name) {
-    for (const char* n :
-         {res::kAO, res::kAmbient, res::kIndirect, res::kContactShadow, res::kDirectLight})
-      if (name == n) return true;
-    return false;
+    return std::any_of(kLightingInputs.begin(), kLightingInputs.end(),
+                       [&](const LightingInput& in) { return name == in.resource; });
   }
 
   // Adds one effect's (or built-in's) passes and checks them against its declaration.
@@ -373,14 +371,9 @@ struct Renderer::Impl : EffectContext {
     enginePasses.clear();
     Blackboard& bb = graph.blackboard();
     // The neutral value of each optional lighting input, declared in this one place.
-    graph.declareFallback(res::kAO, VK_FORMAT_R8G8B8A8_UNORM, {{1.0f, 1.0f, 1.0f, 1.0f}});
-    graph.declareFallback(res::kAmbient, VK_FORMAT_R16G16B16A16_SFLOAT, {{0.0f, 0.0f, 0.0f, 0.0f}});
-    graph.declareFallback(res::kIndirect, VK_FORMAT_R16G16B16A16_SFLOAT,
-                          {{0.0f, 0.0f, 0.0f, 0.0f}});
-    graph.declareFallback(res::kContactShadow, VK_FORMAT_R8G8B8A8_UNORM,
-                          {{1.0f, 1.0f, 1.0f, 1.0f}});
-    graph.declareFallback(res::kDirectLight, VK_FORMAT_R16G16B16A16_SFLOAT,
-                          {{0.0f, 0.0f, 0.0f, 0.0f}});
+    for (const LightingInput& in : kLightingInputs)
+      graph.declareFallback(in.resource, in.format,
+                            {{in.neutral[0], in.neutral[1], in.neutral[2], in.neutral[3]}});
     // Engine data every pass may read: lights, shadow views, the environment.
     bb.put(res::kLights,
            graph.importBuffer(res::kLights, lightBuffer.handle(), lightBuffer.size()));

@@ -3,6 +3,7 @@
 // orchestrates them (renderer.cpp); what they share with it is EngineState.
 #pragma once
 
+#include <array>
 #include <memory>
 #include <string>
 
@@ -40,13 +41,37 @@ std::unique_ptr<Effect> makeLightingPass(EngineState& state);
 std::unique_ptr<Effect> makeTonemapPass(EngineState& state);
 std::unique_ptr<Effect> makeFloorPass(EngineState& state);
 
+// The lighting pass's optional inputs, in this one table: the blackboard resource an effect may
+// publish, the 1x1 neutral texture that stands in when none does (its format and value: the
+// renderer declares it), the lighting.comp sampler it is bound to, and the lighting.comp
+// specialization constant (constant_id) that says whether it is absent (0: its fetch compiled
+// out), of the output's size (1: one texel fetch) or of another size (2: bilinear).
+struct LightingInput {
+  const char* resource;
+  VkFormat format;
+  std::array<float, 4> neutral;
+  const char* texture;
+  uint32_t constantId;
+};
+inline const std::array<LightingInput, 5> kLightingInputs = {{
+    {resources::kAO, VK_FORMAT_R8G8B8A8_UNORM, {1.0f, 1.0f, 1.0f, 1.0f}, "aoTexture", 3},
+    {resources::kAmbient, VK_FORMAT_R16G16B16A16_SFLOAT, {}, "ambientTexture", 4},
+    {resources::kIndirect, VK_FORMAT_R16G16B16A16_SFLOAT, {}, "indirectTexture", 5},
+    {resources::kContactShadow,
+     VK_FORMAT_R8G8B8A8_UNORM,
+     {1.0f, 1.0f, 1.0f, 1.0f},
+     "contactTexture",
+     7},
+    {resources::kDirectLight, VK_FORMAT_R16G16B16A16_SFLOAT, {}, "directTexture", 8},
+}};
+
 // Workgroup of the engine's full-screen compute passes (lighting, tonemap): llvmpipe
 // pays a fixed cost per workgroup, so large groups are faster there (measured for SSAO).
 inline constexpr uint32_t kScreenGroupX = 32, kScreenGroupY = 16;
 
-// The shape tonemap and floor share: a compute shader with (0) the frame uniforms, (1) one
-// sampled input and (2) one storage output, dispatched over the output in groupX x groupY
-// workgroups (image_filter.cpp).
+// The shape tonemap, floor and the G-buffer unpacking share: a compute shader with the frame
+// uniforms ("Frame"), one sampled input and one storage output (whatever their names),
+// dispatched over the output in groupX x groupY workgroups (image_filter.cpp).
 vk::Pipeline makeImageFilterPipeline(vk::Context& ctx, const std::string& spirvName,
                                      std::vector<uint32_t> specialization = {});
 void recordImageFilter(PassContext& pc, const vk::Pipeline& pipeline, VkBuffer frame,

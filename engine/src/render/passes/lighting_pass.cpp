@@ -1,10 +1,12 @@
 // "lighting": composes the lit image from the G-buffer, the lights and shadow maps, the
 // environment and the optional inputs effects publish (ao, ambient, indirect, contact_shadow,
-// direct_light; neutral when absent: the fallbacks are declared once, in the renderer's
-// buildGraph()).
+// direct_light; neutral when absent: one table, kLightingInputs in builtin_passes.h, gives
+// each one's resource, fallback, sampler and specialization constant).
 #include <algorithm>
 #include <array>
 #include <map>
+#include <string>
+#include <string_view>
 
 #include "gi/errors.h"
 #include "gi/lit_surface.h"
@@ -35,9 +37,9 @@ class LightingPass final : public Effect {
   void addPasses(FrameGraph& graph, EffectContext& ctx, const SettingValues&) override {
     struct Io {
       LitSurfaceInputs surface;  // the G-buffer and the lights (gi/lit_surface.h)
-      TextureHandle ao, ambient, indirect, contact, direct, environment, lit;
-      // ao, ambient, indirect, contact_shadow, direct_light: the neutral stand-in
-      bool fallback[5] = {true, true, true, true, true};
+      std::array<TextureHandle, kLightingInputs.size()> inputs;  // published or the neutral one
+      std::array<bool, kLightingInputs.size()> fallback{};
+      TextureHandle environment, lit;
     };
     auto io = std::make_shared<Io>();
 
@@ -46,19 +48,13 @@ class LightingPass final : public Effect {
         "lighting",
         [&](PassBuilder& b) {
           io->surface.read(b, bb);
-          io->ao = b.readOptional(res::kAO);
-          io->ambient = b.readOptional(res::kAmbient);
-          io->indirect = b.readOptional(res::kIndirect);
-          io->fallback[0] = b.isFallback(io->ao);
-          io->fallback[1] = b.isFallback(io->ambient);
-          io->fallback[2] = b.isFallback(io->indirect);
-          io->contact = b.readOptional(res::kContactShadow);
-          io->fallback[3] = b.isFallback(io->contact);
-          io->direct = b.readOptional(res::kDirectLight);
-          io->fallback[4] = b.isFallback(io->direct);
+          for (size_t i = 0; i < kLightingInputs.size(); ++i) {
+            io->inputs[i] = b.readOptional(kLightingInputs[i].resource);
+            io->fallback[i] = b.isFallback(io->inputs[i]);
+          }
           // The contact factors multiply single lights' shadows; a published direct_light has
           // summed the lights already, so whoever publishes it must have applied them.
-          if (!io->fallback[3] && !io->fallback[4])
+          if (!io->fallback[input(res::kContactShadow)] && !io->fallback[input(res::kDirectLight)])
             throw Error(ErrorKind::Usage, "",
                         "both 'contact_shadow' and 'direct_light' are published: the effect "
                         "that publishes direct_light must apply the contact shadows itself");
@@ -70,25 +66,21 @@ class LightingPass final : public Effect {
           const VkSampler nearest = s_.nearest, linear = s_.linear;
           const VkExtent2D e = pc.extent(io->lit);
           // An optional input is read once per pixel at the output's size, bilinearly otherwise.
-          auto inputMode = [&](bool isFallback, TextureHandle h) {
-            if (isFallback) return 0u;
-            const VkExtent2D i = pc.extent(h);
-            return i.width == e.width && i.height == e.height ? 1u : 2u;
-          };
-          const vk::Pipeline& pipeline = variant(
-              {inputMode(io->fallback[0], io->ao), inputMode(io->fallback[1], io->ambient),
-               inputMode(io->fallback[2], io->indirect), inputMode(io->fallback[3], io->contact),
-               inputMode(io->fallback[4], io->direct)});
+          std::array<uint32_t, kLightingInputs.size()> modes{};
+          for (size_t i = 0; i < modes.size(); ++i) {
+            const VkExtent2D in = pc.extent(io->inputs[i]);
+            modes[i] = io->fallback[i]                                ? 0u
+                       : in.width == e.width && in.height == e.height ? 1u
+                                                                      : 2u;
+          }
+          const vk::Pipeline& pipeline = variant(modes);
           vk::DescriptorWriter w(pipeline);
           w.buffer("Frame", frame);
           io->surface.bind(w, pc, nearest);
           w.image("outLit", pc.view(io->lit))
-              .texture("aoTexture", pc.view(io->ao), linear)
-              .texture("ambientTexture", pc.view(io->ambient), linear)
-              .texture("indirectTexture", pc.view(io->indirect), linear)
-              .texture("environmentMap", pc.view(io->environment), s_.scene.linearRepeat())
-              .texture("contactTexture", pc.view(io->contact), linear)
-              .texture("directTexture", pc.view(io->direct), linear);
+              .texture("environmentMap", pc.view(io->environment), s_.scene.linearRepeat());
+          for (size_t i = 0; i < kLightingInputs.size(); ++i)
+            w.texture(kLightingInputs[i].texture, pc.view(io->inputs[i]), linear);
           pc.dispatch(pipeline, w, e, kScreenGroupX, kScreenGroupY);
         });
     bb.put(res::kLit, io->lit);
@@ -98,25 +90,30 @@ class LightingPass final : public Effect {
   // The lighting.comp specialization constants of one configuration (constant_id order).
   using Variant = std::array<uint32_t, 9>;
 
+  // Where `resource` is in kLightingInputs.
+  static size_t input(const char* resource) {
+    for (size_t i = 0; i < kLightingInputs.size(); ++i)
+      if (std::string_view(kLightingInputs[i].resource) == resource) return i;
+    throw Error(ErrorKind::Usage, "", std::string("lighting: no optional input ") + resource);
+  }
+
   // The pipeline for this frame's lights, PCF radius, optional inputs (mode per input: 0
   // fallback, 1 same size, 2 other size) and environment kind, built on first use: a scene
   // needs one or two, and the disk pipeline cache keeps them between runs.
-  const vk::Pipeline& variant(const std::array<uint32_t, 5>& inputs) {
+  const vk::Pipeline& variant(const std::array<uint32_t, kLightingInputs.size()>& inputs) {
     uint32_t types = 0, shadowTypes = 0;
     for (const GpuLight& l : s_.lights.lights) {
       const uint32_t bit = 1u << std::clamp(int(l.directionType.w), 0, 2);
       types |= bit;
       if (l.shadow.x >= 0.0f) shadowTypes |= bit;
     }
-    const Variant key{types,
-                      shadowTypes,
-                      std::min(s_.settings.pcfRadius, 3u),
-                      inputs[0],
-                      inputs[1],
-                      inputs[2],
-                      s_.environment.kind(),
-                      inputs[3],
-                      inputs[4]};
+    Variant key{};
+    key[0] = types;
+    key[1] = shadowTypes;
+    key[2] = std::min(s_.settings.pcfRadius, 3u);
+    key[6] = s_.environment.kind();
+    for (size_t i = 0; i < kLightingInputs.size(); ++i)
+      key[kLightingInputs[i].constantId] = inputs[i];
     auto found = pipelines_.find(key);
     if (found != pipelines_.end()) return found->second;
     return pipelines_
