@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cstddef>
 
 #include "gi/uniform_block.h"
 #include "vulkan_fixture.h"
@@ -49,6 +50,21 @@ TEST_F(UniformBlockTest, WritesOnlyWhenTheKeyChanges) {
   const auto* p = static_cast<const Params*>(host.mapped());
   EXPECT_EQ(p->radius, 0.25f);
   EXPECT_EQ(p->samples, 32);
+
+  // A part written every frame stays while the key is unchanged; a new key rewrites it all.
+  auto readBack = [&] {
+    ctx().submitAndWait([&](VkCommandBuffer cmd) {
+      const VkBufferCopy region{0, 0, sizeof(Params)};
+      vkCmdCopyBuffer(cmd, block.handle(), host.handle(), 1, &region);
+    });
+    return *static_cast<const Params*>(host.mapped());
+  };
+  const int32_t part = 7;
+  block.writePart(&part, sizeof part, offsetof(Params, samples));
+  EXPECT_FALSE(upload(0.25, 32));
+  EXPECT_EQ(readBack().samples, 7);
+  EXPECT_TRUE(upload(0.25, 64));
+  EXPECT_EQ(readBack().samples, 64);
 }
 
 }  // namespace

@@ -32,6 +32,7 @@
 #include "gi/effect_registry.h"
 #include "gi/lights.h"
 #include "gi/lit_surface.h"
+#include "gi/uniform_block.h"
 #include "gi/vk/pipeline.h"
 #include "gi/vk/resources.h"
 #include "ssdo.comp.h"                  // const uint32_t ssdo_comp[]
@@ -204,9 +205,12 @@ class SsdoEffect : public gi::Effect {
     if (layers_ > 2)
       layersPipeline_ = gi::vk::Pipeline::compute(
           vk, shader("ssdo_layers.comp", ssdo_layers_comp, {layers_}, false));
-    if (!uniforms_)
-      uniforms_ =
-          gi::vk::Buffer(vk, sizeof(gi::ssdo::Uniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true);
+    uniforms_.create(vk);
+    h_.radius = settings.handle<double>("radius");
+    h_.bounce_strength = settings.handle<double>("bounce_strength");
+    h_.distance_clamp = settings.handle<double>("distance_clamp");
+    h_.samples = settings.handle<int>("samples");
+    h_.pattern_sets = settings.handle<int>("pattern_sets");
     // The importance samples of environment_sampling=mis: two vec4 per sample slot (bound, but
     // not read, in the other modes).
     if (!environmentSamples_)
@@ -675,25 +679,27 @@ class SsdoEffect : public gi::Effect {
       const float sz[4] = {v.viewport.x, v.viewport.y, v.viewport.z, v.viewport.w};
       std::memcpy(cams[c].size, sz, sizeof sz);
     }
-    uniforms_.write(cams.data(), sizeof cams, offsetof(gi::ssdo::Uniforms, cameras));
+    uniforms_.writePart(cams.data(), sizeof cams, offsetof(gi::ssdo::Uniforms, cameras));
   }
 
   // Host-visible, written while recording: the renderer waits for each frame before it records
   // the next. Rebuilt only when a setting changed since the last upload.
   void upload(const gi::SettingValues& s) {
-    const std::array<double, 5> key = {s.number("radius"), double(s.integer("samples")),
-                                       double(s.integer("pattern_sets")),
-                                       s.number("bounce_strength"), s.number("distance_clamp")};
-    if (key == uploaded_) return;
-    const gi::ssdo::Uniforms u =
-        gi::ssdo::makeUniforms(key[0], int(key[1]), int(key[2]), key[3], key[4]);
-    uniforms_.write(&u, sizeof u);
-    uploaded_ = key;
+    const std::array<double, 5> key = {s[h_.radius], double(s[h_.samples]),
+                                       double(s[h_.pattern_sets]), s[h_.bounce_strength],
+                                       s[h_.distance_clamp]};
+    uniforms_.update(key, [&] {
+      return gi::ssdo::makeUniforms(key[0], int(key[1]), int(key[2]), key[3], key[4]);
+    });
   }
 
   gi::vk::Pipeline surface_, cameraSurface_, ssdo_, blurX_, resolve_, contactPipeline_,
       layersPipeline_;
-  gi::vk::Buffer uniforms_;
+  gi::UniformBlock<gi::ssdo::Uniforms> uniforms_;  // cameras: written every frame (writePart)
+  struct Handles {  // typed settings read every frame, found by name in prepare()
+    gi::Setting<double> radius, bounce_strength, distance_clamp;
+    gi::Setting<int> samples, pattern_sets;
+  } h_;
   std::vector<std::shared_ptr<gi::ViewUniforms>> views_;  // the additional cameras
   bool bounce_ = true;
   uint32_t samples_ = 12, environmentKind_ = 0, layers_ = 1, cameras_ = 0, pcf_ = 1;
@@ -706,7 +712,6 @@ class SsdoEffect : public gi::Effect {
   bool contact_ = false;
   uint32_t contactSamples_ = 4;
   std::optional<std::array<uint32_t, 2>> contactMasks_;  // built on first use
-  std::optional<std::array<double, 5>> uploaded_;
 };
 
 }  // namespace

@@ -42,6 +42,11 @@ class UniformBlock {
     ++uploads_;
     return true;
   }
+  // Writes `bytes` at `offset` now: a part of the block that changes every frame (a camera),
+  // kept when update() does not rewrite the block, overwritten when it does.
+  void writePart(const void* data, size_t bytes, size_t offset) {
+    buffer_.write(data, bytes, offset);
+  }
   // The next update() writes whatever its key (e.g. what make() reads besides the key changed).
   void invalidate() { key_.clear(); }
   uint64_t uploads() const { return uploads_; }
