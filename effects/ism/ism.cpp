@@ -221,6 +221,15 @@ class IsmEffect : public gi::Effect {
   }
 
   void prepare(gi::EffectContext& ctx, const gi::SettingValues& s) override {
+    h_.distance_clamp = s.handle<double>("distance_clamp");
+    h_.bias = s.handle<double>("bias");
+    h_.bias_slope = s.handle<double>("bias_slope");
+    h_.pull_threshold = s.handle<double>("pull_threshold");
+    h_.push_threshold = s.handle<double>("push_threshold");
+    h_.strength = s.handle<double>("strength");
+    h_.blur_tolerance = s.handle<double>("blur_tolerance");
+    h_.splat_scale = s.handle<double>("splat_scale");
+    h_.environment_normal_offset = s.handle<double>("environment_normal_offset");
     gi::vk::Context& vk = ctx.vulkan();
     vk.requireWorkgroup(kGroupX, kGroupY, "ism");
     Config c;
@@ -820,18 +829,18 @@ class IsmEffect : public gi::Effect {
   void upload(gi::EffectContext& ctx, const gi::SettingValues& s) {
     const Config& c = cfg_;
     const float extent = sceneExtent(ctx);
-    const float dMin = float(s.number("distance_clamp")) * extent;
+    const float dMin = float(s[h_.distance_clamp]) * extent;
     const float k = float(c.block);
     gi::ism::Uniforms u{};
     u.rsm = glm::vec4(3 * c.rsm, 2 * c.rsm, c.vpls, c.padded);
     u.atlas = glm::vec4(c.res, c.perRow, c.perIsm, 0.0f);  // point count: set by ism_splat
-    u.bias = glm::vec4(float(s.number("bias")) * extent, float(s.number("bias_slope")),
-                       classicNear(extent), classicFar(extent));
-    u.pull = glm::vec4(float(s.number("pull_threshold")) * extent,
-                       float(s.number("push_threshold")) * extent, c.levels, extent);
-    u.gather = glm::vec4(dMin * dMin, k, k * k, float(s.number("strength")));
-    u.blur = glm::vec4(float(s.number("blur_tolerance")), 0.9f, float(s.number("splat_scale")),
-                       float(c.total()));
+    u.bias = glm::vec4(float(s[h_.bias]) * extent, float(s[h_.bias_slope]), classicNear(extent),
+                       classicFar(extent));
+    u.pull = glm::vec4(float(s[h_.pull_threshold]) * extent, float(s[h_.push_threshold]) * extent,
+                       c.levels, extent);
+    u.gather = glm::vec4(dMin * dMin, k, k * k, float(s[h_.strength]));
+    u.blur =
+        glm::vec4(float(s[h_.blur_tolerance]), 0.9f, float(s[h_.splat_scale]), float(c.total()));
     glm::vec3 lo, hi;
     ctx.scene().bounds(lo, hi);
     const glm::vec3 centre = 0.5f * (lo + hi);
@@ -839,8 +848,7 @@ class IsmEffect : public gi::Effect {
     const bool finite =
         std::isfinite(centre.x) && std::isfinite(centre.y) && std::isfinite(centre.z);
     u.envSphere = glm::vec4(finite ? centre : glm::vec3(0.0f), radius);
-    u.envVpls =
-        glm::vec4(c.env, c.envPadded, c.total(), float(s.number("environment_normal_offset")));
+    u.envVpls = glm::vec4(c.env, c.envPadded, c.total(), float(s[h_.environment_normal_offset]));
     uniforms_.write(&u, sizeof u);
     uploaded_ = u;
   }
@@ -911,6 +919,10 @@ class IsmEffect : public gi::Effect {
   VkSampler nearest_ = VK_NULL_HANDLE;
   gi::vk::Buffer uniforms_, vplBuffer_, envBuffer_;
   gi::ism::Uniforms uploaded_{};
+  struct Handles {  // typed settings read every frame, found by name in prepare()
+    gi::Setting<double> distance_clamp, bias, bias_slope, pull_threshold, push_threshold, strength,
+        blur_tolerance, splat_scale, environment_normal_offset;
+  } h_;
 };
 
 }  // namespace
