@@ -4,8 +4,6 @@
 // Estimator: hbao_params.h; settings: README.md.
 #include <algorithm>
 #include <array>
-#include <memory>
-#include <optional>
 #include <vector>
 
 #include "gi/depth_aware_blur.h"

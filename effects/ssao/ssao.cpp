@@ -4,8 +4,6 @@
 // lighting pass applies to the environment term. Estimator and kernel: ssao_kernel.h.
 #include <algorithm>
 #include <array>
-#include <memory>
-#include <optional>
 #include <vector>
 
 #include "gi/depth_aware_blur.h"

@@ -195,7 +195,6 @@ ShaderInterface reflectShader(const std::vector<uint32_t>& spirv, VkShaderStageF
   const auto push = r.list(SPVC_RESOURCE_TYPE_PUSH_CONSTANT);
   if (!push.empty()) {
     out.pushConstants = r.block(push.front().base_type_id, push.front().name);
-    out.pushStages = VkShaderStageFlags(stage);
   }
   return out;
 }
@@ -221,7 +220,6 @@ ShaderInterface mergeInterfaces(const ShaderInterface& a, const ShaderInterface&
   std::sort(out.bindings.begin(), out.bindings.end(),
             [](const ShaderBinding& x, const ShaderBinding& y) { return x.binding < y.binding; });
   if (b.pushConstants.size > out.pushConstants.size) out.pushConstants = b.pushConstants;
-  out.pushStages |= b.pushStages;
   return out;
 }
 

@@ -42,7 +42,6 @@ struct ShaderInterface {
   std::string shader;                   // where it came from, for messages
   std::vector<ShaderBinding> bindings;  // set 0, sorted by binding
   BlockLayout pushConstants;            // size 0: none
-  VkShaderStageFlags pushStages = 0;
 
   // The binding named `name` (instance or block type name); nullptr when there is none.
   const ShaderBinding* find(std::string_view name) const;
