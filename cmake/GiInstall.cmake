@@ -7,7 +7,7 @@
 #   <prefix>/bin/shaders/*.spv           <prefix>/share/gi/presets/*.json
 #   <prefix>/bin/plugins/gi_effect_*.so  <prefix>/share/gi/scenes/*.json, models/, environments/
 #   <prefix>/<libdir>/libgi_engine.so,   <prefix>/share/gi/scripts/*.txt (gi-demo --script)
-#       libgi_scene.so
+#       libgi_scene.so, libgi_config.so
 #   <prefix>/<libdir>/cmake/gi/giConfig.cmake, giConfigVersion.cmake, giTargets.cmake,
 #                              GiEffect.cmake
 #
@@ -25,9 +25,10 @@ set(GI_INSTALL_SHADERDIR ${CMAKE_INSTALL_DATADIR}/gi/shaders)
 # Relative RPATHs: bin/ -> libdir, bin/plugins/ -> libdir.
 file(RELATIVE_PATH gi_bin_to_lib /prefix/bin /prefix/${CMAKE_INSTALL_LIBDIR})
 file(RELATIVE_PATH gi_plugins_to_lib /prefix/bin/plugins /prefix/${CMAKE_INSTALL_LIBDIR})
-set_target_properties(gi_scene gi_engine PROPERTIES INSTALL_RPATH "$ORIGIN")
-# Exported as gi::scene and gi::engine, the names the build tree's aliases use.
+set_target_properties(gi_scene gi_config gi_engine PROPERTIES INSTALL_RPATH "$ORIGIN")
+# Exported as gi::scene, gi::config and gi::engine, the names the build tree's aliases use.
 set_target_properties(gi_scene PROPERTIES EXPORT_NAME scene)
+set_target_properties(gi_config PROPERTIES EXPORT_NAME config)
 set_target_properties(gi_engine PROPERTIES EXPORT_NAME engine)
 set(GI_INSTALLED_APPS gi-render gi-bench gi-reference)
 if(TARGET gi-demo)
@@ -35,7 +36,7 @@ if(TARGET gi-demo)
 endif()
 set_target_properties(${GI_INSTALLED_APPS} PROPERTIES INSTALL_RPATH "$ORIGIN/${gi_bin_to_lib}")
 
-install(TARGETS gi_scene gi_engine EXPORT giTargets
+install(TARGETS gi_scene gi_config gi_engine EXPORT giTargets
   LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
   INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(DIRECTORY ${CMAKE_SOURCE_DIR}/engine/include/ DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "gi/effect.h"
 #include "gi/effect_config.h"
 #include "gi/errors.h"
 #include "gi/renderer.h"

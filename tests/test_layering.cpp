@@ -1,11 +1,13 @@
 // The engine's layers, checked on the sources: the Vulkan layer (engine/src/vk,
 // engine/include/gi/vk) includes only itself and gi/errors.h, so it names no renderer, effect,
-// scene or frame graph.
+// scene or frame graph; the scene (engine/src/scene, engine/src/image) and configuration
+// (engine/src/config) layers reach no Vulkan header through any chain of includes.
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
 #include <regex>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -44,6 +46,56 @@ TEST(Layering, TheVulkanLayerIncludesOnlyItself) {
     }
   }
   EXPECT_GT(checked, 10u) << "no includes found: the layout changed";
+}
+
+// Every header reachable from the sources below `dirs` through quoted includes (resolved in
+// engine/include, then beside the including file), with the chain that reaches each system
+// header whose name starts with "vulkan/" in `vulkanChains`.
+void includeClosure(const std::vector<fs::path>& dirs, std::set<std::string>& reached,
+                    std::vector<std::string>& vulkanChains) {
+  const fs::path include = fs::path(GI_SOURCE_DIR) / "engine/include";
+  const std::regex quoted(R"re(^\s*#\s*include\s*"([^"]+)")re");
+  const std::regex system(R"re(^\s*#\s*include\s*<(vulkan/[^>]+)>)re");
+  std::vector<std::pair<fs::path, std::string>> todo;  // file, chain that reached it
+  for (const fs::path& dir : dirs)
+    for (const auto& entry : fs::recursive_directory_iterator(dir))
+      if (entry.is_regular_file()) todo.emplace_back(entry.path(), entry.path().string());
+  while (!todo.empty()) {
+    auto [file, chain] = todo.back();
+    todo.pop_back();
+    if (!reached.insert(fs::weakly_canonical(file).string()).second) continue;
+    std::ifstream in(file);
+    std::string line;
+    while (std::getline(in, line)) {
+      std::smatch m;
+      if (std::regex_search(line, m, system))
+        vulkanChains.push_back(chain + " -> <" + m[1].str() + ">");
+      if (!std::regex_search(line, m, quoted)) continue;
+      for (const fs::path& candidate : {include / m[1].str(), file.parent_path() / m[1].str()})
+        if (fs::is_regular_file(candidate)) {
+          todo.emplace_back(candidate, chain + " -> " + m[1].str());
+          break;
+        }
+    }
+  }
+}
+
+TEST(Layering, TheSceneAndConfigurationLayersReachNoVulkanHeader) {
+  const fs::path root = GI_SOURCE_DIR;
+  std::set<std::string> reached;
+  std::vector<std::string> vulkan;
+  includeClosure({root / "engine/src/scene", root / "engine/src/image", root / "engine/src/config"},
+                 reached, vulkan);
+  for (const std::string& chain : vulkan) ADD_FAILURE() << chain << ": this layer has no Vulkan";
+  // What the configuration layer declares is reached (the walk follows includes).
+  for (const char* header : {"gi/effect_info.h", "gi/render_settings.h", "gi/effect_registry.h",
+                             "gi/effect_config.h", "gi/settings.h", "gi/image_io.h"})
+    EXPECT_TRUE(reached.count((root / "engine/include" / header).string())) << header;
+  // The walk sees a Vulkan include where there is one.
+  reached.clear();
+  vulkan.clear();
+  includeClosure({root / "engine/src/render"}, reached, vulkan);
+  EXPECT_FALSE(vulkan.empty());
 }
 
 }  // namespace

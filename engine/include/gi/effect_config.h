@@ -17,7 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "gi/effect_registry.h"
-#include "gi/renderer.h"
+#include "gi/render_settings.h"
 #include "gi/scene.h"
 
 namespace gi {

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "gi/effect.h"
+#include "gi/effect_info.h"
 
 namespace gi {
 

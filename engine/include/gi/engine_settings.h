@@ -6,7 +6,7 @@
 
 #include <vector>
 
-#include "gi/renderer.h"
+#include "gi/render_settings.h"
 #include "gi/settings.h"
 
 namespace gi {
