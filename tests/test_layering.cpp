@@ -1,7 +1,8 @@
 // The engine's layers, checked on the sources: the Vulkan layer (engine/src/vk,
 // engine/include/gi/vk) includes only itself and gi/errors.h, so it names no renderer, effect,
 // scene or frame graph; the scene (engine/src/scene, engine/src/image) and configuration
-// (engine/src/config) layers reach no Vulkan header through any chain of includes.
+// (engine/src/config) layers reach no Vulkan header through any chain of includes; apps share
+// code only through apps/common and apps/scoring.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -96,6 +97,26 @@ TEST(Layering, TheSceneAndConfigurationLayersReachNoVulkanHeader) {
   vulkan.clear();
   includeClosure({root / "engine/src/render"}, reached, vulkan);
   EXPECT_FALSE(vulkan.empty());
+}
+
+// An app reaches another app's code only through a library (apps/common, apps/scoring): no
+// quoted include of an app names a header that lives only in another app's folder.
+TEST(Layering, AppsIncludeNoOtherAppsHeaders) {
+  const fs::path apps = fs::path(GI_SOURCE_DIR) / "apps";
+  const std::set<std::string> shared = {"common", "scoring"};
+  size_t checked = 0;
+  for (const auto& app : fs::directory_iterator(apps)) {
+    if (!app.is_directory() || shared.count(app.path().filename().string())) continue;
+    for (const auto& [where, header] : quotedIncludes(app.path())) {
+      if (fs::exists(app.path() / header) || header.rfind("gi/", 0) == 0) continue;
+      ++checked;
+      bool inShared = false;
+      for (const std::string& lib : shared) inShared |= fs::exists(apps / lib / header);
+      EXPECT_TRUE(inShared) << where << " includes \"" << header
+                            << "\", which is neither its own nor a shared library's";
+    }
+  }
+  EXPECT_GT(checked, 5u) << "no includes of the shared libraries found: the layout changed";
 }
 
 }  // namespace

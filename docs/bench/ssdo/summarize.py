@@ -10,7 +10,7 @@ Ratios are paired: gi-bench measures the configurations of a run interleaved (re
 every configuration back to back), and results.json keeps each repetition's value in that
 order, so ratio r = value_r(config) / value_r(baseline) compares two measurements taken under
 the same load. Medians come with gi-bench's distribution-free interval of the median
-(apps/gi-bench/stats.cpp): [x_(k), x_(n+1-k)], the largest k reaching 95% coverage
+(apps/scoring/stats.cpp): [x_(k), x_(n+1-k)], the largest k reaching 95% coverage
 (n < 6: [min, max]).
 """
 import csv

@@ -6,7 +6,7 @@
 
 #include <string>
 
-#include "gi/effect.h"
+#include "gi/effect_info.h"
 #include "gi/reference/reference.h"
 
 namespace gi::bench {
