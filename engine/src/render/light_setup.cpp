@@ -5,8 +5,11 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <string>
 
 #include <glm/gtc/matrix_transform.hpp>
+
+#include "gi/errors.h"
 
 namespace gi {
 namespace {
@@ -143,6 +146,40 @@ LightSetup planLights(const Scene& scene, const std::vector<Node>& nodes, const 
     out.world.push_back(info);
   }
   return out;
+}
+
+void checkLightLimits(const LightSetup& next, const VkPhysicalDeviceLimits& limits) {
+  auto refuse = [](const std::string& message) {
+    throw Error(ErrorKind::Unsupported, "", message);
+  };
+  if (next.lights.size() > kMaxLights)
+    refuse(std::to_string(next.lights.size()) + " lights exceed the engine's " +
+           std::to_string(kMaxLights));
+  if (next.views.size() > kMaxShadowViews)
+    refuse(std::to_string(next.views.size()) + " shadow views exceed the engine's " +
+           std::to_string(kMaxShadowViews) +
+           " (a point light takes six, any other light one: cast fewer shadows)");
+  if (next.layerWidth() > limits.maxImageDimension2D ||
+      next.layerHeight() > limits.maxImageDimension2D)
+    refuse("shadow maps of " + std::to_string(next.layerWidth()) + "x" +
+           std::to_string(next.layerHeight()) + " texels exceed the device's " +
+           std::to_string(limits.maxImageDimension2D) +
+           " (a point light's six faces take 3x2 maps: lower engine.shadow_map_size)");
+  if (next.maps.size() > limits.maxImageArrayLayers)
+    refuse(std::to_string(next.maps.size()) + " shadow-casting lights exceed the device's " +
+           std::to_string(limits.maxImageArrayLayers) + " shadow-map layers");
+}
+
+LightBuffers::LightBuffers(vk::Context& ctx)
+    : lights_(ctx, kMaxLights * sizeof(GpuLight), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true),
+      shadowViews_(ctx, kMaxShadowViews * sizeof(GpuShadowView), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
+                   true) {}
+
+void LightBuffers::upload(const LightSetup& setup) {
+  if (!setup.lights.empty())
+    lights_.write(setup.lights.data(), setup.lights.size() * sizeof(GpuLight));
+  if (!setup.views.empty())
+    shadowViews_.write(setup.views.data(), setup.views.size() * sizeof(GpuShadowView));
 }
 
 }  // namespace gi

@@ -10,6 +10,7 @@
 
 #include "gi/lights.h"
 #include "gi/scene.h"
+#include "gi/vk/resources.h"
 
 namespace gi {
 
@@ -41,5 +42,22 @@ struct LightSetup {
 LightSetup planLights(const Scene& scene, const std::vector<Node>& nodes, const CameraView& camera,
                       const glm::vec3& boundsMin, const glm::vec3& boundsMax,
                       uint32_t shadowMapSize);
+
+// Throws gi::Error (Unsupported) naming the limit `setup` exceeds: the engine's (kMaxLights
+// records, kMaxShadowViews views) or the device's (a shadow-map layer's size, the layer count).
+void checkLightLimits(const LightSetup& setup, const VkPhysicalDeviceLimits& limits);
+
+// The uniform buffers "lights" and "shadow_views", full size (the shaders declare fixed-size
+// arrays), holding the last uploaded set-up.
+class LightBuffers {
+ public:
+  explicit LightBuffers(vk::Context& ctx);
+  void upload(const LightSetup& setup);
+  const vk::Buffer& lights() const { return lights_; }
+  const vk::Buffer& shadowViews() const { return shadowViews_; }
+
+ private:
+  vk::Buffer lights_, shadowViews_;
+};
 
 }  // namespace gi

@@ -20,8 +20,10 @@
 #include "gi/vk/gpu_timer.h"
 #include "gi/vk/pipeline.h"
 #include "gi/vk/resources.h"
+#include "render/frame_submission.h"
 #include "render/passes/builtin_passes.h"
 #include "render/target_readback.h"
+#include "render/view_uniforms.h"
 
 namespace gi {
 
@@ -47,77 +49,6 @@ Image makeOutputImage(Context& ctx, uint32_t w, uint32_t h) {
   return Image(ctx, od);
 }
 
-// "shadow_maps" when no light casts shadows: one 1x1 layer cleared to 0 (reverse-Z: nothing).
-Image makeNoShadowsImage(Context& ctx) {
-  ImageDesc d;
-  d.format = VK_FORMAT_D32_SFLOAT;
-  d.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT |
-            VK_IMAGE_USAGE_TRANSFER_SRC_BIT;  // readTarget("shadow_maps") copies from it
-  d.viewType = VK_IMAGE_VIEW_TYPE_2D_ARRAY;
-  Image img(ctx, d);
-  ctx.submitAndWait([&](VkCommandBuffer c) {
-    imageBarrier(c, img.handle(), VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
-                 VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_NONE, 0,
-                 VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
-    VkClearDepthStencilValue zero{0.0f, 0};
-    VkImageSubresourceRange range{VK_IMAGE_ASPECT_DEPTH_BIT, 0, 1, 0, 1};
-    vkCmdClearDepthStencilImage(c, img.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &zero, 1,
-                                &range);
-    imageBarrier(c, img.handle(), VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                 VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_2_CLEAR_BIT,
-                 VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT,
-                 VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
-  });
-  return img;
-}
-
-// The camera part of a view's uniforms: matrices, viewport, position, depth range.
-void setCamera(FrameUniforms& f, const CameraView& c, VkExtent2D extent,
-               const glm::mat4& prevViewProj) {
-  f.view = c.view;
-  f.proj = c.proj;
-  f.viewProj = c.proj * c.view;
-  f.invView = glm::inverse(c.view);
-  f.invProj = glm::inverse(c.proj);
-  f.prevViewProj = prevViewProj;
-  const float w = float(std::max(extent.width, 1u)), h = float(std::max(extent.height, 1u));
-  f.viewport = glm::vec4(w, h, 1.0f / w, 1.0f / h);
-  f.cameraPos = glm::vec4(c.position, 1.0f);
-  f.params.z = c.znear;
-  f.params.w = c.zfar;
-}
-
-// An extra view's uniforms: the main view's frame-wide values with this view's camera.
-class ViewUniformsImpl final : public ViewUniforms {
- public:
-  explicit ViewUniformsImpl(Context& ctx)
-      : buffer_(ctx, sizeof(FrameUniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true) {}
-  void setCamera(const CameraView& camera, VkExtent2D extent) override {
-    camera_ = camera;
-    extent_ = extent;
-  }
-  VkBuffer buffer() const override { return buffer_.handle(); }
-  const FrameUniforms& current() const override { return data_; }
-  // Called by the renderer before each frame; motion is against the last refreshed camera.
-  void refresh(const FrameUniforms& main) {
-    const glm::mat4 viewProj = camera_.proj * camera_.view;
-    data_ = main;
-    gi::setCamera(data_, camera_, extent_, seen_ ? prevViewProj_ : viewProj);
-    buffer_.write(&data_, sizeof data_);
-    prevViewProj_ = viewProj;
-    seen_ = true;
-  }
-  void forgetHistory() { seen_ = false; }  // no motion into the next frame (resize)
-
- private:
-  Buffer buffer_;
-  CameraView camera_;
-  VkExtent2D extent_{1, 1};
-  FrameUniforms data_{};
-  glm::mat4 prevViewProj_{1.0f};
-  bool seen_ = false;
-};
-
 }  // namespace
 
 struct Renderer::Impl : EffectContext {
@@ -138,14 +69,14 @@ struct Renderer::Impl : EffectContext {
   std::unique_ptr<EnvironmentGpu> environment;
   std::unique_ptr<SurfacePointsPass> surfacePoints;
   uint32_t pointsRequested = 0;
-  Image output, noShadows;
+  Image output;
   Sampler linearClamp, nearestClamp;
-  Buffer frameBuffer, lightBuffer, shadowViewBuffer;
+  Buffer frameBuffer;
+  std::optional<LightBuffers> lightBuffers;
   FrameUniforms frameData{};
   glm::mat4 prevViewProj{1.0f};  // the camera of the previous frame (motion vectors)
-  double timeSeconds = 0.0, lastFrameTime = 0.0;
-  uint64_t framesRendered = 0;
-  std::vector<std::weak_ptr<ViewUniformsImpl>> views;  // extra views, refreshed per frame
+  FrameClock clock;
+  std::vector<std::weak_ptr<ExtraViewUniforms>> views;  // extra views, refreshed per frame
   std::unique_ptr<EngineState> state;
 
   // Built-in passes, in frame order around the effects.
@@ -160,8 +91,7 @@ struct Renderer::Impl : EffectContext {
   DescriptorArena descriptors;
   std::unique_ptr<GpuTimer> timer;  // sized to the compiled graph
   uint32_t timerScopes = 0;
-  VkCommandBuffer cmd = VK_NULL_HANDLE;
-  VkFence fence = VK_NULL_HANDLE;
+  std::unique_ptr<FrameSubmission> submission;
   std::vector<PassTiming> timings;
 
   Impl(Context& c, const Scene& s, const RenderSettings& rs, const EffectRegistry* reg)
@@ -178,14 +108,14 @@ struct Renderer::Impl : EffectContext {
     sceneGpu = std::make_unique<SceneGpu>(ctx, source);
     environment = std::make_unique<EnvironmentGpu>(ctx, source.environment);
     output = makeOutputImage(ctx, settings.width, settings.height);
-    noShadows = makeNoShadowsImage(ctx);
+    lightBuffers.emplace(ctx);
     linearClamp = Sampler(ctx, VK_FILTER_LINEAR, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE);
     nearestClamp = Sampler(ctx, VK_FILTER_NEAREST, VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE);
     frameBuffer = Buffer(ctx, sizeof(FrameUniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true);
     updateLights();
     updateFrameUniforms();  // frame() is valid from the first prepare() on
     state.reset(new EngineState{ctx, settings, *sceneGpu, lightSetup, *environment, surfacePoints,
-                                output, noShadows, nearestClamp.handle(), linearClamp.handle()});
+                                output, nearestClamp.handle(), linearClamp.handle()});
     ctx.requireWorkgroup(256, 1, "skinning / surface points");  // local_size_x 256
     skinningPass = makeSkinningPass(*state);
     gbufferPass = makeGBufferPass(*state);
@@ -198,17 +128,7 @@ struct Renderer::Impl : EffectContext {
     for (const EffectConfig& e : settings.effects) effects.push_back(createEffect(e));
     updateSurfacePoints();
     buildGraph();
-    // Raw handles last: nothing after them may throw (~Impl does not run if the ctor throws).
-    VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
-    alloc.commandPool = ctx.commandPool();
-    alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-    alloc.commandBufferCount = 1;
-    check(vkAllocateCommandBuffers(ctx.device(), &alloc, &cmd), "vkAllocateCommandBuffers");
-    VkFenceCreateInfo fenceInfo{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-    if (VkResult r = vkCreateFence(ctx.device(), &fenceInfo, nullptr, &fence); r != VK_SUCCESS) {
-      vkFreeCommandBuffers(ctx.device(), ctx.commandPool(), 1, &cmd);
-      check(r, "vkCreateFence");
-    }
+    submission = std::make_unique<FrameSubmission>(ctx);
   }
 
   ~Impl() override {
@@ -216,8 +136,6 @@ struct Renderer::Impl : EffectContext {
     graph.reset();
     graph.releasePersistent();
     effects.clear();
-    vkDestroyFence(ctx.device(), fence, nullptr);
-    vkFreeCommandBuffers(ctx.device(), ctx.commandPool(), 1, &cmd);
   }
 
   float aspect() const { return float(settings.width) / float(settings.height); }
@@ -246,7 +164,7 @@ struct Renderer::Impl : EffectContext {
   }
   GpuScene& scene() override { return *sceneGpu; }
   std::shared_ptr<ViewUniforms> createView() override {
-    auto v = std::make_shared<ViewUniformsImpl>(ctx);
+    auto v = std::make_shared<ExtraViewUniforms>(ctx);
     views.push_back(v);
     return v;
   }
@@ -279,48 +197,19 @@ struct Renderer::Impl : EffectContext {
     sceneGpu->bounds(lo, hi);
     LightSetup next =
         planLights(source, sceneGpu->pose().nodes, cameraView, lo, hi, settings.shadowMapSize);
-    if (next.lights.size() > kMaxLights)
-      throw Error(ErrorKind::Unsupported, "",
-                  std::to_string(next.lights.size()) + " lights exceed the engine's " +
-                      std::to_string(kMaxLights));
-    if (next.views.size() > kMaxShadowViews)
-      throw Error(ErrorKind::Unsupported, "",
-                  std::to_string(next.views.size()) + " shadow views exceed the engine's " +
-                      std::to_string(kMaxShadowViews) +
-                      " (a point light takes six, any other light one: cast fewer shadows)");
-    if (!lightBuffer) {  // full size: the shaders declare fixed-size uniform arrays
-      lightBuffer =
-          Buffer(ctx, kMaxLights * sizeof(GpuLight), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true);
-      shadowViewBuffer = Buffer(ctx, kMaxShadowViews * sizeof(GpuShadowView),
-                                VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true);
-    }
+    checkLightLimits(next, ctx.properties().limits);
     if (!next.sameLayout(lightSetup)) graphDirty = true;
-    const VkPhysicalDeviceLimits& limits = ctx.properties().limits;
-    if (next.layerWidth() > limits.maxImageDimension2D ||
-        next.layerHeight() > limits.maxImageDimension2D)
-      throw Error(ErrorKind::Unsupported, "",
-                  "shadow maps of " + std::to_string(next.layerWidth()) + "x" +
-                      std::to_string(next.layerHeight()) + " texels exceed the device's " +
-                      std::to_string(limits.maxImageDimension2D) +
-                      " (a point light's six faces take 3x2 maps: lower engine.shadow_map_size)");
-    if (next.maps.size() > limits.maxImageArrayLayers)
-      throw Error(ErrorKind::Unsupported, "",
-                  std::to_string(next.maps.size()) + " shadow-casting lights exceed the device's " +
-                      std::to_string(limits.maxImageArrayLayers) + " shadow-map layers");
-    if (!next.lights.empty())
-      lightBuffer.write(next.lights.data(), next.lights.size() * sizeof(GpuLight));
-    if (!next.views.empty())
-      shadowViewBuffer.write(next.views.data(), next.views.size() * sizeof(GpuShadowView));
+    lightBuffers->upload(next);
     lightSetup = std::move(next);
   }
 
   void setTime(double seconds) {
-    timeSeconds = seconds;
+    clock.seconds = seconds;
     sceneGpu->setTime(seconds);
     // Animated cameras and lights. The motion vectors compare with the camera of the last
     // rendered frame (renderFrame keeps it); before the first frame nothing moved.
     if (source.activeCameraNode >= 0 || cameraOverride) cameraView = currentCamera();
-    if (framesRendered == 0) prevViewProj = cameraView.proj * cameraView.view;
+    if (clock.framesRendered == 0) prevViewProj = cameraView.proj * cameraView.view;
     updateLights();
   }
 
@@ -375,10 +264,11 @@ struct Renderer::Impl : EffectContext {
       graph.declareFallback(in.resource, in.format,
                             {{in.neutral[0], in.neutral[1], in.neutral[2], in.neutral[3]}});
     // Engine data every pass may read: lights, shadow views, the environment.
-    bb.put(res::kLights,
-           graph.importBuffer(res::kLights, lightBuffer.handle(), lightBuffer.size()));
-    bb.put(res::kShadowViews, graph.importBuffer(res::kShadowViews, shadowViewBuffer.handle(),
-                                                 shadowViewBuffer.size()));
+    bb.put(res::kLights, graph.importBuffer(res::kLights, lightBuffers->lights().handle(),
+                                            lightBuffers->lights().size()));
+    bb.put(res::kShadowViews,
+           graph.importBuffer(res::kShadowViews, lightBuffers->shadowViews().handle(),
+                              lightBuffers->shadowViews().size()));
     const Image& envMap = environment->map();
     TextureDesc envDesc{envMap.desc().format, SizeClass::Absolute, 1.0f, envMap.desc().width,
                         envMap.desc().height};
@@ -443,50 +333,17 @@ struct Renderer::Impl : EffectContext {
 
   // The main view's uniforms of the coming frame (frameData, uploaded).
   void updateFrameUniforms() {
-    FrameUniforms f{};
-    const Environment& e = source.environment;
-    const bool constant = e.kind == Environment::Kind::Constant;
-    const float kind = float(environment->kind());
-    const float scale = std::max(settings.environmentIntensity, 0.0f);
-    f.skyZenith = glm::vec4(e.zenithColor, std::max(e.intensity, 0.0f) * scale);
-    f.skyHorizon = glm::vec4(e.horizonColor, kind);
-    f.skyGround = glm::vec4(constant ? e.constantColor : e.groundColor, 0.0f);
-    f.params = glm::vec4(settings.exposure, float(lightSetup.lights.size()), 0.0f, 0.0f);
-    setCamera(f, cameraView, {settings.width, settings.height}, prevViewProj);
-    const SH9& sh = environment->irradiance();
-    for (int i = 0; i < 9; ++i) f.irradianceSH[i] = glm::vec4(sh[i] * scale, 0.0f);
-    f.time = glm::vec4(float(timeSeconds), float(framesRendered),
-                       framesRendered ? float(timeSeconds - lastFrameTime) : 0.0f, 0.0f);
-    f.options = glm::vec4(float(settings.pcfRadius), 0.0f, 0.0f, 0.0f);
-    frameData = f;
-    frameBuffer.write(&f, sizeof f);
+    frameData =
+        mainViewUniforms(settings, source.environment, *environment,
+                         uint32_t(lightSetup.lights.size()), cameraView, prevViewProj, clock);
+    frameBuffer.write(&frameData, sizeof frameData);
   }
 
   // Extra views: frame-wide values from the main view, their own camera (after the effects'
   // update() hooks moved them).
   void updateViews() {
-    std::erase_if(views, [](const std::weak_ptr<ViewUniformsImpl>& v) { return v.expired(); });
+    std::erase_if(views, [](const std::weak_ptr<ExtraViewUniforms>& v) { return v.expired(); });
     for (const auto& v : views) v.lock()->refresh(frameData);
-  }
-
-  // CPU time of the whole process (every thread, a CPU driver's workers included), ms.
-  static double processCpuMs() {
-    timespec ts{};
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return double(ts.tv_sec) * 1e3 + double(ts.tv_nsec) * 1e-6;
-  }
-
-  // Ends `c`, submits it and waits for it to complete.
-  void submitAndWait(VkCommandBuffer c) {
-    check(vkEndCommandBuffer(c), "vkEndCommandBuffer");
-    VkCommandBufferSubmitInfo cmdInfo{VK_STRUCTURE_TYPE_COMMAND_BUFFER_SUBMIT_INFO};
-    cmdInfo.commandBuffer = c;
-    VkSubmitInfo2 submit{VK_STRUCTURE_TYPE_SUBMIT_INFO_2};
-    submit.commandBufferInfoCount = 1;
-    submit.pCommandBufferInfos = &cmdInfo;
-    check(vkResetFences(ctx.device(), 1, &fence), "vkResetFences");
-    check(vkQueueSubmit2(ctx.queue(), 1, &submit, fence), "vkQueueSubmit2");
-    check(vkWaitForFences(ctx.device(), 1, &fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
   }
 
   void renderFrame() {
@@ -497,33 +354,10 @@ struct Renderer::Impl : EffectContext {
     for (ActiveEffect& a : effects) a.effect->update(*this, a.settings);
     updateViews();
     descriptors.reset();
-    check(vkResetCommandBuffer(cmd, 0), "vkResetCommandBuffer");
-    VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-    begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-    check(vkBeginCommandBuffer(cmd, &begin), "vkBeginCommandBuffer");
-    timer->beginFrame(cmd);
-    FrameGraph::PassBoundary isolate;
-    std::vector<double> cpuMarks;  // process CPU time before the first pass and after each
-    if (settings.isolatePasses) {
-      cpuMarks.push_back(processCpuMs());
-      isolate = [this, &begin, &cpuMarks](VkCommandBuffer c) {
-        submitAndWait(c);
-        cpuMarks.push_back(processCpuMs());
-        check(vkResetCommandBuffer(c, 0), "vkResetCommandBuffer");
-        check(vkBeginCommandBuffer(c, &begin), "vkBeginCommandBuffer");
-        return c;
-      };
-    }
-    graph.execute(cmd, descriptors, timer.get(), isolate);
-    submitAndWait(cmd);
-    timings.clear();
-    for (auto& [name, ms] : timer->collect()) timings.push_back({name, ms, -1.0});
-    // One boundary per executed pass, in the order the timer saw them.
-    if (cpuMarks.size() == timings.size() + 1)
-      for (size_t i = 0; i < timings.size(); ++i) timings[i].cpuMs = cpuMarks[i + 1] - cpuMarks[i];
+    timings = submission->run(graph, descriptors, *timer, settings.isolatePasses);
     prevViewProj = cameraView.proj * cameraView.view;
-    lastFrameTime = timeSeconds;
-    ++framesRendered;
+    clock.previousSeconds = clock.seconds;
+    ++clock.framesRendered;
   }
 
   // ---- live changes ---------------------------------------------------------------------
@@ -777,7 +611,7 @@ void Renderer::setCameraOverride(const std::optional<CameraView>& camera) {
                 "camera override: needs 0 < znear < zfar and a vertical fov in (0, 3.14)");
   impl_->cameraOverride = camera;
   impl_->cameraView = impl_->currentCamera();
-  if (impl_->framesRendered == 0)
+  if (impl_->clock.framesRendered == 0)
     impl_->prevViewProj = impl_->cameraView.proj * impl_->cameraView.view;
   impl_->updateLights();
 }

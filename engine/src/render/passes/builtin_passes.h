@@ -27,8 +27,7 @@ struct EngineState {
   LightSetup& lights;
   EnvironmentGpu& environment;
   std::unique_ptr<SurfacePointsPass>& surfacePoints;
-  vk::Image& output;     // the tonemapped RGBA8 image (imported as "output")
-  vk::Image& noShadows;  // 1x1 one-layer D32 array cleared to 0: "shadow_maps" without shadows
+  vk::Image& output;  // the tonemapped RGBA8 image (imported as "output")
   VkSampler nearest, linear;
   uint32_t skinnedThisFrame = 0;  // written by the skinning pass
 };

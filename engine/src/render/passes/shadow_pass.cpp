@@ -2,12 +2,37 @@
 // through GpuScene into its own layer of "shadow_maps" (D32 reverse-Z 2-D array; a point light's
 // six faces share its layer as a 3x2 atlas). Without shadowed lights "shadow_maps" is the
 // engine's 1x1 array cleared to "no occluder". Only readers keep these passes alive.
+#include "gi/vk/common.h"
 #include "render/passes/builtin_passes.h"
 
 namespace gi {
 namespace {
 
 namespace res = resources;
+
+// "shadow_maps" when no light casts shadows: one 1x1 layer cleared to 0 (reverse-Z: nothing).
+vk::Image makeNoShadowsImage(vk::Context& ctx) {
+  vk::ImageDesc d;
+  d.format = VK_FORMAT_D32_SFLOAT;
+  d.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT |
+            VK_IMAGE_USAGE_TRANSFER_SRC_BIT;  // readTarget("shadow_maps") copies from it
+  d.viewType = VK_IMAGE_VIEW_TYPE_2D_ARRAY;
+  vk::Image img(ctx, d);
+  ctx.submitAndWait([&](VkCommandBuffer c) {
+    vk::imageBarrier(c, img.handle(), VK_IMAGE_ASPECT_DEPTH_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                     VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_NONE, 0,
+                     VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
+    VkClearDepthStencilValue zero{0.0f, 0};
+    VkImageSubresourceRange range{VK_IMAGE_ASPECT_DEPTH_BIT, 0, 1, 0, 1};
+    vkCmdClearDepthStencilImage(c, img.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &zero, 1,
+                                &range);
+    vk::imageBarrier(c, img.handle(), VK_IMAGE_ASPECT_DEPTH_BIT,
+                     VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                     VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT,
+                     VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
+  });
+  return img;
+}
 
 class ShadowPass final : public Effect {
  public:
@@ -18,7 +43,9 @@ class ShadowPass final : public Effect {
     return i;
   }
   std::vector<SettingDesc> settings() const override { return {}; }
-  void prepare(EffectContext&, const SettingValues&) override {}
+  void prepare(EffectContext& ctx, const SettingValues&) override {
+    if (!noShadows_) noShadows_ = makeNoShadowsImage(ctx.vulkan());
+  }
   void addPasses(FrameGraph& graph, EffectContext& ctx, const SettingValues&) override {
     const LightSetup& setup = s_.lights;
     if (setup.maps.empty()) {
@@ -26,7 +53,7 @@ class ShadowPass final : public Effect {
       desc.type = TextureType::Tex2DArray;
       graph.blackboard().put(
           res::kShadowMaps,
-          graph.importTexture(res::kShadowMaps, s_.noShadows.handle(), s_.noShadows.view(), desc,
+          graph.importTexture(res::kShadowMaps, noShadows_.handle(), noShadows_.view(), desc,
                               VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL));
       return;
     }
@@ -65,6 +92,7 @@ class ShadowPass final : public Effect {
 
  private:
   EngineState& s_;
+  vk::Image noShadows_;  // 1x1 one-layer D32 array cleared to 0: "shadow_maps" without shadows
 };
 
 }  // namespace
