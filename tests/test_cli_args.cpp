@@ -134,6 +134,64 @@ TEST(CliArgs, ArgumentLoopAndUsageErrors) {
   EXPECT_EQ(msg, "unknown argument '--bogus' (see gi-test --help)");
 }
 
+TEST(CliArgs, CommonFlagsAreParsedInOnePlace) {
+  Parsed p({"--scene",
+            "a.json",
+            "--width",
+            "320",
+            "--height",
+            "200",
+            "--preset",
+            "low",
+            "--effects",
+            "ssao,hbao",
+            "--set",
+            "ssao.radius=1",
+            "--set",
+            "engine.exposure=2",
+            "--view",
+            "ao",
+            "--device",
+            "1",
+            "--validation",
+            "--frames",
+            "3"});
+  cli::Args a = p.args();
+  cli::CommonFlags f;
+  std::vector<std::string> others;
+  while (a.next())
+    if (!cli::parseCommonFlag(a, f)) others.push_back(a.flag() + "=" + a.value());
+  EXPECT_EQ(f.scene, "a.json");
+  EXPECT_EQ(f.width, 320u);
+  EXPECT_EQ(f.height, 200u);
+  EXPECT_EQ(f.request.preset, "low");
+  EXPECT_EQ(f.request.overrides.effects, (std::vector<std::string>{"ssao", "hbao"}));
+  EXPECT_EQ(f.request.overrides.sets,
+            (std::vector<std::string>{"ssao.radius=1", "engine.exposure=2"}));
+  EXPECT_EQ(f.request.view, "ao");
+  EXPECT_EQ(f.device, "1");
+  EXPECT_TRUE(f.validation);
+  EXPECT_EQ(others, std::vector<std::string>{"--frames=3"});  // not a common flag: the app's
+
+  // A group the app does not take is left to it (and so is unknown there).
+  Parsed q({"--preset", "low"});
+  cli::Args b = q.args();
+  ASSERT_TRUE(b.next());
+  EXPECT_FALSE(cli::parseCommonFlag(b, f, cli::kSceneFlags | cli::kSizeFlags));
+  // Sizes are checked against the app's smallest.
+  Parsed r({"--width", "8"});
+  cli::Args c = r.args();
+  ASSERT_TRUE(c.next());
+  f.minSize = 16;
+  EXPECT_EQ(errorOf([&] { cli::parseCommonFlag(c, f); }, ErrorKind::Usage),
+            "--width: expects an integer in [16, 16384], got '8' (see gi-test --help)");
+  // --effects refuses a name twice, as before.
+  Parsed t({"--effects", "ssao,ssao"});
+  cli::Args d = t.args();
+  ASSERT_TRUE(d.next());
+  errorOf([&] { cli::parseCommonFlag(d, f); }, ErrorKind::Usage);
+}
+
 TEST(CliArgs, ListsRefuseEmptyAndRepeatedItems) {
   EXPECT_EQ(cli::splitList("--effects", "ssao,gtao"), (std::vector<std::string>{"ssao", "gtao"}));
   EXPECT_TRUE(cli::splitList("--effects", "").empty());

@@ -156,6 +156,39 @@ TEST(EffectConfig, WorldLengthDefaultsFollowABareModelsSize) {
 
 using test::expectError;
 
+TEST(EffectConfig, ConfigureRenderIsTheWholeSetUp) {
+  // One call from (scene, preset, --effects, --set, view) to the frame's settings: what every
+  // app and the effect tests' fixture do.
+  EffectRegistry reg = testRegistry();
+  const std::string dir = test::makeTempDir("configure");
+  RenderRequest request;
+  request.preset = writeFile(dir, "p.json", R"({"effects": {"const_ao": {"value": 0.2},
+      "engine": {"exposure": 2, "shadow_map_size": 256}}})");
+  request.overrides.sets = {"const_ao.samples=64", "engine.exposure=3"};
+  request.view = "orphan";  // an effect's name: its debug view
+  Scene scene = sceneWith({{"const_ao", {{"samples", 32}}}, {"orphan", {}}});
+  scene.effects.push_back({"engine", {{"pcf_radius", 2}}});
+  RenderSettings base;
+  base.width = 123;
+  base.keepForReadback = {"ao"};
+  const RenderSettings rs = configureRender(scene, reg, request, base);
+  ASSERT_EQ(rs.effects.size(), 2u);
+  EXPECT_EQ(rs.effects[0].name, "const_ao");
+  EXPECT_DOUBLE_EQ(rs.effects[0].settings.number("value"), 0.2);  // preset
+  EXPECT_EQ(rs.effects[0].settings.integer("samples"), 64);       // --set over the scene
+  EXPECT_FLOAT_EQ(rs.exposure, 3.0f);                             // --set over the preset
+  EXPECT_EQ(rs.shadowMapSize, 256u);                              // preset
+  EXPECT_EQ(rs.pcfRadius, 2u);                                    // scene
+  EXPECT_EQ(rs.view, "orphan");
+  EXPECT_EQ(rs.width, 123u);  // the caller's own fields are kept
+  EXPECT_EQ(rs.keepForReadback, std::vector<std::string>{"ao"});
+  request.view = "lit";  // a resource stays itself
+  EXPECT_EQ(configureRender(scene, reg, request).view, "lit");
+  request.preset = dir + "/missing.json";
+  expectError([&] { configureRender(scene, reg, request); }, ErrorKind::FileNotFound,
+              {"missing.json"});
+}
+
 TEST(EffectConfig, BadPresetsAndSettingsNameFileKeyAndRange) {
   EffectRegistry reg = testRegistry();
   const std::string dir = test::makeTempDir("bad-presets");

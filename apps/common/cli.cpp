@@ -6,6 +6,7 @@
 #include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -130,6 +131,40 @@ std::vector<std::string> splitList(const std::string& flag, const std::string& t
 
 void usageError(const std::string& app, const std::string& where, const std::string& message) {
   throw Error(ErrorKind::Usage, where, message + " (see " + app + " --help)");
+}
+
+bool Args::next() {
+  if (++i_ >= argc_) return false;
+  flag_ = argv_[i_];
+  if (usage_ && (flag_ == "--help" || flag_ == "-h")) {
+    std::fputs(usage_, stdout);
+    std::exit(0);
+  }
+  return true;
+}
+
+bool parseCommonFlag(Args& a, CommonFlags& f, unsigned groups) {
+  if ((groups & kSceneFlags) && a.is("--scene"))
+    f.scene = a.value();
+  else if ((groups & kSizeFlags) && a.is("--width"))
+    f.width = uint32_t(a.integer(f.minSize, 16384));
+  else if ((groups & kSizeFlags) && a.is("--height"))
+    f.height = uint32_t(a.integer(f.minSize, 16384));
+  else if ((groups & kEffectFlags) && a.is("--preset"))
+    f.request.preset = a.value();
+  else if ((groups & kEffectFlags) && a.is("--effects"))
+    f.request.overrides.effects = a.effectList();  // a name twice is refused
+  else if ((groups & kEffectFlags) && a.is("--set"))
+    f.request.overrides.sets.push_back(a.value());
+  else if ((groups & kEffectFlags) && a.is("--view"))
+    f.request.view = a.value();
+  else if ((groups & kDeviceFlags) && a.is("--device"))
+    f.device = a.value();
+  else if ((groups & kDeviceFlags) && a.is("--validation"))
+    f.validation = true;
+  else
+    return false;
+  return true;
 }
 
 void Args::unknown() const {

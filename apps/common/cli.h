@@ -12,6 +12,7 @@
 #include <string_view>
 #include <vector>
 
+#include "gi/effect_config.h"
 #include "gi/errors.h"
 
 namespace gi::cli {
@@ -34,11 +35,13 @@ std::vector<std::string> splitList(const std::string& flag, const std::string& t
 [[noreturn]] void usageError(const std::string& app, const std::string& where,
                              const std::string& message);
 
-// The argument loop: for (Args a(app, argc, argv); a.next();) if (a.is("--width")) ...
+// The argument loop: for (Args a(app, argc, argv, usage); a.next();) if (a.is("--width")) ...
+// With a `usage` text, --help and -h print it and exit 0.
 class Args {
  public:
-  Args(const char* app, int argc, char** argv) : app_(app), argc_(argc), argv_(argv) {}
-  bool next() { return ++i_ < argc_ && (flag_ = argv_[i_], true); }
+  Args(const char* app, int argc, char** argv, const char* usage = nullptr)
+      : app_(app), usage_(usage), argc_(argc), argv_(argv) {}
+  bool next();
   const std::string& flag() const { return flag_; }
   bool is(std::string_view name) const { return flag_ == name; }
   // The flag's value (the next argument); usage error when there is none.
@@ -63,11 +66,34 @@ class Args {
 
  private:
   const char* app_;
+  const char* usage_;
   int argc_;
   char** argv_;
   int i_ = 0;
   std::string flag_;
 };
+
+// The flags the rendering apps share, parsed in one place (parseCommonFlag). An app sets its
+// defaults (size, validation from GI_VALIDATION) before the loop.
+struct CommonFlags {
+  std::string scene;                   // --scene FILE|default
+  uint32_t width = 640, height = 480;  // --width, --height
+  uint32_t minSize = 1;                // the smallest size the app accepts
+  RenderRequest request;               // --preset, --effects, --set, --view
+  std::string device;                  // --device NAME|INDEX (empty: GI_DEVICE or the first)
+  bool validation = false;             // --validation
+};
+// Which groups of common flags an app takes.
+enum CommonFlagGroup : unsigned {
+  kSceneFlags = 1,   // --scene
+  kSizeFlags = 2,    // --width, --height
+  kEffectFlags = 4,  // --preset, --effects, --set, --view
+  kDeviceFlags = 8,  // --device, --validation
+  kAllCommonFlags = 15,
+};
+// True when the argument at `a` is one of the common flags in `groups`: its value is read (and
+// checked) into `flags`. False for any other argument, which the app then parses.
+bool parseCommonFlag(Args& a, CommonFlags& flags, unsigned groups = kAllCommonFlags);
 
 // An output file that will be written later: its folder must be writable (or, when missing,
 // its nearest existing ancestor: the writers make the missing folders) and the path must not be

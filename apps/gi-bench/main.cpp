@@ -166,11 +166,11 @@ Options parseArgs(int argc, char** argv) {
   Options o;
   o.validation = gi::vk::ContextOptions::fromEnvironment().validation;
   for (int i = 0; i < argc; ++i) o.commandLine += (i ? " " : "") + std::string(argv[i]);
-  for (gi::cli::Args a("gi-bench", argc, argv); a.next();) {
-    if (a.is("--help") || a.is("-h")) {
-      std::fputs(kUsage, stdout);
-      std::exit(0);
-    } else if (a.is("--out"))
+  gi::cli::CommonFlags device;  // --device, --validation: parsed as every app parses them
+  device.validation = o.validation;
+  for (gi::cli::Args a("gi-bench", argc, argv, kUsage); a.next();) {
+    if (gi::cli::parseCommonFlag(a, device, gi::cli::kDeviceFlags)) continue;
+    if (a.is("--out"))
       o.out = a.value();
     else if (a.is("--scenes") || a.is("--scene"))
       o.scenes = a.list();
@@ -236,13 +236,11 @@ Options parseArgs(int argc, char** argv) {
         a.fail("expects ssim or nrmse, got '" + o.metric + "'");
     } else if (a.is("--no-progress"))
       o.progress = false;
-    else if (a.is("--validation"))
-      o.validation = true;
-    else if (a.is("--device"))
-      o.device = a.value();
     else
       a.unknown();
   }
+  o.validation = device.validation;
+  o.device = device.device;
   if (o.out.empty()) usageError("", "--out is required");
   if (o.scenes.empty()) usageError("--scenes", "no scene given");
   if (o.presets.empty()) usageError("--presets", "no preset given");
@@ -503,8 +501,9 @@ struct Config {
   std::string effectLabel, preset, params, series, gridKey;
   double gridValue = 0.0;
   const gi::Preset* presetPtr = nullptr;
-  std::vector<gi::EffectConfig> effects;
-  gi::SettingValues engine;  // the engine's settings (preset and scene "engine" entries)
+  // The effects and engine settings (preset, scene "engine" entries, grid --set), as every app
+  // resolves them (gi::configureRender); size and timing options are set when measured.
+  gi::RenderSettings settings;
   Comparison comparison;
 };
 
@@ -612,9 +611,8 @@ Row::AoSplit splitError(const gi::ImageRGBA32F& out, const Reference& reference,
 // What a configuration renders.
 struct RenderJob {
   const gi::Scene* scene = nullptr;
-  const std::vector<gi::EffectConfig>* effects = nullptr;
-  const gi::SettingValues* engine = nullptr;
-  std::string resource;  // read back after the last repetition
+  const gi::RenderSettings* settings = nullptr;  // effects and engine settings
+  std::string resource;                          // read back after the last repetition
 };
 
 // One repetition: a warm-up frame (the previous repetition ran other configurations), then
@@ -678,13 +676,11 @@ std::vector<Measurement> measureAll(
     const size_t last = std::min(jobs.size(), first + kInterleaveBatch);
     std::vector<std::unique_ptr<gi::Renderer>> renderers;
     for (size_t i = first; i < last; ++i) {
-      gi::RenderSettings settings;
-      gi::applyEngineSettings(*jobs[i].engine, settings);
+      gi::RenderSettings settings = *jobs[i].settings;
       settings.width = o.width;
       settings.height = o.height;
       settings.floorPass = floorPass;
       settings.isolatePasses = o.isolatePasses;
-      settings.effects = *jobs[i].effects;
       settings.keepForReadback = {jobs[i].resource, gi::resources::kDepth};  // read when scored
       if (o.excludeEmitters) settings.keepForReadback.push_back(gi::resources::kEmission);
       renderers.push_back(std::make_unique<gi::Renderer>(ctx, *jobs[i].scene, settings, &registry));
@@ -942,13 +938,13 @@ std::vector<Config> buildConfigs(const Options& o, const Setup& s,
               c.series += " " + kv;
             }
           }
-          c.effects = gi::resolveEffects(s.scenes[si].scene, c.presetPtr, ov, s.registry);
-          c.engine = gi::resolveEngineSettings(s.scenes[si].scene, c.presetPtr, ov, {});
-          c.comparison = comparisonFor(c.effects, s.registry, o.aoSplit);
+          c.settings =
+              gi::configureRender(s.scenes[si].scene, s.registry, c.presetPtr, {.overrides = ov});
+          c.comparison = comparisonFor(c.settings.effects, s.registry, o.aoSplit);
           if (o.target) c.comparison = litAgainst(c.comparison, *o.target);
           // The reference renders the scene's environment as it is: a scaled one would be
           // compared with the wrong ground truth.
-          if (c.engine.number("environment_intensity") != 1.0 &&
+          if (c.settings.environmentIntensity != 1.0f &&
               !gi::bench::isAoLike(c.comparison.target.quantity))
             throw gi::Error(gi::ErrorKind::Usage, "",
                             "engine.environment_intensity must be 1 when lit images are "
@@ -1019,7 +1015,7 @@ int runSweep(const Options& o) {
   gi::vk::Context ctx = makeContext(o);
   std::vector<RenderJob> jobs;
   for (const Config& c : configs)
-    jobs.push_back({&s.scenes[c.scene].scene, &c.effects, &c.engine, c.comparison.resource});
+    jobs.push_back({&s.scenes[c.scene].scene, &c.settings, c.comparison.resource});
   ProgressBar bar(o.progress, "configurations", configs.size());
   std::vector<Scores> vsTargets(configs.size()), vsDeclareds(configs.size());
   std::vector<std::optional<gi::bench::QuantityGap>> gaps(configs.size());
@@ -1145,7 +1141,7 @@ struct CalibrationItem {
   };
   std::vector<Knob> knobs;
   std::vector<std::vector<int>> candidates;
-  std::vector<std::vector<gi::EffectConfig>> configs;
+  std::vector<gi::RenderSettings> configs;  // one per candidate (gi::configureRender)
   std::vector<std::string> labels;
   Comparison cmp;
   size_t firstJob = 0;
@@ -1184,7 +1180,8 @@ CalibrationItem calibrationItem(const std::string& label, const Setup& s) {
   const gi::Scene& scene = s.scenes[0].scene;
   gi::EffectOverrides base;
   base.effects = it.effects;
-  it.cmp = comparisonFor(gi::resolveEffects(scene, nullptr, base, s.registry), s.registry, false);
+  it.cmp = comparisonFor(gi::configureRender(scene, s.registry, {.overrides = base}).effects,
+                         s.registry, false);
   for (const auto& cand : it.candidates) {
     gi::EffectOverrides ov;
     ov.effects = it.effects;
@@ -1193,7 +1190,7 @@ CalibrationItem calibrationItem(const std::string& label, const Setup& s) {
       ov.sets.push_back(it.knobs[k].effect + "." + it.knobs[k].key + "=" + std::to_string(cand[k]));
       text += (text.empty() ? "" : " ") + ov.sets.back();
     }
-    it.configs.push_back(gi::resolveEffects(scene, nullptr, ov, s.registry));
+    it.configs.push_back(gi::configureRender(scene, s.registry, {.overrides = ov}));
     it.labels.push_back(text);
   }
   return it;
@@ -1203,12 +1200,11 @@ CalibrationItem calibrationItem(const std::string& label, const Setup& s) {
 // minimum; cost does not fall as a count rises) measured alone. When even its median is over
 // the limit no candidate can fit, so the run stops at once instead of after the whole search.
 void failFastWhenNothingFits(gi::vk::Context& ctx, const gi::EffectRegistry& registry,
-                             const gi::Scene& scene, const gi::SettingValues& engine,
-                             const std::vector<CalibrationItem>& items, const Options& o,
-                             double limit) {
+                             const gi::Scene& scene, const std::vector<CalibrationItem>& items,
+                             const Options& o, double limit) {
   std::vector<RenderJob> jobs;
   for (const CalibrationItem& it : items)
-    jobs.push_back({&scene, &it.configs.front(), &engine, it.cmp.resource});  // the minimum
+    jobs.push_back({&scene, &it.configs.front(), it.cmp.resource});  // the minimum
   const std::vector<Measurement> cheapest =
       measureAll(ctx, registry, jobs, o, false, [](size_t, const Measurement&) {});
   std::string unfit;
@@ -1248,10 +1244,9 @@ int runCalibrate(const Options& o) {
   std::vector<CalibrationItem> items;
   for (const auto& l : labels) items.push_back(calibrationItem(l, s));
   const gi::Scene& scene = s.scenes[0].scene;
-  const gi::SettingValues engine = gi::resolveEngineSettings(scene, nullptr, {}, {});
   gi::vk::Context ctx = makeContext(o);
   const double limit = o.budgetMs * (1.0 - o.headroom);
-  failFastWhenNothingFits(ctx, s.registry, scene, engine, items, o, limit);
+  failFastWhenNothingFits(ctx, s.registry, scene, items, o, limit);
   std::vector<ReferenceKey> keys;
   for (const auto& it : items) keys.push_back(ReferenceKey{0, it.cmp.target});
   const std::map<ReferenceKey, Reference> refs = computeReferences(o, s, keys);
@@ -1266,7 +1261,7 @@ int runCalibrate(const Options& o) {
     items[ii].firstJob = jobs.size();
     items[ii].scores.resize(items[ii].candidates.size());
     for (size_t ci = 0; ci < items[ii].configs.size(); ++ci) {
-      jobs.push_back({&scene, &items[ii].configs[ci], &engine, items[ii].cmp.resource});
+      jobs.push_back({&scene, &items[ii].configs[ci], items[ii].cmp.resource});
       owner.emplace_back(ii, ci);
     }
   }

@@ -10,20 +10,12 @@
 
 namespace demo {
 
-namespace {
-
-std::string effectView(const gi::EffectRegistry& registry, const std::string& view) {
-  return registry.has(view) ? registry.info(view).debugView : view;
-}
-
-}  // namespace
-
 Controller::Controller(gi::vk::Context& ctx, const gi::Scene& scene,
                        const gi::EffectRegistry& registry, const ControllerOptions& options)
-    : scene_(scene), registry_(registry), overrides_(options.overrides) {
+    : scene_(scene), registry_(registry), overrides_(options.request.overrides) {
   std::optional<gi::Preset> preset;
-  if (!options.preset.empty()) preset = gi::loadPreset(options.preset);
-  preset_ = options.preset;
+  if (!options.request.preset.empty()) preset = gi::loadPreset(options.request.preset);
+  preset_ = options.request.preset;
   // The effects asked for (scene or --effects) are on, in their order; the others follow.
   for (const gi::EffectConfig& c :
        gi::resolveEffects(scene_, preset ? &*preset : nullptr, overrides_, registry_)) {
@@ -36,7 +28,7 @@ Controller::Controller(gi::vk::Context& ctx, const gi::Scene& scene,
       enabled_[name] = false;
     }
   resolve(preset ? &*preset : nullptr);
-  view_ = effectView(registry_, options.view);
+  view_ = gi::resolveView(registry_, options.request.view);
 
   gi::RenderSettings s;
   gi::applyEngineSettings(values_.at(gi::kEngineSettingsOwner), s);
@@ -188,7 +180,7 @@ bool Controller::setPreset(const std::string& nameOrPath) {
 
 bool Controller::setView(const std::string& view) {
   return attempt([&] {
-    const std::string resource = effectView(registry_, view);
+    const std::string resource = gi::resolveView(registry_, view);
     renderer_->setView(resource);
     view_ = resource;
   });

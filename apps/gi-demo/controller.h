@@ -19,9 +19,9 @@
 namespace demo {
 
 struct ControllerOptions {
-  std::string preset;             // name or file; empty: none
-  gi::EffectOverrides overrides;  // --effects and --set, kept across preset switches
-  std::string view = "output";    // a resource name or an effect's name (its debug view)
+  // The preset (name or file; empty: none), --effects and --set (kept across preset switches),
+  // the view (a resource name or an effect's name: its debug view).
+  gi::RenderRequest request;
   uint32_t width = 1280, height = 720;
 };
 

@@ -33,25 +33,14 @@ const char* kUsage =
 demo::AppOptions parseArgs(int argc, char** argv) {
   demo::AppOptions o;
   o.context = gi::vk::ContextOptions::fromEnvironment();
-  for (gi::cli::Args a("gi-demo", argc, argv); a.next();) {
-    if (a.is("--help") || a.is("-h")) {
-      std::fputs(kUsage, stdout);
-      std::exit(0);
-    } else if (a.is("--scene"))
-      o.scene = a.value();
-    else if (a.is("--width"))
-      o.controller.width = uint32_t(a.integer(16, 16384));
-    else if (a.is("--height"))
-      o.controller.height = uint32_t(a.integer(16, 16384));
-    else if (a.is("--preset"))
-      o.controller.preset = a.value();
-    else if (a.is("--effects"))
-      o.controller.overrides.effects = a.effectList();  // a name twice is refused
-    else if (a.is("--set"))
-      o.controller.overrides.sets.push_back(a.value());
-    else if (a.is("--view"))
-      o.controller.view = a.value();
-    else if (a.is("--time"))
+  gi::cli::CommonFlags common;
+  common.width = 1280;
+  common.height = 720;
+  common.minSize = 16;
+  common.validation = o.context.validation;
+  for (gi::cli::Args a("gi-demo", argc, argv, kUsage); a.next();) {
+    if (gi::cli::parseCommonFlag(a, common)) continue;
+    if (a.is("--time"))
       o.time = a.number(-1e9, 1e9);
     else if (a.is("--paused"))
       o.paused = true;
@@ -65,14 +54,14 @@ demo::AppOptions parseArgs(int argc, char** argv) {
       o.outDir = a.value();
     else if (a.is("--shader-dir"))
       o.shaderDir = a.value();
-    else if (a.is("--validation"))
-      o.context.validation = true;
-    else if (a.is("--device"))
-      o.context.device = a.value();
     else
       a.unknown();
   }
-  if (o.scene.empty()) gi::cli::usageError("gi-demo", "", "--scene is required");
+  if (common.scene.empty()) gi::cli::usageError("gi-demo", "", "--scene is required");
+  o.scene = common.scene;
+  o.controller = {common.request, common.width, common.height};
+  o.context.validation = common.validation;
+  if (!common.device.empty()) o.context.device = common.device;
   return o;
 }
 

@@ -60,30 +60,21 @@ const char* kUsage =
     "  --device NAME          pick the Vulkan device by name or index (also GI_DEVICE)\n";
 
 struct Options {
-  std::string scene, out, view = "output", device, preset, graphDot;
-  gi::EffectOverrides overrides;
+  gi::cli::CommonFlags common;  // --scene, --width, --height, --preset, --effects, --set, ...
+  std::string out, graphDot;
   bool listEffects = false, printGraph = false;
-  uint32_t width = 640, height = 480;
   int frames = 0;  // 0: not given (one frame, or until the window closes)
   double time = 0.0, timeStep = 0.0;
-  bool timings = false, validation = false, window = false, isolatePasses = false;
+  bool timings = false, window = false, isolatePasses = false;
 };
 
 Options parseArgs(int argc, char** argv) {
   Options o;
-  o.validation = gi::vk::ContextOptions::fromEnvironment().validation;
-  for (gi::cli::Args a("gi-render", argc, argv); a.next();) {
-    if (a.is("--help") || a.is("-h")) {
-      std::fputs(kUsage, stdout);
-      std::exit(0);
-    } else if (a.is("--scene"))
-      o.scene = a.value();
-    else if (a.is("--out"))
+  o.common.validation = gi::vk::ContextOptions::fromEnvironment().validation;
+  for (gi::cli::Args a("gi-render", argc, argv, kUsage); a.next();) {
+    if (gi::cli::parseCommonFlag(a, o.common)) continue;
+    if (a.is("--out"))
       o.out = a.value();
-    else if (a.is("--width"))
-      o.width = uint32_t(a.integer(1, 16384));
-    else if (a.is("--height"))
-      o.height = uint32_t(a.integer(1, 16384));
     else if (a.is("--frames"))
       o.frames = int(a.integer(1, 100000));
     else if (a.is("--time"))
@@ -95,26 +86,14 @@ Options parseArgs(int argc, char** argv) {
       const bool exposure = a.is("--exposure");
       const std::string text = gi::cli::formatNumber(
           exposure ? a.number(0, 1e6) : double(a.integer(0, int64_t(1) << 24)));
-      o.overrides.sets.push_back(std::string("engine.") +
-                                 (exposure ? "exposure=" : "surface_points=") + text);
-    } else if (a.is("--view"))
-      o.view = a.value();
-    else if (a.is("--device"))
-      o.device = a.value();
-    else if (a.is("--timings"))
+      o.common.request.overrides.sets.push_back(
+          std::string("engine.") + (exposure ? "exposure=" : "surface_points=") + text);
+    } else if (a.is("--timings"))
       o.timings = true;
     else if (a.is("--isolate-passes"))
       o.isolatePasses = true;
-    else if (a.is("--validation"))
-      o.validation = true;
     else if (a.is("--window"))
       o.window = true;
-    else if (a.is("--effects"))
-      o.overrides.effects = a.effectList();  // a name twice is refused
-    else if (a.is("--preset"))
-      o.preset = a.value();
-    else if (a.is("--set"))
-      o.overrides.sets.push_back(a.value());
     else if (a.is("--list-effects"))
       o.listEffects = true;
     else if (a.is("--print-graph"))
@@ -125,7 +104,7 @@ Options parseArgs(int argc, char** argv) {
       a.unknown();
   }
   if (o.listEffects) return o;
-  if (o.scene.empty()) gi::cli::usageError("gi-render", "", "--scene is required");
+  if (o.common.scene.empty()) gi::cli::usageError("gi-render", "", "--scene is required");
   if (o.out.empty() && !o.window)
     gi::cli::usageError("gi-render", "", "--out is required (or --window)");
   return o;
@@ -161,7 +140,7 @@ int run(const Options& o) {
   if (!o.graphDot.empty()) gi::cli::checkOutputWritable(o.graphDot);
   // Load and validate everything (scene, effects, preset, settings) before any Vulkan work,
   // so bad input fails fast.
-  gi::Scene scene = gi::loadScene(o.scene);
+  gi::Scene scene = gi::loadScene(o.common.scene);
   for (const std::string& w : scene.warnings)
     std::fprintf(stderr, "gi-render: warning: %s\n", w.c_str());
   gi::EffectRegistry registry;
@@ -170,37 +149,27 @@ int run(const Options& o) {
   const double pluginLoadMs =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - scanStart)
           .count();
-  std::optional<gi::Preset> preset;
-  if (!o.preset.empty()) preset = gi::loadPreset(o.preset);
-  std::vector<gi::EffectConfig> effects =
-      gi::resolveEffects(scene, preset ? &*preset : nullptr, o.overrides, registry);
-  gi::RenderSettings settings;
-  gi::applyEngineSettings(
-      gi::resolveEngineSettings(scene, preset ? &*preset : nullptr, o.overrides, settings),
-      settings);
-  // An effect's name as a view means its debug view.
-  std::string view = o.view;
-  if (registry.has(view)) view = registry.info(view).debugView;
+  gi::RenderSettings base;
+  base.width = o.common.width;
+  base.height = o.common.height;
+  base.floorPass = o.timings;
+  base.isolatePasses = o.isolatePasses;
+  gi::RenderSettings settings = gi::configureRender(scene, registry, o.common.request, base);
+  const std::string& view = settings.view;
+  // A .pfm of the output view holds the HDR lit image (writeImage).
+  if (view == gi::resources::kOutput) settings.keepForReadback = {gi::resources::kLit};
 
   gi::vk::ContextOptions ctxOptions = gi::vk::ContextOptions::fromEnvironment();
-  ctxOptions.validation = o.validation;
-  if (!o.device.empty()) ctxOptions.device = o.device;
+  ctxOptions.validation = o.common.validation;
+  if (!o.common.device.empty()) ctxOptions.device = o.common.device;
   std::optional<AppWindow> window;  // outlives the context and the swapchain's surface
   if (o.window) {
-    window.emplace(o.width, o.height, "gi-render: " + o.scene);
+    window.emplace(o.common.width, o.common.height, "gi-render: " + o.common.scene);
     ctxOptions.instanceExtensions = AppWindow::instanceExtensions();
     ctxOptions.swapchain = true;
   }
   gi::vk::Context ctx(ctxOptions);
 
-  settings.width = o.width;
-  settings.height = o.height;
-  settings.floorPass = o.timings;
-  settings.view = view;
-  // A .pfm of the output view holds the HDR lit image (writeImage).
-  if (view == gi::resources::kOutput) settings.keepForReadback = {gi::resources::kLit};
-  settings.isolatePasses = o.isolatePasses;
-  settings.effects = effects;
   gi::Renderer renderer(ctx, scene, settings, &registry);
   if (o.printGraph) std::printf("%s", renderer.graphDescription().c_str());
   if (!o.graphDot.empty()) gi::cli::writeFileAtomic(o.graphDot, renderer.graphDot());
@@ -220,8 +189,9 @@ int run(const Options& o) {
   if (rendered > 0 && !o.out.empty()) writeImage(o.out, view, renderer);
 
   if (o.timings && rendered > 0) {
-    std::printf("scene %s, %ux%u, %zu triangles, %d frame(s), device %s\n", o.scene.c_str(),
-                o.width, o.height, scene.triangleCount(), rendered, ctx.deviceName().c_str());
+    std::printf("scene %s, %ux%u, %zu triangles, %d frame(s), device %s\n", o.common.scene.c_str(),
+                o.common.width, o.common.height, scene.triangleCount(), rendered,
+                ctx.deviceName().c_str());
     std::printf("%-12s %12s\n", "pass", "median ms");
     double total = 0;
     for (const std::string& name : renderer.passNames()) {

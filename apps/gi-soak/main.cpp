@@ -38,6 +38,7 @@ const char* kUsage =
     "  --rss-tolerance-kib T  largest resident-set growth after warm-up (default 4096; not\n"
     "                         judged under AddressSanitizer, whose quarantine keeps memory)\n"
     "  --validation           Vulkan validation layers (also GI_VALIDATION=1)\n"
+    "  --device NAME          pick the Vulkan device by name or index (also GI_DEVICE)\n"
     "Warm-up: the first tenth of the frames (at least 20) and the first two cycles. After it,\n"
     "the engine's device allocations must not change at all and the resident set must not rise\n"
     "more than the tolerance above its highest warm-up sample.\n";
@@ -51,36 +52,28 @@ constexpr double kDefaultRssToleranceKiB = 4096;
 #endif
 
 struct Options {
-  std::string scene = std::string(GI_SOURCE_DIR) + "/assets/scenes/animated.json";
   int frames = 10000, cycles = 20, every = 0;
-  uint32_t width = 160, height = 120;
+  gi::cli::CommonFlags common;  // --scene, --width, --height, --validation, --device
   double rssToleranceKiB = kDefaultRssToleranceKiB;
-  bool validation = false;
 };
 
 Options parseArgs(int argc, char** argv) {
   Options o;
-  o.validation = gi::vk::ContextOptions::fromEnvironment().validation;
-  for (gi::cli::Args a("gi-soak", argc, argv); a.next();) {
-    if (a.is("--help") || a.is("-h")) {
-      std::fputs(kUsage, stdout);
-      std::exit(0);
-    } else if (a.is("--scene"))
-      o.scene = a.value();
-    else if (a.is("--frames"))
+  o.common.scene = std::string(GI_SOURCE_DIR) + "/assets/scenes/animated.json";
+  o.common.width = 160;
+  o.common.height = 120;
+  o.common.validation = gi::vk::ContextOptions::fromEnvironment().validation;
+  using namespace gi::cli;
+  for (Args a("gi-soak", argc, argv, kUsage); a.next();) {
+    if (parseCommonFlag(a, o.common, kSceneFlags | kSizeFlags | kDeviceFlags)) continue;
+    if (a.is("--frames"))
       o.frames = int(a.integer(1, 100000000));
     else if (a.is("--cycles"))
       o.cycles = int(a.integer(0, 1000000));
     else if (a.is("--every"))
       o.every = int(a.integer(1, 100000000));
-    else if (a.is("--width"))
-      o.width = uint32_t(a.integer(1, 16384));
-    else if (a.is("--height"))
-      o.height = uint32_t(a.integer(1, 16384));
     else if (a.is("--rss-tolerance-kib"))
       o.rssToleranceKiB = a.number(0, 1e9);
-    else if (a.is("--validation"))
-      o.validation = true;
     else
       a.unknown();
   }
@@ -156,20 +149,19 @@ std::vector<std::string> growth(const std::vector<Sample>& samples, size_t warm,
 
 gi::RenderSettings settingsFor(const gi::Scene& scene, const gi::EffectRegistry& registry,
                                const Options& o) {
-  gi::RenderSettings rs;
-  rs.width = o.width;
-  rs.height = o.height;
-  gi::applyEngineSettings(gi::resolveEngineSettings(scene, nullptr, {}, rs), rs);
-  rs.effects = gi::resolveEffects(scene, nullptr, {}, registry);
-  return rs;
+  gi::RenderSettings base;
+  base.width = o.common.width;
+  base.height = o.common.height;
+  return gi::configureRender(scene, registry, o.common.request, base);
 }
 
 int run(const Options& o) {
   gi::vk::ContextOptions co = gi::vk::ContextOptions::fromEnvironment();
-  co.validation = o.validation;
+  co.validation = o.common.validation;
+  if (!o.common.device.empty()) co.device = o.common.device;
   gi::vk::Context ctx(co);
   std::printf("# gi-soak on %s: %s, %d frames at %ux%u, %d cycles\n", ctx.deviceName().c_str(),
-              o.scene.c_str(), o.frames, o.width, o.height, o.cycles);
+              o.common.scene.c_str(), o.frames, o.common.width, o.common.height, o.cycles);
   std::printf("phase,step,rss_kib,device_bytes,device_allocations,device_blocks\n");
   std::vector<std::string> problems;
   const auto start = std::chrono::steady_clock::now();
@@ -178,7 +170,7 @@ int run(const Options& o) {
   {
     gi::EffectRegistry registry;
     registry.scanDefaultLocations();
-    const gi::Scene scene = gi::loadScene(o.scene);
+    const gi::Scene scene = gi::loadScene(o.common.scene);
     gi::Renderer renderer(ctx, scene, settingsFor(scene, registry, o), &registry);
     std::vector<Sample> samples;
     size_t warm = 0;
@@ -203,7 +195,7 @@ int run(const Options& o) {
   for (int c = 0; c < o.cycles; ++c) {
     gi::EffectRegistry registry;
     registry.scanDefaultLocations();
-    const gi::Scene scene = gi::loadScene(o.scene);
+    const gi::Scene scene = gi::loadScene(o.common.scene);
     gi::RenderSettings rs = settingsFor(scene, registry, o);
     gi::Renderer renderer(ctx, scene, rs, &registry);
     renderer.setTime(c * 0.37);

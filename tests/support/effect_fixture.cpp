@@ -14,14 +14,13 @@ void EffectTest::SetUp() {
 
 RenderSettings EffectTest::settingsFor(const Scene& scene, const std::vector<std::string>& sets,
                                        uint32_t width, uint32_t height) const {
-  EffectOverrides cli;
-  cli.effects = {effectName()};
-  cli.sets = sets;
-  RenderSettings rs;
-  rs.width = width;
-  rs.height = height;
-  rs.effects = resolveEffects(scene, nullptr, cli, registry);
-  return rs;
+  RenderRequest request;
+  request.overrides.effects = {effectName()};
+  request.overrides.sets = sets;
+  RenderSettings base;
+  base.width = width;
+  base.height = height;
+  return configureRender(scene, registry, request, base);  // as every app sets a frame up
 }
 
 }  // namespace gi::test

@@ -65,4 +65,27 @@ std::vector<EffectConfig> resolveEffects(const Scene& scene, const Preset* prese
 SettingValues resolveEngineSettings(const Scene& scene, const Preset* preset,
                                     const EffectOverrides& cli, const RenderSettings& base);
 
+// What an app or a test asks of a frame besides its scene: a preset, the command line's effect
+// list and --set assignments, and a view (a resource, or an effect's name for its debug view).
+struct RenderRequest {
+  std::string preset;  // a name or a .json path; empty: none
+  EffectOverrides overrides;
+  std::string view = "output";
+};
+
+// The one set-up path of every app and test fixture: the preset (loaded and checked against the
+// registry), the effects with their settings (resolveEffects), the engine settings
+// (resolveEngineSettings over `base`, applied), the view resolved (resolveView). The rest of
+// `base` (size, floor pass, timing, read-back) is kept. Throws gi::Error naming the file or flag.
+RenderSettings configureRender(const Scene& scene, const EffectRegistry& registry,
+                               const RenderRequest& request, RenderSettings base = {});
+// The same with a preset already loaded (gi-bench loads each once for many scenes); nullptr:
+// none. request.preset is ignored.
+RenderSettings configureRender(const Scene& scene, const EffectRegistry& registry,
+                               const Preset* preset, const RenderRequest& request,
+                               RenderSettings base = {});
+// An effect's name stands for its debug view (EffectInfo::debugView); any other name is a
+// resource's and is returned as it is.
+std::string resolveView(const EffectRegistry& registry, const std::string& view);
+
 }  // namespace gi

@@ -157,4 +157,24 @@ SettingValues resolveEngineSettings(const Scene& scene, const Preset* preset,
   return v;
 }
 
+RenderSettings configureRender(const Scene& scene, const EffectRegistry& registry,
+                               const Preset* preset, const RenderRequest& request,
+                               RenderSettings base) {
+  base.effects = resolveEffects(scene, preset, request.overrides, registry);
+  applyEngineSettings(resolveEngineSettings(scene, preset, request.overrides, base), base);
+  base.view = resolveView(registry, request.view);
+  return base;
+}
+
+RenderSettings configureRender(const Scene& scene, const EffectRegistry& registry,
+                               const RenderRequest& request, RenderSettings base) {
+  std::optional<Preset> preset;
+  if (!request.preset.empty()) preset = loadPreset(request.preset);  // checked by resolveEffects
+  return configureRender(scene, registry, preset ? &*preset : nullptr, request, std::move(base));
+}
+
+std::string resolveView(const EffectRegistry& registry, const std::string& view) {
+  return registry.has(view) ? registry.info(view).debugView : view;
+}
+
 }  // namespace gi
