@@ -195,6 +195,37 @@ TEST(Settings, TypedHandlesReadTheCurrentValue) {
   expectError([&] { one[s.handle<double>("radius")]; }, ErrorKind::Schema, {"another declaration"});
 }
 
+TEST(Settings, AdoptKeepsValuesWhoseNameAndTypeStillFit) {
+  // A rebuilt plugin's declaration against the values the user had set (plugin hot reload).
+  using T = SettingType;
+  SettingDesc mode{"mode", T::Enum, 0, 0, 0, "", false, {"fast", "exact", "debug"}};
+  SettingValues before("fx", {{"radius", T::Float, 0.5, 0.0, 10.0, ""},
+                              {"taps", T::Int, 8, 1, 64, ""},
+                              {"wide", T::Float, 0.5, 0.0, 10.0, ""},
+                              {"gone", T::Bool, 0, 0, 1, ""},
+                              mode,
+                              {"tint", T::Color, 0, 0, 1, "", false, {}, {1, 1, 1}}});
+  before.set("radius", 2.5, "test");
+  before.set("taps", 32, "test");
+  before.set("wide", 8.0, "test");
+  before.set("mode", "debug", "test");
+  before.set("tint", nlohmann::json::array({0.1, 0.2, 0.3}), "test");
+  mode.options = {"fast", "exact"};  // "debug" removed
+  SettingValues after("fx", {{"radius", T::Float, 1.0, 0.0, 10.0, ""},
+                             {"taps", T::Bool, 0, 0, 1, ""},         // type changed
+                             {"wide", T::Float, 0.5, 0.0, 4.0, ""},  // 8 is out of range now
+                             mode,
+                             {"tint", T::Color, 0, 0, 1, "", false, {}, {1, 1, 1}},
+                             {"fresh", T::Int, 3, 0, 9, ""}});
+  EXPECT_EQ(after.adopt(before), (std::vector<std::string>{"radius", "tint"}));
+  EXPECT_DOUBLE_EQ(after.number("radius"), 2.5);
+  EXPECT_FALSE(after.flag("taps"));
+  EXPECT_DOUBLE_EQ(after.number("wide"), 0.5);
+  EXPECT_EQ(after.option("mode"), "fast");
+  EXPECT_EQ(after.vector("tint"), (std::array<double, 3>{0.1, 0.2, 0.3}));
+  EXPECT_EQ(after.integer("fresh"), 3);
+}
+
 TEST(Settings, GraphDiffersComparesVectorsAndEnums) {
   SettingValues a = fresh(), b = fresh();
   b.set("offset", json::array({0, 1, -1}), "t");  // offset is uniform-only

@@ -43,11 +43,12 @@ std::string writeScript(const std::string& dir, const std::string& text) {
 
 // gi-demo's own exit status, reported from inside the virtual X session: xvfb-run replaces it
 // with its own when it fails to clean up its temporary folder (seen under parallel tests).
-test::ProcessResult runDemo(const std::string& args) {
+// `environment`: "NAME=value ..." set for the demo.
+test::ProcessResult runDemo(const std::string& args, const std::string& environment = "") {
   const std::string marker = "[gi-demo exit ";
-  test::ProcessResult r =
-      test::runCommand("xvfb-run -a -s '-screen 0 640x480x24' sh -c '\"$0\" \"$@\"; echo \"" +
-                       marker + "$?]\"' " + test::binPath("gi-demo") + " --validation" + args);
+  test::ProcessResult r = test::runCommand(
+      environment + " xvfb-run -a -s '-screen 0 640x480x24' sh -c '\"$0\" \"$@\"; echo \"" +
+      marker + "$?]\"' " + test::binPath("gi-demo") + " --validation" + args);
   const size_t at = r.output.rfind(marker);
   if (at == std::string::npos) return r;  // xvfb-run itself failed: keep its status
   r.exitCode = std::atoi(r.output.c_str() + at + marker.size());
@@ -359,6 +360,48 @@ TEST(Demo, AccuracyBeforeAnyFrameOfTheViewSaysToRenderOne) {
   EXPECT_NE(r.output.find("render a frame after changing the effects, view, preset or size"),
             std::string::npos)
       << r.output;
+}
+
+// Plugin hot reload through the demo: a module rebuilt while it runs (version 2 of the test
+// module, AO 0.75 instead of 0.25) replaces the effect with the value set for it kept; a broken
+// file then is reported and the running module stays (tests/test_plugin_reload.cpp tests the
+// registry and renderer underneath).
+TEST(Demo, HotReloadOfARebuiltPlugin) {
+  REQUIRE_DEMO();
+  const std::string dir = test::makeTempDir("demo_plugin_reload");
+  const std::string plugins = dir + "/plugins", plugin = plugins + "/gi_effect_reloadable.so";
+  const std::string modules = GI_TEST_MODULE_DIR;
+  fs::create_directories(plugins);
+  fs::copy_file(modules + "/gi_test_reloadable_v1.so", plugin);
+  std::ofstream(dir + "/broken.so") << "half-written";
+  const std::string script =
+      writeScript(dir, "pause on\nframes 2\nscreenshot " + dir + "/a.png\nreload\n" +  //
+                           "copy " + modules + "/gi_test_reloadable_v2.so " + plugin +
+                           "\nreload\n" + "frames 2\nscreenshot " + dir + "/b.png\n" +  //
+                           "copy " + dir + "/broken.so " + plugin +
+                           "\nreload\nframes 2\nscreenshot " + dir + "/c.png\n");
+  auto r = runDemo(" --scene default --effects reloadable --set reloadable.value=0.9 --view ao" +
+                       kSize + " --script " + script,
+                   "GI_PLUGIN_PATH=" + plugins);
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_EQ(r.output.find("validation"), std::string::npos) << r.output;
+  std::vector<std::string> reloads;
+  std::istringstream lines(r.output);
+  for (std::string line; std::getline(lines, line);)
+    if (line.rfind("plugin reload:", 0) == 0) reloads.push_back(line);
+  ASSERT_EQ(reloads.size(), 2u) << r.output;
+  EXPECT_EQ(reloads[0],
+            "plugin reload: gi_effect_reloadable.so: reloadable; settings kept: reloadable.value");
+  EXPECT_EQ(reloads[1].rfind("plugin reload: error: " + plugin + ": cannot load module", 0), 0u)
+      << reloads[1];
+  const ImageRGBA8 a = readPng(dir + "/a.png"), b = readPng(dir + "/b.png"),
+                   c = readPng(dir + "/c.png");
+  ASSERT_EQ(a.pixels.size(), size_t(160 * 120 * 4));
+  for (size_t i = 0; i < a.pixels.size(); i += 4) {
+    ASSERT_NEAR(a.pixels[i], 64, 1) << "pixel " << i / 4 << ": version 1 writes AO 0.25";
+    ASSERT_NEAR(b.pixels[i], 191, 1) << "pixel " << i / 4 << ": version 2 writes AO 0.75";
+  }
+  EXPECT_EQ(b.pixels, c.pixels) << "a broken module must leave the running one in place";
 }
 
 // Hot reload: a copy of ssao.comp in --shader-dir is broken (the compiler's message is reported,

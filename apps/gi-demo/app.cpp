@@ -53,6 +53,7 @@ App::App(const AppOptions& o) : options_(o) {
   registry_.scanDefaultLocations();
   // The loaded modules registered their shaders: their texts now are the baseline.
   watcher_ = std::make_unique<ShaderWatcher>(o.shaderDir);
+  modules_ = std::make_unique<ModuleWatcher>(registry_.modulePaths());
   if (!o.script.empty()) script_ = loadScript(o.script);
 
   window_ =
@@ -151,9 +152,11 @@ void App::frame() {
   const double wallDt = std::min(std::chrono::duration<double>(start - last_).count(), 0.1);
   last_ = start;
   const double dt = script_.empty() ? wallDt : kScriptStep;
-  // Hot reload: the window checks the shaders twice a second (a script only on `reload`).
+  // Hot reload: the window checks the shaders and the plugin modules twice a second (a script
+  // only on `reload`).
   if (script_.empty() && start - lastWatch_ > std::chrono::milliseconds(500)) {
     lastWatch_ = start;
+    reloadPlugins(true);
     reloadShaders(false);
   }
   gi::Renderer& renderer = controller_->renderer();
@@ -326,6 +329,41 @@ void App::reloadShaders(bool report) {
   std::fflush(stdout);
 }
 
+void App::reloadPlugins(bool settled) {
+  for (const std::string& module : modules_->poll(settled)) {
+    modules_->accept(module);
+    const std::string file = std::filesystem::path(module).filename().string();
+    std::string line;
+    const gi::EffectRegistry before = registry_;  // the previous module's effects, to fall back
+    try {
+      const std::vector<std::string> effects = registry_.reloadModule(module);
+      std::vector<std::string> kept;
+      if (controller_->adoptReloadedModule(effects, &kept)) {
+        std::string names, keys;
+        for (const std::string& e : effects) names += (names.empty() ? "" : ", ") + e;
+        for (const std::string& k : kept) keys += (keys.empty() ? "" : ", ") + k;
+        state_.message = "reloaded plugin " + file + " (" + names + ")";
+        line = "plugin reload: " + file + ": " + names +
+               "; settings kept: " + (keys.empty() ? "none" : keys);
+      } else {
+        const std::string why = controller_->lastError();
+        registry_ = before;
+        controller_->reloadEffects();
+        state_.message = "plugin reload of " + file + " failed, the previous module runs:\n" + why;
+        line = "plugin reload: error: " + why;
+      }
+    } catch (const std::exception& e) {
+      // The registry is unchanged: the previous module keeps running.
+      state_.message =
+          std::string("plugin reload failed (the previous module keeps running):\n") + e.what();
+      line = std::string("plugin reload: error: ") + e.what();
+    }
+    std::replace(line.begin(), line.end(), '\n', ' ');  // one line
+    std::printf("%s\n", line.c_str());
+    std::fflush(stdout);
+  }
+}
+
 void App::printTimings() {
   std::printf(
       "timings: %zu frames at %ux%u, frame %.2f ms (wall, median), GPU passes %.3f ms, UI GPU "
@@ -418,10 +456,15 @@ void App::execute(const ScriptStep& s) {
     std::printf("accuracy: %s nrmse %.6f pixels %zu spp %u seconds %.2f quantity %s\n",
                 r->effect.c_str(), r->nrmse, r->pixels, r->spp, r->seconds, r->quantity.c_str());
   } else if (s.verb == "reload") {
+    reloadPlugins(false);
     reloadShaders(true);
   } else if (s.verb == "copy") {
-    std::filesystem::copy_file(s.args[0], s.args[1],
+    // As a build or an editor replaces a file: a new file renamed over the old one, so that
+    // code or text still mapped from the old file is never changed under a reader.
+    const std::string partial = s.args[1] + ".partial";
+    std::filesystem::copy_file(s.args[0], partial,
                                std::filesystem::copy_options::overwrite_existing);
+    std::filesystem::rename(partial, s.args[1]);
   } else if (s.verb == "screenshot") {
     screenshot(s.args[0]);
   } else if (s.args[0] == "passes") {

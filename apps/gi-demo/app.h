@@ -13,6 +13,7 @@
 #include "controller.h"
 #include "free_camera.h"
 #include "gi/vk/resources.h"
+#include "module_watcher.h"
 #include "panel.h"
 #include "presenter.h"
 #include "script.h"
@@ -51,6 +52,9 @@ class App {
   void printTimings();
   void startAccuracy(const std::string& effect, uint32_t spp);
   void reloadShaders(bool report);
+  // `settled`: only modules whose file stopped changing (the window's polling); a script's
+  // `reload` takes every changed one at once.
+  void reloadPlugins(bool settled);
 
   AppOptions options_;
   gi::Scene scene_;
@@ -63,6 +67,7 @@ class App {
   std::unique_ptr<FreeCamera> camera_;
   AccuracyCheck accuracy_;
   std::unique_ptr<ShaderWatcher> watcher_;
+  std::unique_ptr<ModuleWatcher> modules_;
   std::chrono::steady_clock::time_point lastWatch_;
   gi::vk::Image preview_;  // the viewed resource when it is not the output
   FrameStats stats_;

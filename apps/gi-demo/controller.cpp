@@ -99,6 +99,38 @@ bool Controller::reloadEffects() {
   });
 }
 
+bool Controller::adoptReloadedModule(const std::vector<std::string>& effects,
+                                     std::vector<std::string>* kept) {
+  const auto oldOrder = order_;
+  const auto oldEnabled = enabled_;
+  const auto oldValues = values_;
+  std::vector<std::string> carried;
+  for (const std::string& name : effects) {
+    gi::SettingValues next = registry_.defaultSettings(name);
+    if (auto it = values_.find(name); it != values_.end())
+      for (const std::string& key : next.adopt(it->second)) carried.push_back(name + "." + key);
+    else {
+      order_.push_back(name);
+      enabled_[name] = false;
+    }
+    values_[name] = std::move(next);
+  }
+  std::erase_if(order_, [&](const std::string& name) {
+    if (registry_.has(name)) return false;
+    enabled_.erase(name);
+    values_.erase(name);
+    return true;
+  });
+  if (reloadEffects()) {
+    if (kept) *kept = std::move(carried);
+    return true;
+  }
+  order_ = oldOrder;
+  enabled_ = oldEnabled;
+  values_ = oldValues;
+  return false;
+}
+
 const gi::SettingValues& Controller::settings(const std::string& owner) const {
   auto it = values_.find(owner);
   if (it == values_.end())

@@ -55,6 +55,14 @@ class Controller {
   // Re-creates the effects that are on, as switching them off and on does: their pipelines are
   // built again (from hot-reloaded shaders, gi/vk/shader_overrides.h).
   bool reloadEffects();
+  // After the registry reloaded a module that now registers `effects`: each one's settings
+  // start from its new declaration and keep the values that still fit it
+  // (gi::SettingValues::adopt); effects the registry no longer has are dropped, new ones are
+  // listed (off); then the effects are re-created. False (lastError()) when that fails: the
+  // settings are back as they were and the caller restores the registry. `kept` receives
+  // "effect.key" for every value carried over.
+  bool adoptReloadedModule(const std::vector<std::string>& effects,
+                           std::vector<std::string>* kept = nullptr);
 
   // The image the window shows: the output, or a preview of the viewed resource (RGBA8).
   gi::ImageRGBA8 image();

@@ -17,10 +17,13 @@
 //                            rendered since the last effect, view, preset or size change
 //   screenshot PATH          write the rendered image (without the panel) as PNG
 //   print passes|views|timings|memory|camera   print to stdout (views: what `view` takes)
-//   copy FROM TO             copy a file (e.g. an edited shader into --shader-dir)
-//   reload                   check the effects' GLSL now (hot reload; the window checks every
-//                            0.5 s) and print one line: "reload: N shader(s) rebuilt", or
-//                            "reload: no change", or "reload: error: <compiler message>"
+//   copy FROM TO             copy a file (e.g. an edited shader into --shader-dir), as a new
+//                            file renamed over TO (as a build or an editor replaces one)
+//   reload                   check the plugin modules and the effects' GLSL now (hot reload;
+//                            the window checks every 0.5 s): per rebuilt module one line
+//                            "plugin reload: FILE: EFFECTS; settings kept: EFFECT.KEY, ..." or
+//                            "plugin reload: error: <why>"; then one line "reload: N shader(s)
+//                            rebuilt", or "reload: no change", or "reload: error: <message>"
 #pragma once
 
 #include <string>

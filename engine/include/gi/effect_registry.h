@@ -1,6 +1,8 @@
 // Finds, loads and lists effect plugins. Each effect is a shared module (effects/<name>/)
 // exporting two C functions (see GI_EFFECT_MODULE); the registry dlopen()s it, checks its ABI
-// version and lets it register its effects. Modules stay loaded for the life of the process.
+// version and lets it register its effects. A rebuilt module can be loaded again
+// (reloadModule). Loaded code stays mapped for the life of the process: effect instances made
+// from an earlier version of a module may outlive its reload.
 #pragma once
 
 #include <functional>
@@ -21,6 +23,16 @@ class EffectRegistry {
   // Loads one module; throws gi::Error naming the file on failure (not a module, ABI
   // mismatch, duplicate effect).
   void loadModule(const std::string& path);
+  // Loads the module at `path` (loaded before) again after it was rebuilt: a private copy of
+  // the file is loaded, so the code of the previous version stays mapped and a file still being
+  // written can never be mapped. The effects the new version registers replace the ones the
+  // path registered before. On any failure (not a module, ABI mismatch, a registration that
+  // throws, an invalid or duplicate effect) the registry is unchanged and the gi::Error names
+  // `path`. Returns the names the module now registers. Effects already created keep running
+  // their old code: create them again (Renderer::setEffects) to run the new one.
+  std::vector<std::string> reloadModule(const std::string& path);
+  // The module files loaded, as given to loadModule / found by a scan, in load order.
+  std::vector<std::string> modulePaths() const;
   // Loads every *.so in `dir`; a refused module is reported in problems() and on stderr, the
   // others still load. A missing folder is skipped.
   void scanDirectory(const std::string& dir);
@@ -51,7 +63,14 @@ class EffectRegistry {
   std::string origin_or(const std::string& name) const;
   std::vector<Entry> entries_;
   std::vector<std::string> problems_;
-  std::vector<std::string> loadedPaths_;
+  struct Module {
+    std::string path, canonical;
+  };
+  // Opens `file` as a module (symbols, ABI version; errors name `path`) and registers what it
+  // registers into a copy of the entries without `replaced`'s; commits only when all succeed.
+  void openAndRegister(const std::string& file, const std::string& path,
+                       const std::string& replaced);
+  std::vector<Module> modules_;
 };
 
 }  // namespace gi

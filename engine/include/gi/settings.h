@@ -118,6 +118,10 @@ class SettingValues {
   nlohmann::json toJson() const;
   // True when a setting that changes the graph differs between the two.
   bool graphDiffers(const SettingValues& other) const;
+  // Takes `previous`'s value of every setting declared here with the same name and type that
+  // this declaration accepts (in range, a known option): a rebuilt plugin keeps what the user
+  // set. The others keep their values here. Returns the keys taken over.
+  std::vector<std::string> adopt(const SettingValues& previous);
 
  private:
   const SettingDesc& typed(const std::string& key, std::initializer_list<SettingType> types,

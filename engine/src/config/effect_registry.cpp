@@ -1,6 +1,7 @@
 #include "gi/effect_registry.h"
 
 #include <dlfcn.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -58,11 +59,9 @@ std::string EffectRegistry::origin_or(const std::string& name) const {
   return has(name) ? origin(name) : "?";
 }
 
-void EffectRegistry::loadModule(const std::string& path) {
-  const std::string canonical = fs::weakly_canonical(path).string();
-  if (std::find(loadedPaths_.begin(), loadedPaths_.end(), canonical) != loadedPaths_.end())
-    throw Error(ErrorKind::InvalidData, path, "module already loaded");
-  void* handle = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+void EffectRegistry::openAndRegister(const std::string& file, const std::string& path,
+                                     const std::string& replaced) {
+  void* handle = dlopen(file.c_str(), RTLD_NOW | RTLD_LOCAL);
   if (!handle)
     throw Error(ErrorKind::InvalidData, path, std::string("cannot load module: ") + dlerror());
   auto version = reinterpret_cast<GiEffectAbiVersionFn>(dlsym(handle, "gi_effect_abi_version"));
@@ -80,9 +79,10 @@ void EffectRegistry::loadModule(const std::string& path) {
                     std::to_string(GI_EFFECT_ABI_VERSION) +
                     "; rebuild the module against this engine");
   }
-  // Register into a scratch registry first so a failing module adds nothing.
+  // Register into a scratch registry first so a failing module changes nothing.
   EffectRegistry scratch;
-  scratch.entries_ = entries_;
+  for (const Entry& e : entries_)
+    if (replaced.empty() || e.origin != replaced) scratch.entries_.push_back(e);
   currentModule = &path;
   try {
     registerFn(scratch);
@@ -92,7 +92,58 @@ void EffectRegistry::loadModule(const std::string& path) {
   }
   currentModule = nullptr;
   entries_ = std::move(scratch.entries_);
-  loadedPaths_.push_back(canonical);
+}
+
+void EffectRegistry::loadModule(const std::string& path) {
+  const std::string canonical = fs::weakly_canonical(path).string();
+  for (const Module& m : modules_)
+    if (m.canonical == canonical)
+      throw Error(ErrorKind::InvalidData, path, "module already loaded");
+  openAndRegister(path, path, "");
+  modules_.push_back({path, canonical});
+}
+
+std::vector<std::string> EffectRegistry::reloadModule(const std::string& path) {
+  const std::string canonical = fs::weakly_canonical(path).string();
+  const auto loaded = std::find_if(modules_.begin(), modules_.end(),
+                                   [&](const Module& m) { return m.canonical == canonical; });
+  if (loaded == modules_.end())
+    throw Error(ErrorKind::Usage, path, "cannot reload a module that was never loaded");
+  // dlopen() returns the already loaded object for a path it has seen, and maps a file that a
+  // build may still be writing: a private copy, removed once mapped, avoids both. It sits next
+  // to the module (the same $ORIGIN for the libraries beside it), named so that no scan takes it
+  // for a module, or in the temporary folder when the module's folder is read-only.
+  static int copies = 0;
+  const std::string name = "." + fs::path(path).filename().string() + ".reload-" +
+                           std::to_string(getpid()) + "-" + std::to_string(++copies);
+  std::error_code ec;
+  fs::path copy = fs::path(path).parent_path() / name;
+  if (!fs::copy_file(path, copy, fs::copy_options::overwrite_existing, ec) || ec) {
+    if (!fs::exists(path, ec))
+      throw Error(ErrorKind::FileNotFound, path, "cannot read the module: it is gone");
+    copy = fs::temp_directory_path(ec) / name;
+    if (ec || !fs::copy_file(path, copy, fs::copy_options::overwrite_existing, ec) || ec)
+      throw Error(ErrorKind::FileNotFound, path,
+                  "cannot read the module" + (ec ? ": " + ec.message() : std::string()));
+  }
+  try {
+    openAndRegister(copy.string(), loaded->path, loaded->path);
+  } catch (...) {
+    fs::remove(copy, ec);
+    throw;
+  }
+  fs::remove(copy, ec);
+  std::vector<std::string> names;
+  for (const Entry& e : entries_)
+    if (e.origin == loaded->path) names.push_back(e.info.name);
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+std::vector<std::string> EffectRegistry::modulePaths() const {
+  std::vector<std::string> out;
+  for (const Module& m : modules_) out.push_back(m.path);
+  return out;
 }
 
 void EffectRegistry::scanDirectory(const std::string& dir) {

@@ -369,6 +369,23 @@ std::array<double, 3> SettingValues::vector(const std::string& key) const {
   return values_[index(key)];
 }
 
+std::vector<std::string> SettingValues::adopt(const SettingValues& previous) {
+  std::vector<std::string> taken;
+  const json old = previous.toJson();
+  for (const SettingDesc& d : descs_) {
+    const auto same = std::find_if(previous.descs_.begin(), previous.descs_.end(),
+                                   [&](const SettingDesc& p) { return p.name == d.name; });
+    if (same == previous.descs_.end() || same->type != d.type) continue;
+    try {
+      set(d.name, old.at(d.name), "previous settings");
+      taken.push_back(d.name);
+    } catch (const Error&) {
+      // Out of the new range or an option that no longer exists: the new default stays.
+    }
+  }
+  return taken;
+}
+
 json SettingValues::toJson() const {
   json j = json::object();
   for (const SettingDesc& d : descs_) {
