@@ -14,8 +14,14 @@ void EffectTest::SetUp() {
 
 RenderSettings EffectTest::settingsFor(const Scene& scene, const std::vector<std::string>& sets,
                                        uint32_t width, uint32_t height) const {
+  return settingsFor({effectName()}, scene, sets, width, height);
+}
+
+RenderSettings EffectTest::settingsFor(const std::vector<std::string>& effects, const Scene& scene,
+                                       const std::vector<std::string>& sets, uint32_t width,
+                                       uint32_t height) const {
   RenderRequest request;
-  request.overrides.effects = {effectName()};
+  request.overrides.effects = effects;
   request.overrides.sets = sets;
   RenderSettings base;
   base.width = width;

@@ -20,6 +20,12 @@ class EffectTest : public VulkanTest {
   // "effect.key=value" overrides, as gi-render's --set).
   RenderSettings settingsFor(const Scene& scene, const std::vector<std::string>& sets,
                              uint32_t width, uint32_t height) const;
+  // The same with `effects` in place of the effect (as gi-render's --effects): another effect
+  // to compare it with, several at once, or none (the engine alone). Only effectName() is
+  // checked by SetUp; an effect missing from the registry throws gi::Error here.
+  RenderSettings settingsFor(const std::vector<std::string>& effects, const Scene& scene,
+                             const std::vector<std::string>& sets, uint32_t width,
+                             uint32_t height) const;
   EffectRegistry registry;
 };
 

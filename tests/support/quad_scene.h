@@ -1,6 +1,6 @@
-// Analytic scenes of quads for the screen-space AO tests (test_ssao, test_horizon_ao): a quad
-// mesh, a scene of transformed quads with a camera, the 90-degree corner (floor + wall), and
-// helpers on rendered images.
+// Analytic scenes of quads for the screen-space AO tests (test_ssao, test_horizon_ao, ...): a
+// quad mesh, a scene of transformed quads with a camera, the 90-degree corner (floor + wall),
+// and helpers on rendered images (AoFrame: an AO image read back with its depth and camera).
 #pragma once
 
 #include <algorithm>
@@ -155,6 +155,25 @@ inline bool finite(const ImageRGBA32F& img) {
   return true;
 }
 
+// A frame of an AO effect read back: "ao" (the value in red), "depth" and the camera, w x h
+// pixels, with the look-ups of the helpers here (bookOutline, cornerLinePixels, patternEnergy).
+struct AoFrame {
+  ImageRGBA32F ao, depth;
+  CameraView camera;
+  int w = 0, h = 0;
+  float at(int x, int y) const { return ao.pixels[(size_t(y) * w + x) * 4]; }
+  float depthAt(int x, int y) const { return depth.pixels[(size_t(y) * w + x) * 4]; }
+  bool sky(int x, int y) const { return depthAt(x, y) <= 0.0f; }  // reverse-Z: 0 is far
+  glm::vec3 viewAt(int x, int y) const {  // view-space position of the pixel's centre
+    glm::vec4 v = glm::inverse(camera.proj) *
+                  glm::vec4((x + 0.5f) / w * 2 - 1, (y + 0.5f) / h * 2 - 1, depthAt(x, y), 1.0f);
+    return glm::vec3(v) / v.w;
+  }
+  glm::vec3 worldAt(int x, int y) const {
+    return glm::vec3(glm::inverse(camera.view) * glm::vec4(viewAt(x, y), 1.0f));
+  }
+};
+
 // Floor pixels of the corner scene in the 4 rows nearest to the line x = d (every 4x4 phase
 // of the interleave pattern is present), away from the image border. `r` has w, h and
 // worldAt(x, y).
@@ -171,6 +190,32 @@ std::vector<glm::ivec2> cornerLinePixels(const auto& r, float d) {
     for (int x = r.w / 2 - 16; x < r.w / 2 + 16; ++x)
       if (std::abs(r.worldAt(x, y).y) < 1e-3f) pixels.push_back({x, y});
   return pixels;
+}
+
+// Energy of the 4x4 interleave pattern on the corner's floor between x = minX and maxX,
+// insensitive to the AO's smooth variation: the corner scene's camera has no roll and looks
+// along -x, so image rows are lines of constant distance to the wall. Along x: residual from a
+// straight-line fit per row; along y: second differences of the row means (a linear trend
+// cancels).
+inline double patternEnergy(const AoFrame& r, float minX, float maxX) {
+  double ex = 0.0, ey = 0.0;
+  int nx = 0, ny = 0;
+  std::vector<double> rowMeans;
+  const int x0 = r.w / 2 - 32, x1 = r.w / 2 + 32;
+  for (int y = 0; y < r.h; ++y) {
+    const glm::vec3 c = r.worldAt(r.w / 2, y);
+    if (std::abs(c.y) > 1e-3f || c.x < minX || c.x > maxX) continue;
+    double sx = 0, sy = 0, sxx = 0, sxy = 0;
+    const int n = x1 - x0;
+    for (int x = x0; x < x1; ++x)
+      sx += x, sy += r.at(x, y), sxx += double(x) * x, sxy += double(x) * r.at(x, y);
+    const double slope = (n * sxy - sx * sy) / (n * sxx - sx * sx), icept = (sy - slope * sx) / n;
+    for (int x = x0; x < x1; ++x, ++nx) ex += std::pow(r.at(x, y) - (icept + slope * x), 2);
+    rowMeans.push_back(sy / n);
+  }
+  for (size_t i = 1; i + 1 < rowMeans.size(); ++i, ++ny)
+    ey += std::pow(rowMeans[i] - 0.5 * (rowMeans[i - 1] + rowMeans[i + 1]), 2);
+  return (nx ? ex / nx : 0.0) + (ny ? ey / ny : 0.0);
 }
 
 }  // namespace gi::test
