@@ -16,11 +16,9 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "../effects/obscurance/obscurance_kernel.h"
-#include "gi/effect_config.h"
+#include "effect_fixture.h"
 #include "gi/renderer.h"
 #include "quad_scene.h"
-#include "test_support.h"
-#include "vulkan_fixture.h"
 
 namespace gi {
 namespace {
@@ -28,6 +26,9 @@ namespace {
 namespace obs = obscurance;
 constexpr uint32_t kW = 160, kH = 120;
 
+using test::cornerQuads;
+using test::finite;
+using test::patternEnergy;
 using test::Quads;
 
 // Quads of one material with linear albedo `albedo`, seen from `eye` towards `target`.
@@ -45,10 +46,7 @@ glm::mat4 translation(glm::vec3 t) {
   return glm::translate(glm::mat4(1.0f), t);
 }
 
-// A floor (y = 0) and a wall (x = 0): a 90-degree concave corner.
-Quads cornerQuads() {
-  return {{rotation(-90, {1, 0, 0}), 20.0f}, {rotation(90, {0, 1, 0}), 20.0f}};
-}
+// The 90-degree concave corner (floor y = 0, wall x = 0) of albedo `albedo`.
 Scene cornerScene(float albedo = 0.8f) {
   return quadScene(cornerQuads(), glm::vec3(2.5f, 1.6f, 0.0f), glm::vec3(0.0f), albedo);
 }
@@ -71,59 +69,22 @@ Scene creviceScene(float albedo) {
   return quadScene(q, glm::vec3(1.2f, 1.0f, 1.4f), glm::vec3(0.0f), albedo);
 }
 
-bool finite(const ImageRGBA32F& img) {
-  for (float v : img.pixels)
-    if (!std::isfinite(v)) return false;
-  return true;
-}
-
-class ObscuranceTest : public test::VulkanTest {
+class ObscuranceTest : public test::EffectTest {
  protected:
-  void SetUp() override {
-    VulkanTest::SetUp();
-    registry.scanDirectory(test::binPath("plugins"));
-    ASSERT_TRUE(registry.has("obscurance"))
-        << "obscurance plugin missing from " << test::binPath("plugins");
-  }
-  struct Result {
-    ImageRGBA32F ao, depth;
-    CameraView camera;
-    int w = 0, h = 0;
-    float at(int x, int y) const { return ao.pixels[(size_t(y) * w + x) * 4]; }
-    float depthAt(int x, int y) const { return depth.pixels[(size_t(y) * w + x) * 4]; }
-    bool sky(int x, int y) const { return depthAt(x, y) <= 0.0f; }
-    glm::vec3 viewAt(int x, int y) const {
-      glm::vec4 v = glm::inverse(camera.proj) *
-                    glm::vec4((x + 0.5f) / w * 2 - 1, (y + 0.5f) / h * 2 - 1, depthAt(x, y), 1.0f);
-      return glm::vec3(v) / v.w;
-    }
-    glm::vec3 worldAt(int x, int y) const {
-      return glm::vec3(glm::inverse(camera.view) * glm::vec4(viewAt(x, y), 1.0f));
-    }
+  std::string effectName() const override { return "obscurance"; }
+  struct Result : test::AoFrame {
     double mean() const {
       double s = 0.0;
       for (size_t i = 0; i < ao.pixels.size(); i += 4) s += ao.pixels[i];
       return s / double(ao.pixels.size() / 4);
     }
   };
-  RenderSettings settingsFor(const Scene& scene, const std::vector<std::string>& sets,
-                             uint32_t w = kW, uint32_t h = kH) {
-    EffectOverrides cli;
-    cli.effects = std::vector<std::string>{"obscurance"};
-    cli.sets = sets;
-    RenderSettings rs;
-    rs.width = w;
-    rs.height = h;
-    rs.effects = resolveEffects(scene, nullptr, cli, registry);
-    return rs;
-  }
   Result render(const Scene& scene, const std::vector<std::string>& sets, uint32_t w = kW,
                 uint32_t h = kH) {
     Renderer r(ctx(), scene, settingsFor(scene, sets, w, h), &registry);
     r.renderFrame();
-    return {r.readTarget("ao"), r.readTarget("depth"), r.camera(), int(w), int(h)};
+    return {{r.readTarget("ao"), r.readTarget("depth"), r.camera(), int(w), int(h)}};
   }
-  EffectRegistry registry;
 };
 
 // ---- closed forms ---------------------------------------------------------------------------
@@ -381,9 +342,10 @@ TEST_F(ObscuranceTest, TransferIsFiniteAndOrderedForEveryAlbedo) {
 TEST_F(ObscuranceTest, RadianceTransferWithoutLightsIsTheAlbedoTransferTimesTheAmbient) {
   const Scene crevice = creviceScene(0.7f);  // no lights: the environment alone
   auto lit = [&](const char* transfer, ImageRGBA32F* ambient) {
-    Renderer r(ctx(), crevice,
-               settingsFor(crevice, {transfer, "obscurance.radius=1", "obscurance.samples=16"}),
-               &registry);
+    Renderer r(
+        ctx(), crevice,
+        settingsFor(crevice, {transfer, "obscurance.radius=1", "obscurance.samples=16"}, kW, kH),
+        &registry);
     r.renderFrame();
     if (ambient) *ambient = r.readTarget("ambient");
     return r.readTarget("lit");
@@ -447,7 +409,8 @@ TEST_F(ObscuranceTest, RadianceTransferBleedsTheColourOfALitWall) {
     ImageRGBA32F ambient, lit;
   };
   auto run = [&](const char* transfer) {
-    Renderer r(ctx(), scene, settingsFor(scene, {transfer, "obscurance.radius=0.5"}), &registry);
+    Renderer r(ctx(), scene, settingsFor(scene, {transfer, "obscurance.radius=0.5"}, kW, kH),
+               &registry);
     r.renderFrame();
     Out out{{}, r.readTarget("lit")};
     if (std::string(transfer).find("radiance") != std::string::npos) {
@@ -465,18 +428,14 @@ TEST_F(ObscuranceTest, RadianceTransferBleedsTheColourOfALitWall) {
     // Having summed the lights, the radiance pass publishes them as "direct_light", as SSDO's
     // bounce does (whose direct_light is tested to be the lighting pass's own sum): the same
     // values, within half-float rounding.
-    Renderer r(ctx(), scene,
-               settingsFor(scene, {"obscurance.transfer=radiance", "obscurance.radius=0.5"}),
-               &registry);
+    Renderer r(
+        ctx(), scene,
+        settingsFor(scene, {"obscurance.transfer=radiance", "obscurance.radius=0.5"}, kW, kH),
+        &registry);
     r.renderFrame();
     const ImageRGBA32F mine = r.readTarget("direct_light");
     ASSERT_TRUE(registry.has("ssdo"));
-    EffectOverrides cli;
-    cli.effects = std::vector<std::string>{"ssdo"};
-    RenderSettings rs;
-    rs.width = kW;
-    rs.height = kH;
-    rs.effects = resolveEffects(scene, nullptr, cli, registry);
+    const RenderSettings rs = settingsFor({"ssdo"}, scene, {}, kW, kH);
     Renderer s(ctx(), scene, rs, &registry);
     s.renderFrame();
     const ImageRGBA32F theirs = s.readTarget("direct_light");
@@ -553,29 +512,6 @@ TEST_F(ObscuranceTest, NoFalseSilhouetteShadowAndNoFilterAcrossDepthEdges) {
   }
 }
 
-// Energy of the 4x4 interleave pattern on the corner's floor (rows are lines of constant
-// distance to the wall): residual of a line fit per row plus second differences of row means.
-double patternEnergy(const auto& r, float minX, float maxX) {
-  double ex = 0.0, ey = 0.0;
-  int nx = 0, ny = 0;
-  std::vector<double> rowMeans;
-  const int x0 = r.w / 2 - 32, x1 = r.w / 2 + 32;
-  for (int y = 0; y < r.h; ++y) {
-    const glm::vec3 c = r.worldAt(r.w / 2, y);
-    if (std::abs(c.y) > 1e-3f || c.x < minX || c.x > maxX) continue;
-    double sx = 0, sy = 0, sxx = 0, sxy = 0;
-    const int n = x1 - x0;
-    for (int x = x0; x < x1; ++x)
-      sx += x, sy += r.at(x, y), sxx += double(x) * x, sxy += double(x) * r.at(x, y);
-    const double slope = (n * sxy - sx * sy) / (n * sxx - sx * sx), icept = (sy - slope * sx) / n;
-    for (int x = x0; x < x1; ++x, ++nx) ex += std::pow(r.at(x, y) - (icept + slope * x), 2);
-    rowMeans.push_back(sy / n);
-  }
-  for (size_t i = 1; i + 1 < rowMeans.size(); ++i, ++ny)
-    ey += std::pow(rowMeans[i] - 0.5 * (rowMeans[i - 1] + rowMeans[i + 1]), 2);
-  return (nx ? ex / nx : 0.0) + (ny ? ey / ny : 0.0);
-}
-
 TEST_F(ObscuranceTest, FilterRemovesTheInterleavePattern) {
   for (const char* t : {"obscurance.transfer=off", "obscurance.transfer=albedo"}) {
     auto with = [&](const char* filter) {
@@ -622,8 +558,8 @@ TEST_F(ObscuranceTest, NoNaNAtGrazingAnglesExtremeClipPlanesOrSky) {
     }
   }  // transfer = radiance publishes "ambient": finite and non-negative there too, sky untouched.
   for (const char* radius : {"obscurance.radius=1e-4", "obscurance.radius=1e4"}) {
-    Renderer r(ctx(), grazing, settingsFor(grazing, {radius, "obscurance.transfer=radiance"}),
-               &registry);
+    Renderer r(ctx(), grazing,
+               settingsFor(grazing, {radius, "obscurance.transfer=radiance"}, kW, kH), &registry);
     r.renderFrame();
     const ImageRGBA32F ambient = r.readTarget("ambient"), depth = r.readTarget("depth");
     ASSERT_TRUE(finite(ambient)) << radius;
@@ -640,7 +576,7 @@ TEST_F(ObscuranceTest, NoNaNAtGrazingAnglesExtremeClipPlanesOrSky) {
 
 TEST_F(ObscuranceTest, PassListAndLiveSettings) {
   Scene scene = cornerScene();
-  RenderSettings rs = settingsFor(scene, {});
+  RenderSettings rs = settingsFor(scene, {}, kW, kH);
   Renderer r(ctx(), scene, rs, &registry);
   r.renderFrame();
   EXPECT_EQ(r.passNames(), (std::vector<std::string>{"gbuffer", "obscurance", "obscurance_filter",

@@ -12,11 +12,9 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "../effects/ssao/ssao_kernel.h"
-#include "gi/effect_config.h"
+#include "effect_fixture.h"
 #include "gi/renderer.h"
 #include "quad_scene.h"
-#include "test_support.h"
-#include "vulkan_fixture.h"
 
 namespace gi {
 namespace {
@@ -27,49 +25,21 @@ using test::cornerLinePixels;
 using test::cornerQuads;
 using test::cornerScene;
 using test::finite;
+using test::patternEnergy;
 using test::Quads;
 using test::quadScene;
 
-class SsaoTest : public test::VulkanTest {
+using Result = test::AoFrame;
+
+class SsaoTest : public test::EffectTest {
  protected:
-  void SetUp() override {
-    VulkanTest::SetUp();
-    registry.scanDirectory(test::binPath("plugins"));
-    ASSERT_TRUE(registry.has("ssao")) << "ssao plugin missing from " << test::binPath("plugins");
-  }
-  struct Result {
-    ImageRGBA32F ao, depth;
-    CameraView camera;
-    int w = 0, h = 0;
-    float at(int x, int y) const { return ao.pixels[(size_t(y) * w + x) * 4]; }
-    float depthAt(int x, int y) const { return depth.pixels[(size_t(y) * w + x) * 4]; }
-    glm::vec3 viewAt(int x, int y) const {  // view-space position of the pixel's centre
-      glm::vec4 v = glm::inverse(camera.proj) *
-                    glm::vec4((x + 0.5f) / w * 2 - 1, (y + 0.5f) / h * 2 - 1, depthAt(x, y), 1.0f);
-      return glm::vec3(v) / v.w;
-    }
-    glm::vec3 worldAt(int x, int y) const {
-      return glm::vec3(glm::inverse(camera.view) * glm::vec4(viewAt(x, y), 1.0f));
-    }
-  };
-  RenderSettings settingsFor(const Scene& scene, const std::vector<std::string>& sets,
-                             uint32_t w = kW, uint32_t h = kH) {
-    EffectOverrides cli;
-    cli.effects = std::vector<std::string>{"ssao"};
-    cli.sets = sets;
-    RenderSettings rs;
-    rs.width = w;
-    rs.height = h;
-    rs.effects = resolveEffects(scene, nullptr, cli, registry);
-    return rs;
-  }
+  std::string effectName() const override { return "ssao"; }
   Result render(const Scene& scene, const std::vector<std::string>& sets, uint32_t w = kW,
                 uint32_t h = kH) {
     Renderer r(ctx(), scene, settingsFor(scene, sets, w, h), &registry);
     r.renderFrame();
     return {r.readTarget("ao"), r.readTarget("depth"), r.camera(), int(w), int(h)};
   }
-  EffectRegistry registry;
 };
 
 // ---- the estimator on the CPU ---------------------------------------------------------------
@@ -303,32 +273,6 @@ TEST_F(SsaoTest, NoNaNAtGrazingAnglesOrExtremeClipPlanes) {
   EXPECT_GT(sum / floorPixels, 0.995);  // 1.0 measured; 0.986 without the slide
 }
 
-// Energy of the 4x4 interleave pattern on the corner's floor, insensitive to the AO's smooth
-// variation: this camera has no roll and looks along -x, so image rows are lines of constant
-// distance to the wall. Along x: residual from a straight-line fit per row; along y: second
-// differences of the row means (a linear trend cancels).
-double patternEnergy(const auto& r, float minX, float maxX) {
-  double ex = 0.0, ey = 0.0;
-  int nx = 0, ny = 0;
-  std::vector<double> rowMeans;
-  const int x0 = r.w / 2 - 32, x1 = r.w / 2 + 32;
-  for (int y = 0; y < r.h; ++y) {
-    const glm::vec3 c = r.worldAt(r.w / 2, y);
-    if (std::abs(c.y) > 1e-3f || c.x < minX || c.x > maxX) continue;
-    double sx = 0, sy = 0, sxx = 0, sxy = 0;
-    const int n = x1 - x0;
-    for (int x = x0; x < x1; ++x) {
-      sx += x, sy += r.at(x, y), sxx += double(x) * x, sxy += double(x) * r.at(x, y);
-    }
-    const double slope = (n * sxy - sx * sy) / (n * sxx - sx * sx), icept = (sy - slope * sx) / n;
-    for (int x = x0; x < x1; ++x, ++nx) ex += std::pow(r.at(x, y) - (icept + slope * x), 2);
-    rowMeans.push_back(sy / n);
-  }
-  for (size_t i = 1; i + 1 < rowMeans.size(); ++i, ++ny)
-    ey += std::pow(rowMeans[i] - 0.5 * (rowMeans[i - 1] + rowMeans[i + 1]), 2);
-  return (nx ? ex / nx : 0.0) + (ny ? ey / ny : 0.0);
-}
-
 TEST_F(SsaoTest, BlurRemovesTheInterleavePattern) {
   auto with = [&](const char* blur) {
     return render(cornerScene(),
@@ -390,7 +334,7 @@ TEST_F(SsaoTest, NoHaloAcrossDepthDiscontinuities) {
 
 TEST_F(SsaoTest, SsaoOnlyPassList) {
   Scene scene = cornerScene();  // no lights: no shadow pass
-  Renderer r(ctx(), scene, settingsFor(scene, {}), &registry);
+  Renderer r(ctx(), scene, settingsFor(scene, {}, kW, kH), &registry);
   r.renderFrame();
   EXPECT_EQ(r.passNames(),
             (std::vector<std::string>{"gbuffer", "ssao", "ssao_blur", "lighting", "tonemap"}));
@@ -398,7 +342,7 @@ TEST_F(SsaoTest, SsaoOnlyPassList) {
 
 TEST_F(SsaoTest, DebugViewRunsOnlyWhatFeedsIt) {
   Scene scene = cornerScene();
-  RenderSettings rs = settingsFor(scene, {});
+  RenderSettings rs = settingsFor(scene, {}, kW, kH);
   rs.view = registry.info("ssao").debugView;
   Renderer r(ctx(), scene, rs, &registry);
   r.renderFrame();
@@ -407,7 +351,7 @@ TEST_F(SsaoTest, DebugViewRunsOnlyWhatFeedsIt) {
 
 TEST_F(SsaoTest, BlurRadiusZeroDropsThePassAndSettingsApplyLive) {
   Scene scene = cornerScene();
-  RenderSettings rs = settingsFor(scene, {"ssao.blur_radius=0"});
+  RenderSettings rs = settingsFor(scene, {"ssao.blur_radius=0"}, kW, kH);
   rs.view = "ao";
   Renderer r(ctx(), scene, rs, &registry);
   r.renderFrame();
