@@ -16,11 +16,9 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "../effects/alchemy/alchemy_kernel.h"
-#include "gi/effect_config.h"
+#include "effect_fixture.h"
 #include "gi/renderer.h"
 #include "quad_scene.h"
-#include "test_support.h"
-#include "vulkan_fixture.h"
 
 namespace gi {
 namespace {
@@ -35,52 +33,19 @@ using test::quadScene;
 const glm::mat4 kFloor = test::floorTransform();
 const glm::mat4 kWall = glm::rotate(glm::mat4(1.0f), glm::radians(90.0f), glm::vec3(0, 1, 0));
 
-class AlchemyTest : public test::VulkanTest {
+class AlchemyTest : public test::EffectTest {
  protected:
-  void SetUp() override {
-    VulkanTest::SetUp();
-    registry.scanDirectory(test::binPath("plugins"));
-    ASSERT_TRUE(registry.has("alchemy"))
-        << "alchemy plugin missing from " << test::binPath("plugins");
-  }
-  struct Result {
-    ImageRGBA32F ao, depth, normal;
-    CameraView camera;
-    int w = 0, h = 0;
-    float at(int x, int y) const { return ao.pixels[(size_t(y) * w + x) * 4]; }
-    float depthAt(int x, int y) const { return depth.pixels[(size_t(y) * w + x) * 4]; }
-    glm::vec3 worldAt(int x, int y) const {
-      glm::vec4 v = glm::inverse(camera.proj) *
-                    glm::vec4((x + 0.5f) / w * 2 - 1, (y + 0.5f) / h * 2 - 1, depthAt(x, y), 1.0f);
-      return glm::vec3(glm::inverse(camera.view) * glm::vec4(glm::vec3(v) / v.w, 1.0f));
-    }
+  std::string effectName() const override { return "alchemy"; }
+  struct Result : test::AoFrame {
+    ImageRGBA32F normal;
   };
-  RenderSettings settingsFor(const Scene& scene, const std::vector<std::string>& sets,
-                             uint32_t w = kW, uint32_t h = kH) {
-    EffectOverrides cli;
-    cli.effects = std::vector<std::string>{"alchemy"};
-    cli.sets = sets;
-    RenderSettings rs;
-    rs.width = w;
-    rs.height = h;
-    rs.effects = resolveEffects(scene, nullptr, cli, registry);
-    return rs;
-  }
-  static Result read(Renderer& r, uint32_t w, uint32_t h) {
-    return {r.readTarget("ao"),
-            r.readTarget("depth"),
-            r.readTarget("normal"),
-            r.camera(),
-            int(w),
-            int(h)};
-  }
   Result render(const Scene& scene, const std::vector<std::string>& sets, uint32_t w = kW,
                 uint32_t h = kH) {
     Renderer r(ctx(), scene, settingsFor(scene, sets, w, h), &registry);
     r.renderFrame();
-    return read(r, w, h);
+    return {{r.readTarget("ao"), r.readTarget("depth"), r.camera(), int(w), int(h)},
+            r.readTarget("normal")};
   }
-  EffectRegistry registry;
 };
 
 TEST_F(AlchemyTest, PlaneGivesOne) {
@@ -146,7 +111,7 @@ TEST_F(AlchemyTest, MonotoneInIntensityContrastAndEpsilon) {
   // Documented directions: higher intensity sigma and higher contrast k darken (AO never
   // rises), higher epsilon lightens. Uniform-only settings: one renderer, one depth buffer.
   Scene scene = cornerScene();
-  RenderSettings rs = settingsFor(scene, {"alchemy.blur_radius=0"});
+  RenderSettings rs = settingsFor(scene, {"alchemy.blur_radius=0"}, kW, kH);
   rs.view = "ao";
   Renderer r(ctx(), scene, rs, &registry);
   auto sweep = [&](const char* key, const std::vector<double>& values, bool darker) {
@@ -305,12 +270,12 @@ TEST_F(AlchemyTest, NoNaNAtGrazingAnglesExtremeClipPlanesAndSky) {
 TEST_F(AlchemyTest, PassesAndLiveSettings) {
   Scene scene = cornerScene();  // no lights: no shadow pass
   {
-    Renderer r(ctx(), scene, settingsFor(scene, {}), &registry);
+    Renderer r(ctx(), scene, settingsFor(scene, {}, kW, kH), &registry);
     r.renderFrame();
     EXPECT_EQ(r.passNames(), (std::vector<std::string>{"gbuffer", "alchemy", "alchemy_blur",
                                                        "lighting", "tonemap"}));
   }
-  RenderSettings rs = settingsFor(scene, {"alchemy.blur_radius=0"});
+  RenderSettings rs = settingsFor(scene, {"alchemy.blur_radius=0"}, kW, kH);
   rs.view = "ao";
   Renderer r(ctx(), scene, rs, &registry);
   r.renderFrame();

@@ -11,27 +11,19 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "gi/effect_config.h"
+#include "effect_fixture.h"
 #include "gi/reference/reference.h"
 #include "gi/renderer.h"
 #include "quad_scene.h"
-#include "test_support.h"
-#include "vulkan_fixture.h"
 
 namespace gi {
 namespace {
 
 namespace ref = gi::reference;
 
-class AlchemyReference : public test::VulkanTest {
+class AlchemyReference : public test::EffectTest {
  protected:
-  void SetUp() override {
-    VulkanTest::SetUp();
-    registry.scanDirectory(test::binPath("plugins"));
-    ASSERT_TRUE(registry.has("alchemy"))
-        << "alchemy plugin missing from " << test::binPath("plugins");
-  }
-  EffectRegistry registry;
+  std::string effectName() const override { return "alchemy"; }
 };
 
 // RMS difference over the pixels where both images hold geometry, over the mean of `b` there.
@@ -60,14 +52,10 @@ TEST_F(AlchemyReference, PluginConvergesToTheScreenDiskIntegral) {
                    0.3f});
   const Scene scene = test::quadScene(quads, glm::vec3(2.5f, 1.6f, 0.0f), glm::vec3(0.0f));
   const uint32_t W = 128, H = 96;
-  EffectOverrides cli;
-  cli.effects = std::vector<std::string>{"alchemy"};
-  cli.sets = {"alchemy.samples=64", "alchemy.blur_radius=0", "alchemy.guard_band=48",
-              "alchemy.intensity=0.5"};
-  RenderSettings rs;
-  rs.width = W;
-  rs.height = H;
-  rs.effects = resolveEffects(scene, nullptr, cli, registry);
+  const RenderSettings rs = settingsFor(scene,
+                                        {"alchemy.samples=64", "alchemy.blur_radius=0",
+                                         "alchemy.guard_band=48", "alchemy.intensity=0.5"},
+                                        W, H);
   Renderer renderer(ctx(), scene, rs, &registry);
   renderer.renderFrame();
   const ImageRGBA32F ao = renderer.readTarget("ao"), depth = renderer.readTarget("depth");
