@@ -15,11 +15,10 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "../effects/gtao/gtao_params.h"
-#include "gi/effect_config.h"
+#include "effect_fixture.h"
 #include "gi/renderer.h"
 #include "quad_scene.h"
 #include "test_support.h"
-#include "vulkan_fixture.h"
 
 namespace gi {
 namespace {
@@ -178,31 +177,14 @@ TEST(HbaoCornerIntegral, FromStraightAboveItIsTheClosedForm) {
   }
 }
 
-class HorizonAoTest : public test::VulkanTest {
+// Frames of hbao or gtao (HbaoTest, GtaoTest; HorizonAoTest: both, as its parameter).
+class HorizonAoFixture : public test::EffectTest {
  protected:
-  void SetUp() override {
-    VulkanTest::SetUp();
-    registry.scanDirectory(test::binPath("plugins"));
-    for (const char* e : {"hbao", "gtao", "ssao"})
-      ASSERT_TRUE(registry.has(e)) << e << " plugin missing from " << test::binPath("plugins");
-  }
-  struct Result {
-    ImageRGBA32F ao, depth, extra;
-    CameraView camera;
-    int w = 0, h = 0;
-    float at(int x, int y) const { return ao.pixels[(size_t(y) * w + x) * 4]; }
-    float depthAt(int x, int y) const { return depth.pixels[(size_t(y) * w + x) * 4]; }
+  struct Result : test::AoFrame {
+    ImageRGBA32F extra;
     glm::vec4 extraAt(int x, int y) const {
       const float* p = &extra.pixels[(size_t(y) * w + x) * 4];
       return {p[0], p[1], p[2], p[3]};
-    }
-    glm::vec3 viewAt(int x, int y) const {  // view-space position of the pixel's centre
-      glm::vec4 v = glm::inverse(camera.proj) *
-                    glm::vec4((x + 0.5f) / w * 2 - 1, (y + 0.5f) / h * 2 - 1, depthAt(x, y), 1.0f);
-      return glm::vec3(v) / v.w;
-    }
-    glm::vec3 worldAt(int x, int y) const {
-      return glm::vec3(glm::inverse(camera.view) * glm::vec4(viewAt(x, y), 1.0f));
     }
     // Mean AO over the floor pixels nearest to the line x = d of the corner scene.
     double meanOnLine(float d) const {
@@ -220,42 +202,63 @@ class HorizonAoTest : public test::VulkanTest {
       return pixels.empty() ? -1.0 : sum / pixels.size();
     }
   };
-  RenderSettings settingsFor(const std::string& effect, const Scene& scene,
-                             const std::vector<std::string>& sets) {
-    EffectOverrides cli;
-    cli.effects = std::vector<std::string>{effect};
-    cli.sets = sets;
-    RenderSettings rs;
-    rs.width = kW;
-    rs.height = kH;
-    rs.effects = resolveEffects(scene, nullptr, cli, registry);
-    return rs;
-  }
-  Result render(const std::string& effect, const Scene& scene, const std::vector<std::string>& sets,
-                const std::string& extra = "") {
-    Renderer r(ctx(), scene, settingsFor(effect, scene, sets), &registry);
+  // One frame of `settings`; `extra` (an image name) is read too when given.
+  Result frame(const Scene& scene, const RenderSettings& settings, const std::string& extra = "") {
+    Renderer r(ctx(), scene, settings, &registry);
     r.renderFrame();
-    Result out{r.readTarget("ao"), r.readTarget("depth"), {}, r.camera(), int(kW), int(kH)};
+    Result out{{r.readTarget("ao"), r.readTarget("depth"), r.camera(), int(kW), int(kH)}, {}};
     if (!extra.empty()) out.extra = r.readTarget(extra);
     return out;
   }
-  EffectRegistry registry;
+  Result render(const Scene& scene, const std::vector<std::string>& sets,
+                const std::string& extra = "") {
+    return frame(scene, settingsFor(scene, sets, kW, kH), extra);
+  }
+  // The passes of a frame whose view is "ao".
+  std::vector<std::string> passes(const Scene& scene, const std::vector<std::string>& sets) {
+    RenderSettings rs = settingsFor(scene, sets, kW, kH);
+    rs.view = "ao";
+    Renderer r(ctx(), scene, rs, &registry);
+    r.renderFrame();
+    return r.passNames();
+  }
 };
 
-TEST_F(HorizonAoTest, PlaneIsOpen) {
+class HbaoTest : public HorizonAoFixture {
+ protected:
+  std::string effectName() const override { return "hbao"; }
+};
+
+class GtaoTest : public HorizonAoFixture {
+ protected:
+  std::string effectName() const override { return "gtao"; }
+};
+
+class HorizonAoTest : public HorizonAoFixture, public ::testing::WithParamInterface<std::string> {
+ protected:
+  std::string effectName() const override { return GetParam(); }
+  // The effect's variants the tests cover: gtao also at half (and quarter) resolution.
+  std::vector<std::string> variants(bool quarter) const {
+    if (GetParam() != "gtao") return {GetParam()};
+    if (quarter) return {"gtao", "gtao half", "gtao quarter"};
+    return {"gtao", "gtao half"};
+  }
+};
+
+TEST_P(HorizonAoTest, PlaneIsOpen) {
   // Head-on and oblique (the floor runs to the horizon: grazing far pixels).
   const Scene headOn = quadScene({{glm::mat4(1.0f), 1.0f}}, glm::vec3(0, 0, 5), glm::vec3(0));
   const Scene oblique =
       quadScene({{test::floorTransform(), 20.0f}}, glm::vec3(0, 1.5f, 3), glm::vec3(0, 0, -2));
   for (const Scene* s : {&headOn, &oblique})
-    for (const char* effect : {"hbao", "gtao", "gtao half"})
+    for (const std::string& effect : variants(false))
       for (const char* blur : {"blur_radius=0", "blur_radius=2"}) {
         // "gtao half": at half resolution, upsampled (downsample 2).
-        const bool half = std::string(effect) == "gtao half";
-        const std::string e = half ? "gtao" : effect, b = e + "." + blur;
+        const bool half = effect == "gtao half";
+        const std::string e = effectName(), b = e + "." + blur;
         std::vector<std::string> sets = {e + ".radius=0.5", b};
         if (half) sets.push_back("gtao.downsample=2");
-        Result r = render(e, *s, sets);
+        Result r = render(*s, sets);
         ASSERT_TRUE(finite(r.ao)) << b;
         int sky = 0, geometry = 0;
         float lowest = 1.0f;
@@ -277,14 +280,14 @@ TEST_F(HorizonAoTest, PlaneIsOpen) {
       }
 }
 
-TEST_F(HorizonAoTest, GtaoCornerMatchesTheClosedForm) {
+TEST_F(GtaoTest, CornerMatchesTheClosedForm) {
   // Hard cut-off at R (falloff 0) as the closed form; 4 slices x 8 steps, interleaved and
   // blurred (64 slice rotations averaged). Screen-space horizons are found at discrete samples,
   // so they can only be lower than the true ones: AO errs high. Tolerance: within [-0.01,
   // +0.03] of the closed form at every distance (measured +0.000 .. +0.017); beyond R, open.
   const float R = 0.5f;
-  Result r = render("gtao", cornerScene(),
-                    {"gtao.radius=0.5", "gtao.falloff=0", "gtao.slices=4", "gtao.steps=8"});
+  Result r =
+      render(cornerScene(), {"gtao.radius=0.5", "gtao.falloff=0", "gtao.slices=4", "gtao.steps=8"});
   ASSERT_TRUE(finite(r.ao));
   for (float d : {0.05f, 0.1f, 0.2f, 0.3f, 0.4f, 0.7f}) {
     const double rendered = r.meanOnLine(d), expected = r.closedFormOnLine(d, R);
@@ -297,7 +300,7 @@ TEST_F(HorizonAoTest, GtaoCornerMatchesTheClosedForm) {
   EXPECT_LT(r.meanOnLine(0.05f), 0.65) << "near the crease AO tends to 1/2";
 }
 
-TEST_F(HorizonAoTest, GtaoAtHalfResolutionMatchesTheClosedFormAndTheFullResolution) {
+TEST_F(GtaoTest, AtHalfResolutionMatchesTheClosedFormAndTheFullResolution) {
   // The corner test's setting at downsample 2 (a quarter of the pixels, each standing for a 2x2
   // block; blurred there, upsampled by the engine's depth-aware upsample). Tolerance: within
   // [-0.02, +0.06] of the closed form at every distance (measured -0.015 .. +0.053). Looser
@@ -312,7 +315,7 @@ TEST_F(HorizonAoTest, GtaoAtHalfResolutionMatchesTheClosedFormAndTheFullResoluti
                                          "gtao.steps=8"};
   std::vector<std::string> halfSets = sets;
   halfSets.push_back("gtao.downsample=2");
-  Result full = render("gtao", cornerScene(), sets), half = render("gtao", cornerScene(), halfSets);
+  Result full = render(cornerScene(), sets), half = render(cornerScene(), halfSets);
   ASSERT_TRUE(finite(half.ao));
   for (float d : {0.05f, 0.1f, 0.2f, 0.3f, 0.4f, 0.7f}) {
     const double rendered = half.meanOnLine(d), expected = half.closedFormOnLine(d, R);
@@ -337,15 +340,17 @@ TEST_F(HorizonAoTest, GtaoAtHalfResolutionMatchesTheClosedFormAndTheFullResoluti
   EXPECT_LT(worst, 0.15);
 }
 
-TEST_F(HorizonAoTest, GtaoBeatsSsaoAtEqualTapCount) {
+TEST_F(GtaoTest, BeatsSsaoAtEqualTapCount) {
   // 16 depth taps per pixel each: GTAO 2 slices x 2 sides x 4 steps, SSAO 16 samples; both at
   // their defaults otherwise (interleaved, blur radius 2). Error: mean |AO - closed form| over
   // the corner lines x = 0.05 .. 0.4 (SSAO estimates obscurance with a linear falloff, not the
   // cosine-weighted AO, so its error has a bias term GTAO does not).
   const float R = 0.5f;
   const Scene scene = cornerScene();
-  Result g = render("gtao", scene, {"gtao.radius=0.5", "gtao.slices=2", "gtao.steps=4"});
-  Result s = render("ssao", scene, {"ssao.radius=0.5", "ssao.samples=16"});
+  ASSERT_TRUE(registry.has("ssao")) << "ssao plugin missing from " << test::binPath("plugins");
+  Result g = render(scene, {"gtao.radius=0.5", "gtao.slices=2", "gtao.steps=4"});
+  Result s =
+      frame(scene, settingsFor({"ssao"}, scene, {"ssao.radius=0.5", "ssao.samples=16"}, kW, kH));
   double errG = 0.0, errS = 0.0;
   int n = 0;
   for (float d : {0.05f, 0.1f, 0.2f, 0.3f, 0.4f}) {
@@ -358,7 +363,7 @@ TEST_F(HorizonAoTest, GtaoBeatsSsaoAtEqualTapCount) {
   EXPECT_LT(errG / n, 0.04);  // measured 0.024
 }
 
-TEST_F(HorizonAoTest, HbaoCornerMatchesItsOwnQuantity) {
+TEST_F(HbaoTest, CornerMatchesItsOwnQuantity) {
   // HBAO's quantity is view-dependent (elevations from the image plane), so its reference is
   // the CPU integral above for this camera, per pixel at the pixel's own floor point, averaged
   // over the same pixels (hbaoCornerIntegral; checked against a closed form from straight
@@ -366,9 +371,8 @@ TEST_F(HorizonAoTest, HbaoCornerMatchesItsOwnQuantity) {
   // (256 rotations averaged). Tolerance 0.03 at every distance (measured 0.003 .. 0.016, the
   // largest near the crease, 1-2 pixels away); beyond R, open.
   const double R = 0.5;
-  Result r =
-      render("hbao", cornerScene(),
-             {"hbao.radius=0.5", "hbao.angle_bias=0", "hbao.directions=16", "hbao.steps=16"});
+  Result r = render(cornerScene(), {"hbao.radius=0.5", "hbao.angle_bias=0", "hbao.directions=16",
+                                    "hbao.steps=16"});
   ASSERT_TRUE(finite(r.ao));
   const HbaoSliceView view{glm::dmat4(r.camera.view), glm::dmat4(r.camera.proj), double(r.w),
                            double(r.h)};
@@ -393,13 +397,13 @@ TEST_F(HorizonAoTest, HbaoCornerMatchesItsOwnQuantity) {
   EXPECT_GE(r.meanOnLine(0.8f), 0.999) << "no occluder within R";
 }
 
-TEST_F(HorizonAoTest, MultiBounceRaisesAOWithAlbedoAndKeepsItAtAlbedoZero) {
+TEST_F(GtaoTest, MultiBounceRaisesAOWithAlbedoAndKeepsItAtAlbedoZero) {
   for (float albedo : {0.0f, 0.8f}) {
     Scene scene = cornerScene();
     scene.materials[0].baseColor = glm::vec4(albedo, albedo, albedo, 1.0f);
     // No blur: the fit is per pixel, and the blur would average it with neighbours.
-    Result off = render("gtao", scene, {"gtao.blur_radius=0", "gtao.multi_bounce=false"});
-    Result on = render("gtao", scene, {"gtao.blur_radius=0", "gtao.multi_bounce=true"});
+    Result off = render(scene, {"gtao.blur_radius=0", "gtao.multi_bounce=false"});
+    Result on = render(scene, {"gtao.blur_radius=0", "gtao.multi_bounce=true"});
     ASSERT_TRUE(finite(on.ao));
     double raised = 0.0, worst = 0.0;
     int occluded = 0;
@@ -425,8 +429,8 @@ TEST_F(HorizonAoTest, MultiBounceRaisesAOWithAlbedoAndKeepsItAtAlbedoZero) {
   }
 }
 
-TEST_F(HorizonAoTest, BentNormalsPointAwayFromTheWall) {
-  Result r = render("gtao", cornerScene(), {"gtao.bent_normals=true"}, "gtao_bent_normal");
+TEST_F(GtaoTest, BentNormalsPointAwayFromTheWall) {
+  Result r = render(cornerScene(), {"gtao.bent_normals=true"}, "gtao_bent_normal");
   ASSERT_TRUE(finite(r.extra));
   const glm::mat3 toWorld = glm::mat3(glm::inverse(r.camera.view));
   auto worldBent = [&](glm::ivec2 p) { return toWorld * glm::vec3(r.extraAt(p.x, p.y)); };
@@ -463,16 +467,16 @@ TEST_F(HorizonAoTest, BentNormalsPointAwayFromTheWall) {
   EXPECT_GT(dotSum / n, 0.99);
 }
 
-TEST_F(HorizonAoTest, NoNaNAtGrazingAnglesExtremeClipPlanesOrSky) {
+TEST_P(HorizonAoTest, NoNaNAtGrazingAnglesExtremeClipPlanesOrSky) {
   // Camera skimming a huge plane, near 1e-4, far 1e5; the floor's view normal is exactly +y.
   const Scene grazing = quadScene({{test::floorTransform(), 1000.0f}}, glm::vec3(0, 0.01f, 0),
                                   glm::vec3(0, 0.01f, -10), 1.0f, 1e-4f, 1e5f);
   const Scene corner =
       quadScene(test::cornerQuads(), glm::vec3(2.5f, 1.6f, 0.0f), glm::vec3(0), 1.0f, 1e-4f, 1e5f);
-  for (const char* effect : {"hbao", "gtao", "gtao half", "gtao quarter"})
+  for (const std::string& name : variants(true))
     for (const char* radius : {"radius=0.5", "radius=1e-4", "radius=1e4"})
       for (const Scene* s : {&grazing, &corner}) {
-        const std::string name = effect, e = name.substr(0, 4), rs = name + "." + radius;
+        const std::string e = effectName(), rs = name + "." + radius;
         std::vector<std::string> sets = {e + "." + radius};
         if (e == "gtao")
           sets.insert(sets.end(),
@@ -481,7 +485,7 @@ TEST_F(HorizonAoTest, NoNaNAtGrazingAnglesExtremeClipPlanesOrSky) {
         if (name == "gtao half") sets.push_back("gtao.downsample=2");
         if (name == "gtao quarter")
           sets.insert(sets.end(), {"gtao.downsample=4", "gtao.blur_radius=0"});
-        Result r = render(e, *s, sets, e == "gtao" ? "gtao_bent_normal" : "");
+        Result r = render(*s, sets, e == "gtao" ? "gtao_bent_normal" : "");
         ASSERT_TRUE(finite(r.ao)) << rs;
         if (e == "gtao") {
           ASSERT_TRUE(finite(r.extra)) << rs << " bent normal";
@@ -509,34 +513,35 @@ TEST_F(HorizonAoTest, NoNaNAtGrazingAnglesExtremeClipPlanesOrSky) {
       }
 }
 
-TEST_F(HorizonAoTest, PassListsAndTheUnusedBentNormal) {
+TEST_F(HbaoTest, PassLists) {
   const Scene scene = cornerScene();
-  auto passes = [&](const std::string& effect, const std::vector<std::string>& sets) {
-    RenderSettings rs = settingsFor(effect, scene, sets);
-    rs.view = "ao";
-    Renderer r(ctx(), scene, rs, &registry);
-    r.renderFrame();
-    return r.passNames();
-  };
   using V = std::vector<std::string>;
-  EXPECT_EQ(passes("hbao", {}), (V{"gbuffer", "hbao", "hbao_blur"}));
-  EXPECT_EQ(passes("hbao", {"hbao.blur_radius=0"}), (V{"gbuffer", "hbao"}));
-  EXPECT_EQ(passes("gtao", {}), (V{"gbuffer", "gtao", "gtao_blur"}));
-  EXPECT_EQ(passes("gtao", {"gtao.blur_radius=0", "gtao.bent_normals=true"}),
+  EXPECT_EQ(passes(scene, {}), (V{"gbuffer", "hbao", "hbao_blur"}));
+  EXPECT_EQ(passes(scene, {"hbao.blur_radius=0"}), (V{"gbuffer", "hbao"}));
+}
+
+TEST_F(GtaoTest, PassListsAndTheUnusedBentNormal) {
+  const Scene scene = cornerScene();
+  using V = std::vector<std::string>;
+  EXPECT_EQ(passes(scene, {}), (V{"gbuffer", "gtao", "gtao_blur"}));
+  EXPECT_EQ(passes(scene, {"gtao.blur_radius=0", "gtao.bent_normals=true"}),
             (V{"gbuffer", "gtao"}));
   // At a reduced resolution the engine's blur upsamples; without the blur only that runs.
-  EXPECT_EQ(passes("gtao", {"gtao.downsample=2"}),
+  EXPECT_EQ(passes(scene, {"gtao.downsample=2"}),
             (V{"gbuffer", "gtao", "gtao_blur", "gtao_blur_upsample"}));
-  EXPECT_EQ(passes("gtao", {"gtao.downsample=2", "gtao.blur_radius=0"}),
+  EXPECT_EQ(passes(scene, {"gtao.downsample=2", "gtao.blur_radius=0"}),
             (V{"gbuffer", "gtao", "gtao_blur_upsample"}));
   // Off, "gtao_bent_normal" is the G-buffer normal itself.
-  RenderSettings keep = settingsFor("gtao", scene, {});
+  RenderSettings keep = settingsFor(scene, {}, kW, kH);
   keep.keepForReadback = {"gtao_bent_normal", "normal"};  // nothing in the frame reads them
   Renderer r(ctx(), scene, keep, &registry);
   r.renderFrame();
   const ImageRGBA32F bent = r.readTarget("gtao_bent_normal"), normal = r.readTarget("normal");
   EXPECT_EQ(bent.pixels, normal.pixels);
 }
+
+INSTANTIATE_TEST_SUITE_P(HorizonAo, HorizonAoTest, ::testing::Values("hbao", "gtao"),
+                         [](const auto& info) { return info.param; });
 
 }  // namespace
 }  // namespace gi
