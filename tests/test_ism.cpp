@@ -21,7 +21,6 @@
 
 #include "../effects/ism/ism_params.h"
 #include "effect_fixture.h"
-#include "gi/effect_config.h"
 #include "gi/renderer.h"
 #include "gi/scene_io.h"
 #include "test_support.h"
@@ -190,13 +189,8 @@ class IsmTest : public test::EffectTest {
   };
   Result render(const Scene& scene, const std::vector<std::string>& sets, int frames = 1,
                 bool withIsm = true, double time = 0.0) {
-    EffectOverrides cli;
-    cli.effects = withIsm ? std::vector<std::string>{"ism"} : std::vector<std::string>{};
-    cli.sets = sets;
-    RenderSettings rs;
-    rs.width = kW;
-    rs.height = kH;
-    rs.effects = resolveEffects(scene, nullptr, cli, registry);
+    const RenderSettings rs =
+        withIsm ? settingsFor(scene, sets, kW, kH) : settingsFor({}, scene, sets, kW, kH);
     Renderer r(ctx(), scene, rs, &registry);
     r.setTime(time);
     for (int i = 0; i < frames; ++i) r.renderFrame();

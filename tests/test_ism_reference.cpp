@@ -7,12 +7,10 @@
 #include <cstdio>
 #include <fstream>
 
-#include "gi/effect_config.h"
+#include "effect_fixture.h"
 #include "gi/reference/reference.h"
 #include "gi/renderer.h"
 #include "gi/scene_io.h"
-#include "test_support.h"
-#include "vulkan_fixture.h"
 
 namespace gi {
 namespace {
@@ -20,23 +18,13 @@ namespace {
 namespace ref = gi::reference;
 constexpr uint32_t kW = 160, kH = 120;
 
-class IsmReference : public test::VulkanTest {
+class IsmReference : public test::EffectTest {
  protected:
-  void SetUp() override {
-    VulkanTest::SetUp();
-    registry.scanDirectory(test::binPath("plugins"));
-    ASSERT_TRUE(registry.has("ism"));
-  }
+  std::string effectName() const override { return "ism"; }
+  // The lit image of the second frame with `effects` ({"ism"} or none).
   ImageRGBA32F lit(const Scene& scene, const std::vector<std::string>& effects,
                    const std::vector<std::string>& sets) {
-    EffectOverrides cli;
-    cli.effects = effects;
-    cli.sets = sets;
-    RenderSettings rs;
-    rs.width = kW;
-    rs.height = kH;
-    rs.effects = resolveEffects(scene, nullptr, cli, registry);
-    Renderer r(ctx(), scene, rs, &registry);
+    Renderer r(ctx(), scene, settingsFor(effects, scene, sets, kW, kH), &registry);
     r.renderFrame();
     r.renderFrame();
     return r.readTarget("lit");
@@ -69,7 +57,6 @@ class IsmReference : public test::VulkanTest {
     }
     return n > 0 ? sum / (3.0 * double(n)) : 0.0;
   }
-  EffectRegistry registry;
 };
 
 // The reference without emitter light (ref::Settings::emitterLight): the Cornell box's lamp is
