@@ -14,7 +14,7 @@
 #include <string>
 
 #include "../effects/ssdo/ssdo_samples.h"
-#include "gi/effect_config.h"
+#include "effect_fixture.h"
 #include "gi/environment.h"
 #include "gi/errors.h"
 #include "gi/renderer.h"
@@ -22,7 +22,6 @@
 #include "quad_scene.h"
 #include "ssdo_frames.h"
 #include "test_support.h"
-#include "vulkan_fixture.h"
 
 namespace gi {
 namespace {
@@ -44,13 +43,9 @@ constexpr uint32_t kW = 160, kH = 120;
 
 using test::finite;
 
-class SsdoTest : public test::VulkanTest {
+class SsdoTest : public test::EffectTest {
  protected:
-  void SetUp() override {
-    VulkanTest::SetUp();
-    registry.scanDirectory(test::binPath("plugins"));
-    ASSERT_TRUE(registry.has("ssdo")) << "ssdo plugin missing from " << test::binPath("plugins");
-  }
+  std::string effectName() const override { return "ssdo"; }
   struct Result {
     // ambient: as radiance (albedo applied, as the lighting pass does); ambientRaw: as SSDO
     // publishes it, per unit diffuse albedo (alpha 2).
@@ -69,16 +64,12 @@ class SsdoTest : public test::VulkanTest {
       return glm::vec3(glm::inverse(camera.view) * glm::vec4(glm::vec3(v) / v.w, 1.0f));
     }
   };
+  // The settings of SSDO, of `effect` instead ("ssao") or, for "", of no effect.
   RenderSettings settingsFor(const Scene& scene, const std::string& effect,
-                             const std::vector<std::string>& sets) {
-    EffectOverrides cli;
-    cli.effects = effect.empty() ? std::vector<std::string>{} : std::vector<std::string>{effect};
-    cli.sets = sets;
-    RenderSettings rs;
-    rs.width = kW;
-    rs.height = kH;
-    rs.effects = resolveEffects(scene, nullptr, cli, registry);
-    return rs;
+                             const std::vector<std::string>& sets) const {
+    return EffectTest::settingsFor(
+        effect.empty() ? std::vector<std::string>{} : std::vector<std::string>{effect}, scene, sets,
+        kW, kH);
   }
   // Renders one frame; `ambient` is read only when SSDO ran, `indirect` only when it ran with
   // the bounce (without it SSDO publishes none).
@@ -124,7 +115,6 @@ class SsdoTest : public test::VulkanTest {
     if (count) *count = n;
     return n > 0 ? sum / double(n) : sum;
   }
-  EffectRegistry registry;
 };
 
 // An open plane under a constant environment: nothing is blocked, so the directional term is
