@@ -61,18 +61,7 @@ const std::vector<AoPlugin>& aoPlugins() {
 class AoFamilyTest : public test::EffectTest, public ::testing::WithParamInterface<AoPlugin> {
  protected:
   std::string effectName() const override { return GetParam().name; }
-  struct Result {
-    ImageRGBA32F ao, depth;
-    CameraView camera;
-    int w = 0, h = 0;
-    float at(int x, int y) const { return ao.pixels[(size_t(y) * w + x) * 4]; }
-    glm::vec3 worldAt(int x, int y) const {
-      const float d = depth.pixels[(size_t(y) * w + x) * 4];
-      glm::vec4 v = glm::inverse(camera.proj) *
-                    glm::vec4((x + 0.5f) / w * 2 - 1, (y + 0.5f) / h * 2 - 1, d, 1.0f);
-      return glm::vec3(glm::inverse(camera.view) * glm::vec4(glm::vec3(v) / v.w, 1.0f));
-    }
-  };
+  using Result = test::AoFrame;
   Result render(const Scene& scene, std::vector<std::string> sets, uint32_t w = 160,
                 uint32_t h = 120) {
     sets.insert(sets.begin(), GetParam().base.begin(), GetParam().base.end());
