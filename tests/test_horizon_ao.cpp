@@ -280,7 +280,7 @@ TEST_P(HorizonAoTest, PlaneIsOpen) {
       }
 }
 
-TEST_F(GtaoTest, CornerMatchesTheClosedForm) {
+TEST_F(GtaoTest, GtaoCornerMatchesTheClosedForm) {
   // Hard cut-off at R (falloff 0) as the closed form; 4 slices x 8 steps, interleaved and
   // blurred (64 slice rotations averaged). Screen-space horizons are found at discrete samples,
   // so they can only be lower than the true ones: AO errs high. Tolerance: within [-0.01,
@@ -300,7 +300,7 @@ TEST_F(GtaoTest, CornerMatchesTheClosedForm) {
   EXPECT_LT(r.meanOnLine(0.05f), 0.65) << "near the crease AO tends to 1/2";
 }
 
-TEST_F(GtaoTest, AtHalfResolutionMatchesTheClosedFormAndTheFullResolution) {
+TEST_F(GtaoTest, GtaoAtHalfResolutionMatchesTheClosedFormAndTheFullResolution) {
   // The corner test's setting at downsample 2 (a quarter of the pixels, each standing for a 2x2
   // block; blurred there, upsampled by the engine's depth-aware upsample). Tolerance: within
   // [-0.02, +0.06] of the closed form at every distance (measured -0.015 .. +0.053). Looser
@@ -340,7 +340,7 @@ TEST_F(GtaoTest, AtHalfResolutionMatchesTheClosedFormAndTheFullResolution) {
   EXPECT_LT(worst, 0.15);
 }
 
-TEST_F(GtaoTest, BeatsSsaoAtEqualTapCount) {
+TEST_F(GtaoTest, GtaoBeatsSsaoAtEqualTapCount) {
   // 16 depth taps per pixel each: GTAO 2 slices x 2 sides x 4 steps, SSAO 16 samples; both at
   // their defaults otherwise (interleaved, blur radius 2). Error: mean |AO - closed form| over
   // the corner lines x = 0.05 .. 0.4 (SSAO estimates obscurance with a linear falloff, not the
@@ -363,7 +363,7 @@ TEST_F(GtaoTest, BeatsSsaoAtEqualTapCount) {
   EXPECT_LT(errG / n, 0.04);  // measured 0.024
 }
 
-TEST_F(HbaoTest, CornerMatchesItsOwnQuantity) {
+TEST_F(HbaoTest, HbaoCornerMatchesItsOwnQuantity) {
   // HBAO's quantity is view-dependent (elevations from the image plane), so its reference is
   // the CPU integral above for this camera, per pixel at the pixel's own floor point, averaged
   // over the same pixels (hbaoCornerIntegral; checked against a closed form from straight
