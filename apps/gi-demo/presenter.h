@@ -1,26 +1,27 @@
-// gi-demo's presenter: a FIFO swapchain for the GLFW window whose frames are the renderer's
-// image (blitted, scaled to the window) with the Dear ImGui panel drawn over it in a render
-// pass. Owns the ImGui Vulkan backend and times its pass with GPU timestamps. Recreates the
-// swapchain when the window is resized or the surface goes out of date.
+// gi-demo's presenter: the engine's swapchain (gi/vk/swapchain.h) shows the renderer's image
+// with the Dear ImGui panel drawn over it as the swapchain's overlay, in a render pass over
+// each swapchain image. Owns the ImGui Vulkan backend and times its pass with GPU timestamps.
 #pragma once
 
 #include <vulkan/vulkan.h>
 
+#include <memory>
 #include <vector>
 
 #include "gi/vk/context.h"
+#include "gi/vk/swapchain.h"
 
 struct GLFWwindow;
 struct ImDrawData;
 
 namespace demo {
 
-class Presenter {
+class Presenter final : public gi::vk::SwapchainOverlay {
  public:
   // The context needs GLFW's instance extensions and swapchain = true. Initialises the ImGui
   // Vulkan backend (ImGui's context and GLFW backend must exist already).
   Presenter(gi::vk::Context& ctx, GLFWwindow* window);
-  ~Presenter();
+  ~Presenter() override;
   Presenter(const Presenter&) = delete;
   Presenter& operator=(const Presenter&) = delete;
 
@@ -31,34 +32,24 @@ class Presenter {
   double uiGpuMs() const { return uiGpuMs_; }
   // CPU time of recording the ImGui draw lists (vertex upload included), last frame (ms).
   double uiRecordMs() const { return uiRecordMs_; }
-  VkExtent2D extent() const { return extent_; }
 
  private:
-  void createSwapchain();
-  void releaseSwapchain();
-  void record(VkImage source, VkExtent2D extent, VkImageLayout layout, ImDrawData* ui,
-              uint32_t index);
+  void imagesChanged(const std::vector<VkImageView>& views, VkFormat format, VkExtent2D extent,
+                     uint32_t minImageCount) override;
+  void record(VkCommandBuffer cmd, uint32_t index) override;
+  void releaseFramebuffers();
   void readUiTime();
 
   gi::vk::Context& ctx_;
-  GLFWwindow* window_;
-  VkSurfaceKHR surface_ = VK_NULL_HANDLE;
-  VkSurfaceFormatKHR format_{};
-  VkSwapchainKHR swapchain_ = VK_NULL_HANDLE;
-  VkExtent2D extent_{}, windowSize_{};
-  uint32_t minImageCount_ = 2;
-  std::vector<VkImage> images_;
-  std::vector<VkImageView> views_;
+  VkRenderPass renderPass_ = VK_NULL_HANDLE;  // made for the swapchain's format
   std::vector<VkFramebuffer> framebuffers_;
-  std::vector<VkSemaphore> renderFinished_;
-  VkRenderPass renderPass_ = VK_NULL_HANDLE;
+  VkExtent2D extent_{};
+  uint32_t minImageCount_ = 2, imageCount_ = 2;
   VkDescriptorPool imguiPool_ = VK_NULL_HANDLE;
-  VkCommandPool pool_ = VK_NULL_HANDLE;
-  VkCommandBuffer cmd_ = VK_NULL_HANDLE;
-  VkFence inFlight_ = VK_NULL_HANDLE;
-  VkSemaphore imageAcquired_ = VK_NULL_HANDLE;
   VkQueryPool queries_ = VK_NULL_HANDLE;
-  bool queriesPending_ = false, outOfDate_ = false, imguiReady_ = false;
+  std::unique_ptr<gi::vk::Swapchain> swapchain_;
+  ImDrawData* ui_ = nullptr;  // the panel of the frame being presented
+  bool queriesPending_ = false, imguiReady_ = false;
   double uiGpuMs_ = -1.0, uiRecordMs_ = 0.0;
 };
 

@@ -45,7 +45,8 @@ VkSemaphore createSemaphore(VkDevice device) {
 
 }  // namespace
 
-Swapchain::Swapchain(Context& ctx, GLFWwindow* window) : ctx_(ctx), window_(window) {
+Swapchain::Swapchain(Context& ctx, GLFWwindow* window, SwapchainOverlay* overlay)
+    : ctx_(ctx), window_(window), overlay_(overlay) {
   try {
     init();
   } catch (...) {
@@ -106,7 +107,9 @@ void Swapchain::destroy() {
 // hand it over as oldSwapchain.
 void Swapchain::releaseImages() {
   for (VkSemaphore s : renderFinished_) vkDestroySemaphore(ctx_.device(), s, nullptr);
+  for (VkImageView v : views_) vkDestroyImageView(ctx_.device(), v, nullptr);
   renderFinished_.clear();
+  views_.clear();
   images_.clear();
 }
 
@@ -130,9 +133,13 @@ void Swapchain::create() {
 
   const VkSurfaceFormatKHR surfaceFormat = pickFormat(physical, surface_);
   format_ = surfaceFormat.format;
-  if (!(caps.supportedUsageFlags & VK_IMAGE_USAGE_TRANSFER_DST_BIT) ||
+  VkImageUsageFlags usage = VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+  if (overlay_) usage |= VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT;
+  if ((caps.supportedUsageFlags & usage) != usage ||
       !hasFeature(physical, format_, VK_FORMAT_FEATURE_BLIT_DST_BIT))
-    throw Error(ErrorKind::Vulkan, "", "swapchain images cannot be blitted into on this device");
+    throw Error(ErrorKind::Vulkan, "",
+                overlay_ ? "swapchain images cannot be blitted into and drawn to on this device"
+                         : "swapchain images cannot be blitted into on this device");
 
   VkSwapchainCreateInfoKHR info{VK_STRUCTURE_TYPE_SWAPCHAIN_CREATE_INFO_KHR};
   info.surface = surface_;
@@ -142,7 +149,7 @@ void Swapchain::create() {
   info.imageColorSpace = surfaceFormat.colorSpace;
   info.imageExtent = extent_;
   info.imageArrayLayers = 1;
-  info.imageUsage = VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+  info.imageUsage = usage;
   info.imageSharingMode = VK_SHARING_MODE_EXCLUSIVE;
   info.preTransform = caps.currentTransform;
   info.compositeAlpha = VK_COMPOSITE_ALPHA_OPAQUE_BIT_KHR;
@@ -164,10 +171,23 @@ void Swapchain::create() {
   check(vkGetSwapchainImagesKHR(device, swapchain_, &count, images_.data()),
         "vkGetSwapchainImagesKHR");
   for (uint32_t i = 0; i < count; ++i) renderFinished_.push_back(createSemaphore(device));
+  if (overlay_) {
+    for (VkImage image : images_) {
+      VkImageViewCreateInfo v{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
+      v.image = image;
+      v.viewType = VK_IMAGE_VIEW_TYPE_2D;
+      v.format = format_;
+      v.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+      VkImageView view = VK_NULL_HANDLE;
+      check(vkCreateImageView(device, &v, nullptr, &view), "vkCreateImageView");
+      views_.push_back(view);
+    }
+    overlay_->imagesChanged(views_, format_, extent_, info.minImageCount);
+  }
   outOfDate_ = false;
 }
 
-bool Swapchain::present(VkImage source, VkExtent2D sourceExtent) {
+bool Swapchain::present(VkImage source, VkExtent2D sourceExtent, VkImageLayout layout) {
   VkDevice device = ctx_.device();
   // One frame in flight: the command buffer and the acquire semaphore are free again once the
   // previous submission finished.
@@ -195,7 +215,7 @@ bool Swapchain::present(VkImage source, VkExtent2D sourceExtent) {
   else
     check(r, "vkAcquireNextImageKHR");
 
-  record(source, sourceExtent, index);
+  record(source, sourceExtent, layout, index);
   VkSemaphoreSubmitInfo wait{VK_STRUCTURE_TYPE_SEMAPHORE_SUBMIT_INFO};
   wait.semaphore = imageAcquired_;
   wait.stageMask =
@@ -229,7 +249,8 @@ bool Swapchain::present(VkImage source, VkExtent2D sourceExtent) {
   return r != VK_ERROR_OUT_OF_DATE_KHR;
 }
 
-void Swapchain::record(VkImage source, VkExtent2D sourceExtent, uint32_t imageIndex) {
+void Swapchain::record(VkImage source, VkExtent2D sourceExtent, VkImageLayout layout,
+                       uint32_t imageIndex) {
   check(vkResetCommandBuffer(cmd_, 0), "vkResetCommandBuffer");
   VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
@@ -238,7 +259,7 @@ void Swapchain::record(VkImage source, VkExtent2D sourceExtent, uint32_t imageIn
   VkImage target = images_[imageIndex];
   const VkImageAspectFlags color = VK_IMAGE_ASPECT_COLOR_BIT;
   // The renderer's writes were submitted earlier on this queue: make them visible to the blit.
-  imageBarrier(cmd_, source, color, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+  imageBarrier(cmd_, source, color, layout, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
                VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_MEMORY_WRITE_BIT,
                VK_PIPELINE_STAGE_2_BLIT_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
   // Old contents are not needed; srcStage BLIT waits for the acquire semaphore (same stage).
@@ -258,13 +279,24 @@ void Swapchain::record(VkImage source, VkExtent2D sourceExtent, uint32_t imageIn
                  VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region,
                  linearFilter_ && !sameSize ? VK_FILTER_LINEAR : VK_FILTER_NEAREST);
 
-  imageBarrier(cmd_, target, color, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-               VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, VK_PIPELINE_STAGE_2_BLIT_BIT,
-               VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_NONE, 0);
   // Back to the layout the renderer left it in; later submissions (the next frame overwrites
   // the source) wait for the blit's read.
-  imageBarrier(cmd_, source, color, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL,
+  imageBarrier(cmd_, source, color, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, layout,
                VK_PIPELINE_STAGE_2_BLIT_BIT, 0, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, 0);
+  if (overlay_) {
+    imageBarrier(cmd_, target, color, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                 VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_BLIT_BIT,
+                 VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                 VK_ACCESS_2_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT);
+    overlay_->record(cmd_, imageIndex);
+    imageBarrier(cmd_, target, color, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                 VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, VK_PIPELINE_STAGE_2_COLOR_ATTACHMENT_OUTPUT_BIT,
+                 VK_ACCESS_2_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_2_NONE, 0);
+  } else {
+    imageBarrier(cmd_, target, color, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                 VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, VK_PIPELINE_STAGE_2_BLIT_BIT,
+                 VK_ACCESS_2_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_2_NONE, 0);
+  }
   check(vkEndCommandBuffer(cmd_), "vkEndCommandBuffer");
 }
 
