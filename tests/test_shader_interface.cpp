@@ -2,6 +2,8 @@
 // from SPIR-V; C++ structs checked against them; pipelines and descriptor writes by name.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <functional>
 #include <glm/glm.hpp>
 #include <string>
@@ -194,6 +196,35 @@ TEST(ShaderInterface, UnreadableModulesAndOtherSetsAreClearErrors) {
                       VK_SHADER_STAGE_COMPUTE_BIT, "set1.comp");
   });
   EXPECT_TRUE(contains(m, "'t' is in descriptor set 1")) << m;
+}
+
+TEST(ShaderInterface, SpecializationConstantsByNameAndId) {
+  const std::string src = R"(#version 450
+layout(local_size_x = 1) in;
+layout(constant_id = 3) const int kThird = 0;
+layout(constant_id = 0) const int kFirst = 1;
+layout(constant_id = 7) const bool kSeventh = false;
+layout(set = 0, binding = 0) buffer Out { int v[]; } outBuf;
+void main() { outBuf.v[0] = kThird + kFirst + (kSeventh ? 1 : 0); })";
+  const auto constants = vk::reflectSpecializationConstants(
+      vk::compileGlsl(src, VK_SHADER_STAGE_COMPUTE_BIT, "spec.comp"), "spec.comp");
+  ASSERT_EQ(constants.size(), 3u);
+  EXPECT_EQ(constants[0].name, "kFirst");
+  EXPECT_EQ(constants[0].id, 0u);
+  EXPECT_EQ(constants[1].name, "kThird");
+  EXPECT_EQ(constants[1].id, 3u);
+  EXPECT_EQ(constants[2].name, "kSeventh");
+  EXPECT_EQ(constants[2].id, 7u);
+  // The engine's lighting shader declares what its optional-input table names (the lighting
+  // pass refuses a shader without them; every frame of the other tests goes through it).
+  std::vector<std::string> names;
+  for (const auto& c :
+       vk::reflectSpecializationConstants(vk::loadSpirv("lighting.comp"), "lighting.comp"))
+    names.push_back(c.name);
+  for (const char* n :
+       {"kAoInput", "kAmbientInput", "kIndirectInput", "kContactInput", "kDirectInput",
+        "kLightTypes", "kShadowTypes", "kPcfRadius", "kEnvironmentKind"})
+    EXPECT_NE(std::find(names.begin(), names.end(), n), names.end()) << n;
 }
 
 TEST(ShaderInterface, GraphicsStagesMergeAndMustAgree) {

@@ -76,6 +76,16 @@ class Reflector {
     return spvc_compiler_get_decoration(compiler_, id, d);
   }
   spvc_type type(spvc_type_id id) const { return spvc_compiler_get_type_handle(compiler_, id); }
+  std::vector<SpecializationConstant> specializationConstants() {
+    const spvc_specialization_constant* list = nullptr;
+    size_t count = 0;
+    check(spvc_compiler_get_specialization_constants(compiler_, &list, &count),
+          "specialization constants");
+    std::vector<SpecializationConstant> out;
+    for (size_t i = 0; i < count; ++i) out.push_back({nameOf(list[i].id), list[i].constant_id});
+    std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.id < b.id; });
+    return out;
+  }
 
  private:
   void check(spvc_result r, const char* what) {
@@ -125,6 +135,11 @@ const char* descriptorTypeName(VkDescriptorType type) {
     default:
       return "unknown descriptor";
   }
+}
+
+std::vector<SpecializationConstant> reflectSpecializationConstants(
+    const std::vector<uint32_t>& spirv, const std::string& shaderName) {
+  return Reflector(spirv, shaderName).specializationConstants();
 }
 
 ShaderInterface reflectShader(const std::vector<uint32_t>& spirv, VkShaderStageFlagBits stage,

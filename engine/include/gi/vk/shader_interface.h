@@ -52,6 +52,16 @@ struct ShaderInterface {
   std::string describe() const;
 };
 
+// A specialization constant as the shader declares it: `layout(constant_id = id) const ... name`.
+struct SpecializationConstant {
+  std::string name;
+  uint32_t id = 0;
+};
+// The specialization constants `spirv` declares, by constant_id. Throws gi::Error naming
+// `shaderName` on a module it cannot parse.
+std::vector<SpecializationConstant> reflectSpecializationConstants(
+    const std::vector<uint32_t>& spirv, const std::string& shaderName);
+
 // Reads set 0's bindings, the push-constant block and every block's layout from `spirv`.
 // `shaderName` names the module in errors. Throws gi::Error on a module it cannot parse or on
 // resources outside set 0 (the engine's pipelines have one set).

@@ -42,26 +42,27 @@ std::unique_ptr<Effect> makeFloorPass(EngineState& state);
 
 // The lighting pass's optional inputs, in this one table: the blackboard resource an effect may
 // publish, the 1x1 neutral texture that stands in when none does (its format and value: the
-// renderer declares it), the lighting.comp sampler it is bound to, and the lighting.comp
-// specialization constant (constant_id) that says whether it is absent (0: its fetch compiled
-// out), of the output's size (1: one texel fetch) or of another size (2: bilinear).
+// renderer declares it), and the names lighting.comp gives its sampler and the specialization
+// constant that says whether it is absent (0: its fetch compiled out), of the output's size (1:
+// one texel fetch) or of another size (2: bilinear). The pass finds both in the shader's own
+// reflection (constant ids live only in GLSL) and refuses a shader that lacks one.
 struct LightingInput {
   const char* resource;
   VkFormat format;
   std::array<float, 4> neutral;
   const char* texture;
-  uint32_t constantId;
+  const char* constant;
 };
 inline const std::array<LightingInput, 5> kLightingInputs = {{
-    {resources::kAO, VK_FORMAT_R8G8B8A8_UNORM, {1.0f, 1.0f, 1.0f, 1.0f}, "aoTexture", 3},
-    {resources::kAmbient, VK_FORMAT_R16G16B16A16_SFLOAT, {}, "ambientTexture", 4},
-    {resources::kIndirect, VK_FORMAT_R16G16B16A16_SFLOAT, {}, "indirectTexture", 5},
+    {resources::kAO, VK_FORMAT_R8G8B8A8_UNORM, {1.0f, 1.0f, 1.0f, 1.0f}, "aoTexture", "kAoInput"},
+    {resources::kAmbient, VK_FORMAT_R16G16B16A16_SFLOAT, {}, "ambientTexture", "kAmbientInput"},
+    {resources::kIndirect, VK_FORMAT_R16G16B16A16_SFLOAT, {}, "indirectTexture", "kIndirectInput"},
     {resources::kContactShadow,
      VK_FORMAT_R8G8B8A8_UNORM,
      {1.0f, 1.0f, 1.0f, 1.0f},
      "contactTexture",
-     7},
-    {resources::kDirectLight, VK_FORMAT_R16G16B16A16_SFLOAT, {}, "directTexture", 8},
+     "kContactInput"},
+    {resources::kDirectLight, VK_FORMAT_R16G16B16A16_SFLOAT, {}, "directTexture", "kDirectInput"},
 }};
 
 // Workgroup of the engine's full-screen compute passes (lighting, tonemap): llvmpipe

@@ -1,7 +1,8 @@
 // "lighting": composes the lit image from the G-buffer, the lights and shadow maps, the
 // environment and the optional inputs effects publish (ao, ambient, indirect, contact_shadow,
 // direct_light; neutral when absent: one table, kLightingInputs in builtin_passes.h, gives
-// each one's resource, fallback, sampler and specialization constant).
+// each one's resource, fallback, and the names of its sampler and specialization constant in
+// lighting.comp, whose reflection gives their numbers).
 #include <algorithm>
 #include <array>
 #include <map>
@@ -11,6 +12,7 @@
 #include "gi/errors.h"
 #include "gi/lit_surface.h"
 #include "gi/vk/pipeline.h"
+#include "gi/vk/shader_interface.h"
 #include "render/passes/builtin_passes.h"
 
 namespace gi {
@@ -33,6 +35,16 @@ class LightingPass final : public Effect {
   std::vector<SettingDesc> settings() const override { return {}; }
   void prepare(EffectContext& ctx, const SettingValues&) override {
     ctx.vulkan().requireWorkgroup(kScreenGroupX, kScreenGroupY, "lighting");
+    if (!spirv_.empty()) return;
+    spirv_ = vk::loadSpirv("lighting.comp");
+    constants_ = vk::reflectSpecializationConstants(spirv_, kShader);
+    for (const LightingInput& in : kLightingInputs) {
+      constant(in.constant);  // the shader must declare each input's constant ...
+      if (!vk::reflectShader(spirv_, VK_SHADER_STAGE_COMPUTE_BIT, kShader).find(in.texture))
+        throw Error(ErrorKind::ShaderInterface, "",  // ... and its sampler
+                    std::string(kShader) + " has no sampler '" + in.texture +
+                        "' for the optional input '" + in.resource + "'");
+    }
   }
   void addPasses(FrameGraph& graph, EffectContext& ctx, const SettingValues&) override {
     struct Io {
@@ -87,8 +99,17 @@ class LightingPass final : public Effect {
   }
 
  private:
-  // The lighting.comp specialization constants of one configuration (constant_id order).
-  using Variant = std::array<uint32_t, 9>;
+  static constexpr const char* kShader = "lighting: lighting.comp";
+  // The lighting.comp specialization constants of one configuration, by constant_id.
+  using Variant = std::vector<uint32_t>;
+
+  // The constant_id lighting.comp gives `name`.
+  uint32_t constant(const char* name) const {
+    for (const vk::SpecializationConstant& c : constants_)
+      if (c.name == name) return c.id;
+    throw Error(ErrorKind::ShaderInterface, "",
+                std::string(kShader) + " declares no specialization constant '" + name + "'");
+  }
 
   // Where `resource` is in kLightingInputs.
   static size_t input(const char* resource) {
@@ -107,23 +128,22 @@ class LightingPass final : public Effect {
       types |= bit;
       if (l.shadow.x >= 0.0f) shadowTypes |= bit;
     }
-    Variant key{};
-    key[0] = types;
-    key[1] = shadowTypes;
-    key[2] = std::min(s_.settings.pcfRadius, 3u);
-    key[6] = s_.environment.kind();
+    Variant key(constants_.empty() ? 0 : constants_.back().id + 1, 0u);
+    key[constant("kLightTypes")] = types;
+    key[constant("kShadowTypes")] = shadowTypes;
+    key[constant("kPcfRadius")] = std::min(s_.settings.pcfRadius, 3u);
+    key[constant("kEnvironmentKind")] = s_.environment.kind();
     for (size_t i = 0; i < kLightingInputs.size(); ++i)
-      key[kLightingInputs[i].constantId] = inputs[i];
+      key[constant(kLightingInputs[i].constant)] = inputs[i];
     auto found = pipelines_.find(key);
     if (found != pipelines_.end()) return found->second;
-    return pipelines_
-        .emplace(key, vk::Pipeline::compute(s_.ctx, {"lighting: lighting.comp",
-                                                     vk::loadSpirv("lighting.comp"),
-                                                     {key.begin(), key.end()}}))
+    return pipelines_.emplace(key, vk::Pipeline::compute(s_.ctx, {kShader, spirv_, key}))
         .first->second;
   }
 
   EngineState& s_;
+  std::vector<uint32_t> spirv_;                        // lighting.comp
+  std::vector<vk::SpecializationConstant> constants_;  // its reflection, by constant_id
   std::map<Variant, vk::Pipeline> pipelines_;
 };
 
