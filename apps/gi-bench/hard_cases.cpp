@@ -362,15 +362,15 @@ std::vector<HardCaseRun> runHardCases(vk::Context& ctx, const EffectRegistry& re
       HardCaseRun run{hc.name, effect};
       EffectOverrides ov;
       ov.effects = effect == "none" ? std::vector<std::string>{} : std::vector{effect};
-      // Only the settings of the effect that runs (resolveEffects rejects the others').
+      // Only the settings of the effect that runs (the others' are refused).
       for (const std::string& set : options.sets)
         if (set.rfind(effect + ".", 0) == 0) ov.sets.push_back(set);
-      RenderSettings rs;
-      rs.width = options.width;
-      rs.height = options.height;
-      rs.shadowMapSize = 256;
-      rs.aliasTransients = false;  // each transient keeps its own last version
-      rs.effects = resolveEffects(scene, nullptr, ov, registry);
+      RenderSettings base;
+      base.width = options.width;
+      base.height = options.height;
+      base.shadowMapSize = 256;
+      base.aliasTransients = false;  // each transient keeps its own last version
+      const RenderSettings rs = configureRender(scene, registry, {.overrides = ov}, base);
       Renderer r(ctx, scene, rs, &registry);
       for (int i = 0; i < std::max(options.warmupFrames, 1); ++i) r.renderFrame();
       for (const Renderer::NamedTexture& t : r.readAllTextures()) {
