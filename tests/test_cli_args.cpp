@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "cli.h"
+#include "gi/image_io.h"
 #include "test_support.h"
 
 namespace gi {
@@ -232,6 +233,36 @@ TEST(CliArgs, OutputsAreCheckedBeforeAnyWork) {
   const std::string file = dir.write("file", "x");
   msg = errorOf([&] { cli::checkOutputFolder(file); }, ErrorKind::FileNotFound);
   EXPECT_NE(msg.find("exists and is not a folder"), std::string::npos) << msg;
+}
+
+TEST(CliArgs, OutputsNeverReplaceWhatIsNotARegularFile) {
+  // A FIFO (as a device node would be) at an output path: refused before any work and again
+  // at commit, by the text and the image writers alike; it stays a FIFO, nothing is left.
+  test::TempDir dir("test_cli_args_fifo");
+  const std::string fifo = dir.path("pipe.png");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  auto stillAFifo = [&] {
+    EXPECT_TRUE(fs::is_fifo(fifo)) << "replaced";
+    EXPECT_FALSE(fs::exists(fifo + ".partial"));
+  };
+  const std::string msg = errorOf([&] { cli::checkOutputWritable(fifo); }, ErrorKind::FileNotFound);
+  EXPECT_NE(msg.find("not a regular file"), std::string::npos) << msg;
+  errorOf([&] { cli::writeFileAtomic(fifo, "digraph {}\n"); }, ErrorKind::FileNotFound);
+  stillAFifo();
+  ImageRGBA8 image;
+  image.width = image.height = 1;
+  image.pixels = {1, 2, 3, 255};
+  errorOf([&] { writePng(fifo, image); }, ErrorKind::FileNotFound);
+  stillAFifo();
+  // Through a symbolic link too; a link to a regular file is an ordinary output.
+  const std::string link = dir.path("link.png");
+  fs::create_symlink(fifo, link);
+  errorOf([&] { cli::checkOutputWritable(link); }, ErrorKind::FileNotFound);
+  stillAFifo();
+  EXPECT_TRUE(fs::is_symlink(link));
+  const std::string plain = dir.write("plain.png", "x"), plainLink = dir.path("plain_link.png");
+  fs::create_symlink(plain, plainLink);
+  cli::checkOutputWritable(plainLink);
 }
 
 TEST(CliArgs, AtomicWritesLeaveNothingOnFailure) {

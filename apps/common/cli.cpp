@@ -11,6 +11,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include "gi/image_io.h"
+
 namespace gi::cli {
 
 namespace fs = std::filesystem;
@@ -232,8 +234,7 @@ void checkWritableFolder(const fs::path& folder, const std::string& path, const 
 
 void checkOutputWritable(const std::string& path) {
   std::error_code ec;
-  if (fs::is_directory(path, ec))
-    throw Error(ErrorKind::FileNotFound, path, "output path is a folder, not a file");
+  checkReplaceableOutput(path);  // a folder, device, FIFO or socket
   const fs::path folder = fs::path(path).parent_path();
   if (!folder.empty() && !fs::exists(folder, ec)) {
     // Made when the file is written (with its missing parents): the nearest existing
@@ -260,6 +261,7 @@ void checkOutputFolder(const std::string& dir) {
 }
 
 void writeFileAtomic(const std::string& path, const std::string& text) {
+  checkReplaceableOutput(path);
   const std::string tmp = path + ".partial";
   std::error_code ec;
   if (const fs::path folder = fs::path(path).parent_path(); !folder.empty())
@@ -272,6 +274,12 @@ void writeFileAtomic(const std::string& path, const std::string& text) {
       fs::remove(tmp, ec);
       throw Error(ErrorKind::FileNotFound, path, "cannot write the file");
     }
+  }
+  try {
+    checkReplaceableOutput(path);  // again: it may have appeared while the text was written
+  } catch (...) {
+    fs::remove(tmp, ec);
+    throw;
   }
   fs::rename(tmp, path, ec);
   if (ec) {

@@ -19,6 +19,10 @@ struct ImageRGBA32F {
 };
 
 void writePng(const std::string& path, const ImageRGBA8& image);
+// Every output replaces only a regular file (or nothing): a device, FIFO, socket or folder at
+// `path` (followed through symbolic links) is a gi::Error(FileNotFound) naming it, never
+// replaced by a rename. The writers check it before they commit; apps check it before any work.
+void checkReplaceableOutput(const std::string& path);
 // Portable float map (3 channels, little-endian, bottom-to-top rows as the format requires).
 void writePfm(const std::string& path, const ImageRGBA32F& image);
 ImageRGBA32F readPfm(const std::string& path);

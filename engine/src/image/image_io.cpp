@@ -20,6 +20,12 @@ namespace {
 // Moves a finished temporary file into place; removes it on failure.
 void commitFile(const std::string& tmp, const std::string& path) {
   std::error_code ec;
+  try {
+    checkReplaceableOutput(path);
+  } catch (...) {
+    std::filesystem::remove(tmp, ec);
+    throw;
+  }
   std::filesystem::rename(tmp, path, ec);
   if (ec) {
     std::filesystem::remove(tmp, ec);
@@ -35,6 +41,17 @@ std::string tempName(const std::string& path) {
   return path + ".partial";
 }
 }  // namespace
+
+void checkReplaceableOutput(const std::string& path) {
+  std::error_code ec;
+  const std::filesystem::file_status st = std::filesystem::status(path, ec);
+  if (ec || !std::filesystem::exists(st) || std::filesystem::is_regular_file(st)) return;
+  throw Error(ErrorKind::FileNotFound, path,
+              std::filesystem::is_directory(st)
+                  ? "output path is a folder, not a file"
+                  : "output path is not a regular file (a device, FIFO or socket): it is never "
+                    "replaced");
+}
 
 void writePng(const std::string& path, const ImageRGBA8& image) {
   const std::string tmp = tempName(path);
