@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 #include "gi/effect_registry.h"
@@ -96,6 +97,61 @@ TEST(Registry, RefusesAModuleDuplicatingABuiltInEffect) {
   EXPECT_TRUE(contains(message, "built-in")) << message;
   EXPECT_EQ(registry.origin("test_good"), "built-in");
   EXPECT_EQ(registry.info("test_good").description, "built in");
+}
+
+TEST(Registry, AModuleThatThrowsIsRefusedByName) {
+  // Whatever its constructor throws (even what is not a std::exception), the app gets an error
+  // naming the module, and a scan goes on with the others.
+  for (const char* name : {"throws_int", "throws_std"}) {
+    EffectRegistry registry;
+    const std::string path = modulePath(name);
+    const Error e = thrownBy([&] { registry.loadModule(path); });
+    EXPECT_EQ(e.kind(), ErrorKind::InvalidData);
+    EXPECT_EQ(e.file(), path);
+    EXPECT_TRUE(contains(e.what(), "failed while registering its effects")) << e.what();
+    if (std::string(name) == "throws_std") {
+      EXPECT_TRUE(contains(e.what(), "the GPU is on fire")) << e.what();
+    }
+    EXPECT_TRUE(registry.names().empty());
+  }
+  const std::string dir = test::makeTempDir("registry-throwing");
+  for (const char* name : {"throws_int", "good_module", "throws_std"})
+    fs::copy_file(modulePath(name), dir + "/gi_test_" + std::string(name) + ".so");
+  EffectRegistry registry;
+  registry.scanDirectory(dir);
+  EXPECT_EQ(registry.names(), std::vector<std::string>{"test_good"});
+  EXPECT_EQ(registry.problems().size(), 2u);
+}
+
+TEST(Registry, TruncatedModulesAndLinkLoopsAreRefusedNotFatal) {
+  // A module cut short (as while a build writes it) would fault (SIGBUS) once mapped: refused
+  // before dlopen. A link loop and a dangling link in the folder are not modules.
+  const std::string dir = test::makeTempDir("registry-truncated");
+  const std::string good = modulePath("good_module"), cut = dir + "/gi_test_cut.so";
+  std::string bytes;
+  {
+    std::ifstream in(good, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  ASSERT_GT(bytes.size(), 4096u);
+  for (const size_t keep : {size_t(64 + 56), bytes.size() / 2, bytes.size() - 1}) {
+    std::ofstream(cut, std::ios::binary | std::ios::trunc)
+        .write(bytes.data(), std::streamsize(keep));
+    EffectRegistry registry;
+    const Error e = thrownBy([&] { registry.loadModule(cut); });
+    EXPECT_EQ(e.file(), cut);
+    EXPECT_TRUE(contains(e.what(), "truncated module") || contains(e.what(), "cannot load"))
+        << keep << " bytes: " << e.what();
+  }
+  fs::create_symlink(dir + "/loop_b.so", dir + "/loop_a.so");
+  fs::create_symlink(dir + "/loop_a.so", dir + "/loop_b.so");
+  fs::create_symlink(dir + "/missing.so", dir + "/dangling.so");
+  fs::copy_file(good, dir + "/gi_test_good_module.so");
+  EffectRegistry registry;
+  registry.scanDirectory(dir);
+  EXPECT_EQ(registry.names(), std::vector<std::string>{"test_good"});
+  ASSERT_EQ(registry.problems().size(), 1u);  // the truncated one
+  EXPECT_TRUE(contains(registry.problems()[0], "gi_test_cut.so")) << registry.problems()[0];
 }
 
 TEST(Registry, RefusesLoadingTheSameModuleTwice) {

@@ -1,12 +1,15 @@
 #include "gi/effect_registry.h"
 
 #include <dlfcn.h>
+#include <elf.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <sstream>
 
 #include "gi/engine_settings.h"
@@ -19,6 +22,35 @@ namespace fs = std::filesystem;
 namespace {
 // The module being loaded, so add() can name it as the origin of what it registers.
 thread_local const std::string* currentModule = nullptr;
+
+// dlopen() maps a module by what its ELF headers say; a file cut short (a build writing it, a
+// truncated copy) makes the mapped pages past its end fault with SIGBUS on first use, in any
+// process that scans the folder. Checked before dlopen: the headers must lie within the file.
+void checkElfComplete(const std::string& file, const std::string& path) {
+  std::error_code ec;
+  const uintmax_t size = fs::file_size(file, ec);
+  if (ec) throw Error(ErrorKind::FileNotFound, path, "cannot read the module: " + ec.message());
+  std::ifstream in(file, std::ios::binary);
+  Elf64_Ehdr eh{};
+  if (!in.read(reinterpret_cast<char*>(&eh), sizeof eh) ||
+      std::memcmp(eh.e_ident, ELFMAG, SELFMAG) != 0 || eh.e_ident[EI_CLASS] != ELFCLASS64)
+    return;  // not a 64-bit ELF file: dlopen says what it is
+  auto truncated = [&](uint64_t needed) {
+    throw Error(ErrorKind::InvalidData, path,
+                "truncated module: " + std::to_string(size) + " bytes, its headers need " +
+                    std::to_string(needed) + " (still being written?)");
+  };
+  const uint64_t ph = eh.e_phoff + uint64_t(eh.e_phnum) * eh.e_phentsize;
+  const uint64_t sh = eh.e_shoff + uint64_t(eh.e_shnum) * eh.e_shentsize;
+  if (ph > size) truncated(ph);
+  if (sh > size) truncated(sh);
+  for (unsigned i = 0; i < eh.e_phnum; ++i) {
+    Elf64_Phdr p{};
+    in.seekg(std::streamoff(eh.e_phoff + uint64_t(i) * eh.e_phentsize));
+    if (!in.read(reinterpret_cast<char*>(&p), sizeof p)) truncated(ph);
+    if (p.p_type == PT_LOAD && p.p_offset + p.p_filesz > size) truncated(p.p_offset + p.p_filesz);
+  }
+}
 
 bool validName(const std::string& n) {
   if (n.empty()) return false;
@@ -61,6 +93,7 @@ std::string EffectRegistry::origin_or(const std::string& name) const {
 
 void EffectRegistry::openAndRegister(const std::string& file, const std::string& path,
                                      const std::string& replaced) {
+  checkElfComplete(file, path);
   void* handle = dlopen(file.c_str(), RTLD_NOW | RTLD_LOCAL);
   if (!handle)
     throw Error(ErrorKind::InvalidData, path, std::string("cannot load module: ") + dlerror());
@@ -83,12 +116,23 @@ void EffectRegistry::openAndRegister(const std::string& file, const std::string&
   EffectRegistry scratch;
   for (const Entry& e : entries_)
     if (replaced.empty() || e.origin != replaced) scratch.entries_.push_back(e);
+  // The handle stays open whatever happens: code from it may still be referenced. A module's
+  // own exception (its constructor's, whatever its type) becomes an error naming the module.
   currentModule = &path;
   try {
     registerFn(scratch);
+  } catch (const Error&) {
+    currentModule = nullptr;
+    throw;  // the registry's own refusals name the module already
+  } catch (const std::exception& e) {
+    currentModule = nullptr;
+    throw Error(ErrorKind::InvalidData, path,
+                std::string("the module failed while registering its effects: ") + e.what());
   } catch (...) {
     currentModule = nullptr;
-    throw;  // the handle stays open: code from it may still be referenced by the exception
+    throw Error(ErrorKind::InvalidData, path,
+                "the module failed while registering its effects (it threw something that is "
+                "not a std::exception)");
   }
   currentModule = nullptr;
   entries_ = std::move(scratch.entries_);
@@ -150,9 +194,11 @@ void EffectRegistry::scanDirectory(const std::string& dir) {
   std::error_code ec;
   if (!fs::is_directory(dir, ec)) return;
   std::vector<fs::path> modules;
-  for (const auto& entry : fs::directory_iterator(dir, ec))
-    if (entry.is_regular_file() && entry.path().extension() == ".so")
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    std::error_code entryError;  // a dangling link or a link loop: not a module, no error
+    if (entry.is_regular_file(entryError) && entry.path().extension() == ".so")
       modules.push_back(entry.path());
+  }
   std::sort(modules.begin(),
             modules.end());  // deterministic order, so duplicates resolve the same way
   for (const fs::path& m : modules) {
