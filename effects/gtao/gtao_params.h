@@ -17,9 +17,9 @@
 #pragma once
 
 #include <algorithm>
-#include <array>
-#include <cmath>
 #include <cstdint>
+
+#include "gi/interleave.h"
 
 namespace gi::gtao {
 
@@ -38,21 +38,9 @@ struct Uniforms {
 };
 static_assert(sizeof(Uniforms) == 16 + 16 * 16, "std140 layout");
 
-// 4x4 Bayer order: entry (y & 3) * 4 + (x & 3) holds the phase's rank j in 0..15.
-inline constexpr std::array<int, 16> kBayer4 = {0, 8,  2, 10, 12, 4, 14, 6,
-                                                3, 11, 1, 9,  15, 7, 13, 5};
-
-// Slice rotation (fraction of one slice's angle) and step jitter of pixel phase e; both
-// strata midpoints, the step jitter in another order (rank x 5 mod 16) to decorrelate them.
-// Without interleaving every pixel takes the midpoints (0.5, 0.5).
-inline std::array<float, 2> noise(int e, bool interleave) {
-  if (!interleave) return {0.5f, 0.5f};
-  const int j = kBayer4[size_t(e)];
-  return {(float(j) + 0.5f) / 16.0f, (float((j * 5) % 16) + 0.5f) / 16.0f};
-}
-
 // falloff: the fraction of R over which an occluder's weight fades to 0 (0: hard cut-off).
-// slices: the rotation of phase e is noise(e).x x pi / slices (one slice's angle, stratified).
+// slices: the rotation of phase e is interleaveNoise(e).x x pi / slices (one slice's angle,
+// stratified).
 inline Uniforms makeUniforms(double radius, double falloff, double thickness, bool interleave,
                              int slices) {
   Uniforms u{};
@@ -60,13 +48,7 @@ inline Uniforms makeUniforms(double radius, double falloff, double thickness, bo
   // Guard: falloff 0 is a step; the slope stays finite (1e30 per world unit).
   u.falloffSlope = float(1.0 / std::max(falloff * radius, 1e-30));
   u.thickness = float(thickness);
-  for (int e = 0; e < 16; ++e) {
-    const auto n = noise(e, interleave);
-    const double rotation = n[0] * 3.14159265358979323846 / std::max(slices, 1);
-    u.noise[e][0] = float(std::cos(rotation));
-    u.noise[e][1] = float(std::sin(rotation));
-    u.noise[e][2] = n[1];
-  }
+  interleaveRotations(u.noise, 3.14159265358979323846, slices, interleave);
   return u;
 }
 

@@ -12,9 +12,10 @@
 // (no cosine term, elevations from the image plane, attenuation instead of a hard radius).
 #pragma once
 
-#include <array>
 #include <cmath>
 #include <cstdint>
+
+#include "gi/interleave.h"
 
 namespace gi::hbao {
 
@@ -30,19 +31,7 @@ struct Uniforms {
 };
 static_assert(sizeof(Uniforms) == 16 + 16 * 16, "std140 layout");
 
-inline constexpr std::array<int, 16> kBayer4 = {0, 8,  2, 10, 12, 4, 14, 6,
-                                                3, 11, 1, 9,  15, 7, 13, 5};
-
-// Direction rotation (fraction of the angle between two directions) and step jitter of pixel
-// phase e: strata midpoints, the jitter in another order (rank x 5 mod 16). Without
-// interleaving, every pixel takes (0.5, 0.5).
-inline std::array<float, 2> noise(int e, bool interleave) {
-  if (!interleave) return {0.5f, 0.5f};
-  const int j = kBayer4[size_t(e)];
-  return {(float(j) + 0.5f) / 16.0f, (float((j * 5) % 16) + 0.5f) / 16.0f};
-}
-
-// directions: the rotation of phase e is noise(e).x x 2 pi / directions (stratified).
+// directions: the rotation of phase e is interleaveNoise(e).x x 2 pi / directions (stratified).
 inline Uniforms makeUniforms(double radius, double angleBiasDegrees, bool interleave,
                              int directions) {
   constexpr double kPi = 3.14159265358979323846;
@@ -51,13 +40,7 @@ inline Uniforms makeUniforms(double radius, double angleBiasDegrees, bool interl
   u.invRadius2 = float(1.0 / (radius * radius));  // radius >= 1e-4 (the setting's range)
   u.cosBias = float(std::cos(angleBiasDegrees * kPi / 180.0));
   u.sinBias = float(std::sin(angleBiasDegrees * kPi / 180.0));
-  for (int e = 0; e < 16; ++e) {
-    const auto n = noise(e, interleave);
-    const double rotation = n[0] * 2.0 * kPi / (directions < 1 ? 1 : directions);
-    u.noise[e][0] = float(std::cos(rotation));
-    u.noise[e][1] = float(std::sin(rotation));
-    u.noise[e][2] = n[1];
-  }
+  interleaveRotations(u.noise, 2.0 * kPi, directions, interleave);
   return u;
 }
 
