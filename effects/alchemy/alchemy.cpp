@@ -15,10 +15,10 @@
 #include "alchemy_blur_x.comp.h"  // const uint32_t alchemy_blur_x_comp[]
 #include "alchemy_blur_y.comp.h"  // const uint32_t alchemy_blur_y_comp[]
 #include "alchemy_kernel.h"
-#include "gi/effect.h"
 #include "gi/effect_registry.h"
-#include "gi/uniform_block.h"
-#include "gi/vk/pipeline.h"
+#include "gi/effect_shader.h"
+#include "gi/screen_space_ao.h"
+#include "gi/setting_uniforms.h"
 #include "gi/vk/resources.h"
 
 namespace {
@@ -33,26 +33,13 @@ constexpr VkFormat kAOFormat = VK_FORMAT_R16_SFLOAT;
 // Workgroup size of the shaders (local_size_x/y there): 32x16 measured fastest on llvmpipe.
 constexpr uint32_t kGroupX = 32, kGroupY = 16;
 
-template <size_t N>
-std::vector<uint32_t> words(const uint32_t (&code)[N]) {
-  return {code, code + N};
-}
-
 class AlchemyEffect : public gi::Effect {
  public:
   gi::EffectInfo info() const override {
-    gi::EffectInfo i;
-    i.name = "alchemy";
-    i.version = "1.0";
-    i.description =
+    return gi::aoEffectInfo(
+        "alchemy",
         "Alchemy screen-space ambient obscurance (McGuire et al. 2011: eq. 10, spiral taps, "
-        "cross-bilateral filter, guard band)";
-    i.stage = gi::EffectStage::BeforeLighting;
-    i.reads = {res::kDepth, res::kGBuffer};
-    i.writes = {res::kAO};
-    i.debugView = res::kAO;
-    i.estimates = gi::GroundTruth::AmbientOcclusion;
-    return i;
+        "cross-bilateral filter, guard band)");
   }
 
   // The Alchemy integral of eq. 10 (README "What it estimates"): sigma = intensity, u = 0,
@@ -87,9 +74,8 @@ class AlchemyEffect : public gi::Effect {
                             false};
     epsilon.logScale = true;
     return {
-        gi::SettingDesc::length("radius", 0.5, 1e-6, 1e9,
-                                "world-space radius r: taps lie on its projected disk, occluders "
-                                "farther than r count nothing"),
+        gi::aoRadiusSetting("world-space radius r: taps lie on its projected disk, occluders "
+                            "farther than r count nothing"),
         gi::SettingDesc::samples("samples", 12, 1, kMaxSamples,
                                  "taps s per pixel (specialized: a change rebuilds the pipeline)",
                                  true),
@@ -116,12 +102,6 @@ class AlchemyEffect : public gi::Effect {
   }
 
   void prepare(gi::EffectContext& ctx, const gi::SettingValues& s) override {
-    h_.radius = s.handle<double>("radius");
-    h_.bias = s.handle<double>("bias");
-    h_.intensity = s.handle<double>("intensity");
-    h_.contrast = s.handle<double>("contrast");
-    h_.epsilon = s.handle<double>("epsilon");
-    h_.samples = s.handle<int>("samples");
     gi::vk::Context& vk = ctx.vulkan();
     vk.requireWorkgroup(kGroupX, kGroupY, "alchemy");
     using gi::alchemy::Uniforms;
@@ -137,19 +117,18 @@ class AlchemyEffect : public gi::Effect {
                GI_BLOCK_MEMBER(Uniforms, epsilon), GI_BLOCK_MEMBER(Uniforms, blurTolerance),
                GI_BLOCK_MEMBER(Uniforms, radius2), GI_BLOCK_MEMBER(Uniforms, pad),
                GI_BLOCK_MEMBER(Uniforms, taps)})}}};
-    ao_ = gi::vk::Pipeline::compute(vk, {"alchemy: alchemy.comp",
-                                         words(alchemy_comp),
-                                         {uint32_t(samples), uint32_t(band)},
-                                         params});
+    ao_ = gi::vk::Pipeline::compute(vk,
+                                    gi::computeShader("alchemy: alchemy.comp", alchemy_comp,
+                                                      {uint32_t(samples), uint32_t(band)}, params));
     if (blur > 0) {
       blurX_ = gi::vk::Pipeline::compute(
-          vk,
-          {"alchemy: alchemy_blur_x.comp", words(alchemy_blur_x_comp), {uint32_t(blur)}, params});
+          vk, gi::computeShader("alchemy: alchemy_blur_x.comp", alchemy_blur_x_comp,
+                                {uint32_t(blur)}, params));
       blurY_ = gi::vk::Pipeline::compute(
-          vk,
-          {"alchemy: alchemy_blur_y.comp", words(alchemy_blur_y_comp), {uint32_t(blur)}, params});
+          vk, gi::computeShader("alchemy: alchemy_blur_y.comp", alchemy_blur_y_comp,
+                                {uint32_t(blur)}, params));
     }
-    uniforms_.create(vk);
+    uniforms_.prepare(vk, s, {"radius", "bias", "intensity", "contrast", "epsilon", "samples"});
     if (band > 0 && !view_) view_ = ctx.createView();
   }
 
@@ -224,10 +203,14 @@ class AlchemyEffect : public gi::Effect {
               gi::TextureUsage::StorageWrite);
         },
         [this, io, values = &settings, frame, nearest](gi::PassContext& pc) {
-          upload(*values);
+          // The epsilon setting is relative to r^2: the block holds the absolute one.
+          const VkBuffer params = uniforms_.upload(*values, [](const auto& k) {
+            return gi::alchemy::makeUniforms(k[0], k[1], k[2], k[3],
+                                             gi::alchemy::absoluteEpsilon(k[4], k[0]), int(k[5]));
+          });
           gi::vk::DescriptorWriter w(ao_);
           w.buffer("Frame", frame)
-              .buffer("params", uniforms_.handle())
+              .buffer("params", params)
               .texture("gDepth", pc.view(io->depth), nearest)
               .texture("giGBuffer", pc.view(io->packed), nearest)
               .image("outAO", pc.view(io->raw));
@@ -269,26 +252,10 @@ class AlchemyEffect : public gi::Effect {
   }
 
  private:
-  void upload(const gi::SettingValues& s) {
-    const double radius = s[h_.radius];
-    const std::array<double, 6> key = {radius,
-                                       s[h_.bias],
-                                       s[h_.intensity],
-                                       s[h_.contrast],
-                                       gi::alchemy::absoluteEpsilon(s[h_.epsilon], radius),
-                                       double(s[h_.samples])};
-    uniforms_.update(key, [&] {
-      return gi::alchemy::makeUniforms(key[0], key[1], key[2], key[3], key[4], int(key[5]));
-    });
-  }
-
   gi::vk::Pipeline ao_, blurX_, blurY_;
-  struct Handles {  // typed settings, found by name once in prepare()
-    gi::Setting<double> radius, bias, intensity, contrast, epsilon;
-    gi::Setting<int> samples;
-  } h_;
-  gi::UniformBlock<gi::alchemy::Uniforms> uniforms_;  // rewritten only when a setting changed
-  std::shared_ptr<gi::ViewUniforms> view_;            // the guard-band view (guard_band > 0)
+  // Rewritten only when a setting changed.
+  gi::SettingUniforms<gi::alchemy::Uniforms, 6> uniforms_;
+  std::shared_ptr<gi::ViewUniforms> view_;  // the guard-band view (guard_band > 0)
 };
 
 }  // namespace

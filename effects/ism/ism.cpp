@@ -14,6 +14,7 @@
 
 #include "gi/effect.h"
 #include "gi/effect_registry.h"
+#include "gi/effect_shader.h"
 #include "gi/errors.h"
 #include "gi/lights.h"
 #include "gi/vk/pipeline.h"
@@ -52,8 +53,8 @@ template <size_t N>
 gi::vk::ComputeDesc shader(const char* name, const uint32_t (&words)[N],
                            std::vector<uint32_t> constants = {}, bool readsParams = true) {
   using gi::ism::Uniforms;
-  gi::vk::ComputeDesc d{
-      std::string("ism: ") + name, {std::begin(words), std::end(words)}, std::move(constants)};
+  gi::vk::ComputeDesc d =
+      gi::computeShader(std::string("ism: ") + name, words, std::move(constants));
   if (readsParams)
     d.blocks.uniforms = {
         {"ism", gi::vk::cppBlock<Uniforms>(
@@ -115,24 +116,23 @@ struct Config {
 
 class IsmEffect : public gi::Effect {
  public:
+  // "ambient" is published (as "nothing") only with environment VPLs, which then carry the
+  // environment's light in "indirect", shadowed, in place of the engine's unshadowed term.
   gi::EffectInfo info() const override {
-    gi::EffectInfo i;
-    i.name = "ism";
-    i.version = "1.0";
-    i.description =
-        "instant radiosity with imperfect shadow maps (Ritschel et al. 2008): VPLs from the "
-        "primary light's RSM, point-splatted paraboloid ISMs with pull-push, interleaved "
-        "gathering, geometry-aware blur; 1 to 3 diffuse bounces; optionally the environment as "
-        "directional VPLs with orthographic ISMs";
-    i.stage = gi::EffectStage::BeforeLighting;
-    i.reads = {res::kDepth, res::kGBuffer, res::kSurfacePoints, res::kEnvironmentMap,
-               res::kEnvironmentSampling};
-    // ambient: published (as "nothing") only with environment VPLs, which then carry the
-    // environment's light in "indirect", shadowed, in place of the engine's unshadowed term.
-    i.writes = {res::kIndirect, res::kAmbient, kAtlasView};
-    i.debugView = res::kIndirect;
-    i.estimates = gi::GroundTruth::IndirectLight;
-    return i;
+    return {
+        .name = "ism",
+        .version = "1.0",
+        .description =
+            "instant radiosity with imperfect shadow maps (Ritschel et al. 2008): VPLs from the "
+            "primary light's RSM, point-splatted paraboloid ISMs with pull-push, interleaved "
+            "gathering, geometry-aware blur; 1 to 3 diffuse bounces; optionally the "
+            "environment as directional VPLs with orthographic ISMs",
+        .stage = gi::EffectStage::BeforeLighting,
+        .reads = {res::kDepth, res::kGBuffer, res::kSurfacePoints, res::kEnvironmentMap,
+                  res::kEnvironmentSampling},
+        .writes = {res::kIndirect, res::kAmbient, kAtlasView},
+        .debugView = res::kIndirect,
+        .estimates = gi::GroundTruth::IndirectLight};
   }
 
   std::vector<gi::SettingDesc> settings() const override {

@@ -11,11 +11,11 @@
 #include <memory>
 #include <vector>
 
-#include "gi/effect.h"
 #include "gi/effect_registry.h"
+#include "gi/effect_shader.h"
 #include "gi/lit_surface.h"
-#include "gi/uniform_block.h"
-#include "gi/vk/pipeline.h"
+#include "gi/screen_space_ao.h"
+#include "gi/setting_uniforms.h"
 #include "gi/vk/resources.h"
 #include "obscurance.comp.h"         // const uint32_t obscurance_comp[]
 #include "obscurance_filter.comp.h"  // const uint32_t obscurance_filter_comp[]
@@ -37,28 +37,23 @@ constexpr VkFormat kSumsFormat = VK_FORMAT_R32G32B32A32_UINT;
 constexpr uint32_t kGroupX = 32, kGroupY = 16;  // 32x16: llvmpipe's fastest
 constexpr int kFilterRadius = 2;                // [.5 1 1 1 .5]: the 4x4 box
 
-std::vector<uint32_t> words(const uint32_t* begin, const uint32_t* end) {
-  return {begin, end};
-}
-
 class ObscuranceEffect : public gi::Effect {
  public:
+  // "ambient" and "direct_light" are written only with transfer = radiance, "ao" otherwise. Its
+  // physical target is AO (equal to obscurance for membership step); what it estimates exactly
+  // is estimatedQuantity().
   gi::EffectInfo info() const override {
-    gi::EffectInfo i;
-    i.name = "obscurance";
-    i.version = "1.0";
-    i.description =
-        "obscurance with a fuzzy membership and the ambient transfer function with "
-        "interreflections (seed 001)";
-    i.stage = gi::EffectStage::BeforeLighting;
-    i.reads = {res::kDepth, res::kGBuffer, res::kLights, res::kShadowViews, res::kShadowMaps};
-    // "ambient" and "direct_light" only with transfer = radiance, "ao" otherwise.
-    i.writes = {res::kAO, res::kAmbient, res::kDirectLight};
-    i.debugView = res::kAO;
-    // Its physical target is AO (equal to obscurance for membership step); what it estimates
-    // exactly is estimatedQuantity().
-    i.estimates = gi::GroundTruth::AmbientOcclusion;
-    return i;
+    return {
+        .name = "obscurance",
+        .version = "1.0",
+        .description =
+            "obscurance with a fuzzy membership and the ambient transfer function "
+            "with interreflections (seed 001)",
+        .stage = gi::EffectStage::BeforeLighting,
+        .reads = {res::kDepth, res::kGBuffer, res::kLights, res::kShadowViews, res::kShadowMaps},
+        .writes = {res::kAO, res::kAmbient, res::kDirectLight},
+        .debugView = res::kAO,
+        .estimates = gi::GroundTruth::AmbientOcclusion};
   }
 
   // transfer off: obscurance with the membership setting (gi-reference --quantity obscurance
@@ -83,8 +78,7 @@ class ObscuranceEffect : public gi::Effect {
 
   std::vector<gi::SettingDesc> settings() const override {
     return {
-        gi::SettingDesc::length(
-            "radius", 0.5, 1e-6, 1e9,
+        gi::aoRadiusSetting(
             "world-space radius R: the membership reaches 1 (fully open) at distance R"),
         gi::SettingDesc::enumeration(
             "membership", obs::membershipNames(), int(obs::Membership::Sqrt),
@@ -109,18 +103,12 @@ class ObscuranceEffect : public gi::Effect {
          false},
         {"filter", SettingType::Bool, 1, 0, 1,
          "depth-aware 4x4 box filter of the interleaved estimate", true},
-        {"interleave", SettingType::Bool, 1, 0, 1,
-         "rotate the sample set in a 4x4 pixel pattern (16 rotations) for the filter to average",
-         false},
+        gi::interleaveSetting("rotate the sample set in a 4x4 pixel pattern (16 rotations) for the "
+                              "filter to average"),
     };
   }
 
   void prepare(gi::EffectContext& ctx, const gi::SettingValues& s) override {
-    h_.radius = s.handle<double>("radius");
-    h_.bias = s.handle<double>("bias");
-    h_.membership = s.handle<int>("membership");
-    h_.samples = s.handle<int>("samples");
-    h_.interleave = s.handle<bool>("interleave");
     gi::vk::Context& vk = ctx.vulkan();
     vk.requireWorkgroup(kGroupX, kGroupY, "obscurance");
     using obs::Uniforms;
@@ -129,8 +117,7 @@ class ObscuranceEffect : public gi::Effect {
     radiance_ = mode == int(obs::Transfer::Radiance);
     if (radiance_)
       radiancePipeline_ = gi::vk::Pipeline::compute(
-          vk, {"obscurance: obscurance_radiance.comp",
-               words(std::begin(obscurance_radiance_comp), std::end(obscurance_radiance_comp))});
+          vk, gi::computeShader("obscurance: obscurance_radiance.comp", obscurance_radiance_comp));
     const gi::vk::BlockChecks params{
         {},
         {{"obs", gi::vk::cppBlock<Uniforms>(
@@ -139,28 +126,22 @@ class ObscuranceEffect : public gi::Effect {
                       GI_BLOCK_MEMBER(Uniforms, filterTolerance), GI_BLOCK_MEMBER(Uniforms, guard),
                       GI_BLOCK_MEMBER(Uniforms, rotation), GI_BLOCK_MEMBER(Uniforms, kernel)})}}};
     main_ = gi::vk::Pipeline::compute(
-        vk,
-        {"obscurance: obscurance.comp",
-         words(std::begin(obscurance_comp), std::end(obscurance_comp)),
-         {uint32_t(s.integer("samples")), uint32_t(s.integer("points_per_ray")), uint32_t(mode)},
-         params});
+        vk, gi::computeShader("obscurance: obscurance.comp", obscurance_comp,
+                              {uint32_t(s.integer("samples")),
+                               uint32_t(s.integer("points_per_ray")), uint32_t(mode)},
+                              params));
     const std::vector<uint32_t> filterSpec = {uint32_t(mode),
                                               uint32_t(filter_ ? kFilterRadius : 0)};
     filterX_ = gi::vk::Pipeline::compute(
-        vk, {"obscurance: obscurance_filter.comp",
-             words(std::begin(obscurance_filter_comp), std::end(obscurance_filter_comp)),
-             filterSpec, params});
+        vk, gi::computeShader("obscurance: obscurance_filter.comp", obscurance_filter_comp,
+                              filterSpec, params));
     resolve_ = gi::vk::Pipeline::compute(
-        vk, radiance_ ? gi::vk::ComputeDesc{"obscurance: obscurance_resolve_ambient.comp",
-                                            words(std::begin(obscurance_resolve_ambient_comp),
-                                                  std::end(obscurance_resolve_ambient_comp)),
-                                            filterSpec, params}
-                      : gi::vk::ComputeDesc{"obscurance: obscurance_resolve.comp",
-                                            words(std::begin(obscurance_resolve_comp),
-                                                  std::end(obscurance_resolve_comp)),
-                                            filterSpec, params});
-    uniforms_.create(vk);
-    uniforms_.invalidate();  // the sample count may have changed
+        vk, radiance_ ? gi::computeShader("obscurance: obscurance_resolve_ambient.comp",
+                                          obscurance_resolve_ambient_comp, filterSpec, params)
+                      : gi::computeShader("obscurance: obscurance_resolve.comp",
+                                          obscurance_resolve_comp, filterSpec, params));
+    uniforms_.prepare(vk, s, {"radius", "bias", "membership", "samples", "interleave"});
+    uniforms_.block().invalidate();  // the sample count may have changed
   }
 
   void addPasses(gi::FrameGraph& graph, gi::EffectContext& ctx,
@@ -210,10 +191,14 @@ class ObscuranceEffect : public gi::Effect {
                              gi::TextureUsage::StorageWrite);
         },
         [this, io, values = &settings, frame, nearest](gi::PassContext& pc) {
-          upload(*values);
+          // The sample set is rebuilt only when a setting it depends on changed.
+          const VkBuffer params = uniforms_.upload(*values, [](const auto& k) {
+            return obs::makeUniforms(k[0], k[1], obs::Membership(int(k[2])), int(k[3]),
+                                     k[4] != 0.0);
+          });
           gi::vk::DescriptorWriter w(main_);
           w.buffer("Frame", frame)
-              .buffer("obs", uniforms_.handle())
+              .buffer("obs", params)
               .texture("gDepth", pc.view(io->depth), nearest)
               .texture("giGBuffer", pc.view(io->gbuffer), nearest)
               .texture("gRadiance", pc.view(io->sent), nearest)
@@ -264,24 +249,9 @@ class ObscuranceEffect : public gi::Effect {
   }
 
  private:
-  // The sample set is rebuilt only when a setting it depends on changed.
-  void upload(const gi::SettingValues& s) {
-    const std::array<double, 5> key = {s[h_.radius], s[h_.bias], double(s[h_.membership]),
-                                       double(s[h_.samples]), s[h_.interleave] ? 1.0 : 0.0};
-    uniforms_.update(key, [&] {
-      return obs::makeUniforms(key[0], key[1], obs::Membership(int(key[2])), int(key[3]),
-                               key[4] != 0.0);
-    });
-  }
-
   gi::vk::Pipeline main_, filterX_, resolve_, radiancePipeline_;
   bool filter_ = true, radiance_ = false;
-  struct Handles {  // typed settings, found by name once in prepare()
-    gi::Setting<double> radius, bias;
-    gi::Setting<int> membership, samples;
-    gi::Setting<bool> interleave;
-  } h_;
-  gi::UniformBlock<obs::Uniforms> uniforms_;  // rewritten only when a setting changed
+  gi::SettingUniforms<obs::Uniforms, 5> uniforms_;  // rewritten only when a setting changed
 };
 
 }  // namespace

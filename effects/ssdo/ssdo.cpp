@@ -30,6 +30,7 @@
 
 #include "gi/effect.h"
 #include "gi/effect_registry.h"
+#include "gi/effect_shader.h"
 #include "gi/lights.h"
 #include "gi/lit_surface.h"
 #include "gi/uniform_block.h"
@@ -64,8 +65,8 @@ template <size_t N>
 gi::vk::ComputeDesc shader(const char* name, const uint32_t (&words)[N],
                            std::vector<uint32_t> constants, bool readsParams = true) {
   using gi::ssdo::Uniforms;
-  gi::vk::ComputeDesc d{
-      std::string("ssdo: ") + name, {std::begin(words), std::end(words)}, std::move(constants)};
+  gi::vk::ComputeDesc d =
+      gi::computeShader(std::string("ssdo: ") + name, words, std::move(constants));
   if (readsParams)
     d.blocks.uniforms = {
         {"ssdo",
@@ -94,24 +95,17 @@ std::array<uint32_t, 2> lightMasks(const std::vector<gi::LightInfo>& lights) {
 class SsdoEffect : public gi::Effect {
  public:
   gi::EffectInfo info() const override {
-    gi::EffectInfo i;
-    i.name = "ssdo";
-    i.version = "1.0";
-    i.description =
-        "screen-space directional occlusion of the environment with one indirect bounce "
-        "(Ritschel et al. 2009; 16 interleaved sample sets, geometry-aware blur)";
-    i.stage = gi::EffectStage::BeforeLighting;
-    i.reads = {res::kDepth,
-               res::kGBuffer,
-               res::kLights,
-               res::kShadowViews,
-               res::kShadowMaps,
-               res::kEnvironmentMap,
-               res::kEnvironmentSampling};
-    i.writes = {res::kAmbient, res::kIndirect, res::kContactShadow, res::kDirectLight};
-    i.debugView = res::kAmbient;
-    i.estimates = gi::GroundTruth::IndirectLight;
-    return i;
+    return {.name = "ssdo",
+            .version = "1.0",
+            .description =
+                "screen-space directional occlusion of the environment with one indirect bounce "
+                "(Ritschel et al. 2009; 16 interleaved sample sets, geometry-aware blur)",
+            .stage = gi::EffectStage::BeforeLighting,
+            .reads = {res::kDepth, res::kGBuffer, res::kLights, res::kShadowViews, res::kShadowMaps,
+                      res::kEnvironmentMap, res::kEnvironmentSampling},
+            .writes = {res::kAmbient, res::kIndirect, res::kContactShadow, res::kDirectLight},
+            .debugView = res::kAmbient,
+            .estimates = gi::GroundTruth::IndirectLight};
   }
 
   std::vector<gi::SettingDesc> settings() const override {
