@@ -17,7 +17,8 @@
 // 11: GpuScene::drawGBuffer takes an optional culling matrix.
 // 12: vk::Pipeline holds its shader's reflected interface (bindings by name, checked blocks);
 //     SettingValues stores values per declaration index (typed Setting<T> handles).
-#define GI_EFFECT_ABI_VERSION 12u
+// 13: ImagePass gained `publish` (its layout grew).
+#define GI_EFFECT_ABI_VERSION 13u
 
 namespace gi {
 

@@ -29,6 +29,9 @@ struct ImagePass {
   // Called while the pass records: bind further resources, push constants (pipeline.push).
   // Read uniform-only settings here (the effect's SettingValues outlive the graph).
   std::function<void(vk::DescriptorWriter&, PassContext&)> bind;
+  // Blackboard names the output is published under once the pass is added (e.g. its own name
+  // for --view and resources::kLit for the passes after it); empty: publish it yourself.
+  std::vector<std::string> publish;
 };
 
 // Adds the pass and returns the output texture.

@@ -28,6 +28,7 @@ TextureHandle addImagePass(FrameGraph& graph, EffectContext& ctx, ImagePass pass
         if (p->bind) p->bind(w, pc);
         pc.dispatch(*p->pipeline, w, pc.extent(io->out), p->groupX, p->groupY);
       });
+  for (const std::string& name : p->publish) bb.put(name, io->out);
   return io->out;
 }
 
