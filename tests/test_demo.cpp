@@ -529,5 +529,35 @@ TEST(Demo, BadScriptFailsWithOneLineBeforeAnyWindow) {
   EXPECT_NE(none.output.find("no display available: "), std::string::npos) << none.output;
 }
 
+// Every numeric argument of a script has a range (a script always ends, a camera stays finite,
+// a window stays a size Vulkan can have), and an empty script is an error: each refused before
+// any window with the line named.
+TEST(Demo, ScriptNumbersAreRangedAndAnEmptyScriptIsRefused) {
+  if (!fs::exists(test::binPath("gi-demo"))) GTEST_SKIP() << "gi-demo not built";
+  const std::string dir = test::makeTempDir("demo_script_ranges");
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"frames -1", "line 1: frames: argument 1 expects an integer in [1, 1e5], got '-1'"},
+      {"frames 1e10", "line 1: frames: argument 1 expects an integer in [1, 1e5]"},
+      {"frames 2.5", "line 1: frames: argument 1 expects an integer"},
+      {"accuracy ssao 0", "line 1: accuracy: argument 2 expects an integer in [1, 65536]"},
+      {"resize -1 -1", "line 1: resize: argument 1 expects an integer in [16, 16384]"},
+      {"resize 0 0", "line 1: resize: argument 1 expects an integer in [16, 16384]"},
+      {"look 1e308 0", "line 1: look: argument 1 expects a number in [-1e5, 1e5]"},
+      {"camera 1e308 0 0 0 0", "line 1: camera: argument 1 expects a number"},
+      {"camera 0 0 0 0 91", "line 1: camera: argument 5 expects a number in [-90, 90]"},
+      {"key w 0", "line 1: key: argument 2 expects an integer in [1, 1e5]"},
+      {"# only a comment", "the script has no step"},
+      {"", "the script has no step"},
+  };
+  for (const auto& [text, expected] : cases) {
+    const std::string script = writeScript(dir, text + "\n");
+    auto r = test::runCommand("env -u DISPLAY -u WAYLAND_DISPLAY " + test::binPath("gi-demo") +
+                              " --scene default --script " + script);
+    EXPECT_EQ(r.exitCode, 1) << text << ": " << r.output;
+    EXPECT_NE(r.output.find(expected), std::string::npos) << text << ": " << r.output;
+    EXPECT_EQ(r.output.find("no display"), std::string::npos) << text << ": checked first";
+  }
+}
+
 }  // namespace
 }  // namespace gi
