@@ -3,14 +3,18 @@
 // writes, and the check of those declarations against what an effect's passes really do.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cmath>
 #include <fstream>
 
 #include "gi/effect.h"
+#include "gi/effect_config.h"
 #include "gi/effect_registry.h"
 #include "gi/errors.h"
 #include "gi/renderer.h"
 #include "gi/scene_io.h"
+#include "test_support.h"
 #include "vulkan_fixture.h"
 
 namespace gi {
@@ -297,6 +301,49 @@ TEST_F(LightingCompositionTest, DirectLightReplacesTheLightsAndRefusesContactSha
 
 // A declared optional lighting input may stay unpublished (an effect's setting turns it off):
 // the neutral fallback stands in, bit for bit; any other declared write must be published.
+// Guard GI_MAX_RADIANCE (common.glsl): legal extremes (an environment, a light and an emission
+// of ~1e38, each inside its declared range) give the lit image's brightest finite value, 65504,
+// never inf or NaN, with no effect and with effects that sum light of their own.
+TEST_F(LightingCompositionTest, LegalExtremeRadianceStaysFinite) {
+  const test::TempDir dir("extreme_radiance");
+  EffectRegistry registry;
+  registry.scanDirectory(test::binPath("plugins"));
+  for (const char* environment : {R"("type": "sky", "intensity": 1e38)",
+                                  R"("type": "constant", "color": [1, 1, 1], "intensity": 1e38)"}) {
+    const std::string path = dir.write("scene.json", std::string(R"({
+      "models": [ { "primitive": "plane", "size": 20 },
+                  { "primitive": "box", "size": [1, 1, 1], "translation": [0, 0.5, 0],
+                    "material": { "emission": [3.4e38, 3.4e38, 3.4e38] } } ],
+      "lights": [ { "type": "point", "position": [1, 2, 1], "intensity": 3.4e38 } ],
+      "camera": { "position": [0, 3, 5], "target": [0, 0, 0] },
+      "environment": { )") + environment + " } }");
+    const Scene scene = loadScene(path);
+    for (const std::vector<std::string>& effects :
+         {std::vector<std::string>{}, {"ssao"}, {"ssdo"}, {"ism"}}) {
+      RenderRequest request;
+      request.overrides.effects = effects;
+      RenderSettings base;
+      base.width = 48;
+      base.height = 36;
+      base.keepForReadback = {resources::kLit};
+      Renderer renderer(ctx(), scene, configureRender(scene, registry, request, base), &registry);
+      renderer.renderFrame();
+      const ImageRGBA32F lit = renderer.readTarget(resources::kLit);
+      float brightest = 0.0f;
+      size_t nonFinite = 0;
+      for (size_t i = 0; i < lit.pixels.size(); ++i) {
+        if (i % 4 == 3) continue;
+        nonFinite += !std::isfinite(lit.pixels[i]);
+        if (std::isfinite(lit.pixels[i])) brightest = std::max(brightest, lit.pixels[i]);
+      }
+      const std::string what = std::string(environment) + ", effects " +
+                               (effects.empty() ? std::string("none") : effects[0]);
+      EXPECT_EQ(nonFinite, 0u) << what;
+      EXPECT_EQ(brightest, 65504.0f) << what;
+    }
+  }
+}
+
 TEST_F(LightingCompositionTest, DeclaredOptionalInputsMayStayUnpublished) {
   const Scene scene = loadScene("default");
   EffectRegistry reg;

@@ -36,6 +36,15 @@ vec3 safeNormalize(vec3 v, vec3 fallback) {
   return (len2 > 1e-30 && !isinf(len2) && !isnan(len2)) ? v * inversesqrt(len2) : fallback;
 }
 
+// Guard: the lit image is RGBA16F, whose largest value is 65504 (above it a half float is inf).
+// Radiance is clamped to +-GI_MAX_RADIANCE where it is stored, so a legal extreme (an
+// environment, light or emission of 1e38) gives the brightest finite value, never inf; a NaN
+// reads 0. (Values in range pass unchanged.)
+const float GI_MAX_RADIANCE = 65504.0;
+vec3 giClampRadiance(vec3 c) {
+  return mix(clamp(c, vec3(-GI_MAX_RADIANCE), vec3(GI_MAX_RADIANCE)), vec3(0.0), isnan(c));
+}
+
 // View-space position from a reverse-Z depth sample and the pixel's UV (0..1, y down).
 vec3 viewPositionFromDepth(mat4 invProj, vec2 uv, float depth) {
   vec4 clip = vec4(uv * 2.0 - 1.0, depth, 1.0);

@@ -77,7 +77,7 @@ void main() {
       sky = frame.skyGround.rgb * frame.skyZenith.w;
     else
       sky = proceduralSkyRadiance(frame, viewDirWorld);
-    imageStore(outLit, p, vec4(sky, 1.0));
+    imageStore(outLit, p, vec4(giClampRadiance(sky), 1.0));
     return;
   }
   vec3 pos = viewPositionFromDepth(frame.invProj, uv, depth);
@@ -110,5 +110,5 @@ void main() {
   }
   if (kIndirectInput != 0)
     color += max(optionalInput(indirectTexture, kIndirectInput, p, uv).rgb, vec3(0.0));
-  imageStore(outLit, p, vec4(color, 1.0));
+  imageStore(outLit, p, vec4(giClampRadiance(color), 1.0));
 }
