@@ -303,6 +303,8 @@ TEST(BenchCli, BadInputFailsBeforeRendering) {
       {"--effects none,ssao+ssao", "'ssao' appears twice in 'ssao+ssao'"},
       {"--width 1.5", "--width: expects an integer in [1, 16384], got '1.5'"},
       {"--ref-seed 0x20", "which is hexadecimal"},
+      {"--effects ssao+", "'ssao+' has an empty effect name"},
+      {"--effects none,+ssao", "'+ssao' has an empty effect name"},
   };
   for (const auto& [args, needle] : cases) {
     auto r = test::runCommand(
@@ -314,6 +316,33 @@ TEST(BenchCli, BadInputFailsBeforeRendering) {
     EXPECT_FALSE(fs::exists(out)) << args << ": output written";
     EXPECT_FALSE(fs::exists(dir + "/cache")) << args << ": references computed";
   }
+  // The hard-case sweep's options: none dropped silently, all checked before any render.
+  const std::vector<std::pair<std::string, std::string>> hard = {
+      {"--cases ''", "--cases: no case given"},
+      {"--effects none --set ssao.radius=1", "'ssao' is neither 'engine' nor an effect of the"},
+      {"--set nosuch.radius=1", "'nosuch' is neither 'engine' nor an effect of the sweep"},
+      {"--effects none --set engine.no_such_key=1", "no_such_key"},
+      {"--effects none --set engine.exposure=-1", "exposure"},
+  };
+  for (const auto& [args, needle] : hard) {
+    auto r = test::runCommand(bench("--hard-cases " + args + " --out '" + out + "'"));
+    EXPECT_NE(r.exitCode, 0) << args << ": " << r.output;
+    EXPECT_LT(r.exitCode, 128) << args << ": " << r.output;
+    EXPECT_NE(r.output.find(needle), std::string::npos) << args << ": " << r.output;
+    EXPECT_FALSE(fs::exists(out)) << args << ": output written";
+  }
+  // A scene whose camera sees no geometry has nothing to score: an error naming it, not a
+  // perfect NRMSE 0 / SSIM 1 over zero pixels.
+  const std::string empty = dir + "/sees_nothing.json";
+  std::ofstream(empty) << R"({ "models": [ { "primitive": "plane", "size": 1,
+      "translation": [0, -100, 0] } ], "camera": { "position": [0, 0, 5], "target": [0, 0, 10] } })";
+  auto nothing = test::runCommand(bench("--quick --no-progress --scenes '" + empty + "' --cache '" +
+                                        dir + "/cache' --out '" + out + "'"));
+  EXPECT_EQ(nothing.exitCode, 1) << nothing.output;
+  EXPECT_NE(nothing.output.find(empty + ": no pixel is geometry in both"), std::string::npos)
+      << nothing.output;
+  EXPECT_FALSE(fs::exists(out));
+  fs::remove_all(dir + "/cache");
   // An output folder that cannot be written is found before the sweep, not after it.
   for (const char* bad : {"/sys/gi-bench-out", "/sys"}) {
     auto r =

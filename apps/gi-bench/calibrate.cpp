@@ -195,7 +195,7 @@ int runCalibrate(const Options& o) {
       measureAll(ctx, s.registry, jobs, o, false, [&](size_t j, const Measurement& m) {
         CalibrationItem& it = items[owner[j].first];
         it.scores[owner[j].second] =
-            score(m, it.cmp.target, refs.at(ReferenceKey{0, it.cmp.target}), o);
+            score(m, it.cmp.target, refs.at(ReferenceKey{0, it.cmp.target}), o, s.scenes[0].name);
         bar.step(it.labels[owner[j].second]);
       });
   const bool bySsim = o.metric == "ssim";

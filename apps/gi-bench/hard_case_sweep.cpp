@@ -23,8 +23,6 @@ int runHardCaseSweep(const Options& o) {
   if (o.effects)
     for (const std::string& item : *o.effects) hc.effects.push_back(item);
   gi::vk::Context ctx = makeContext(o);
-  std::error_code ec;
-  fs::create_directories(o.out, ec);
   std::string csv =
       "case,effect,textures,undecoded,values,non_finite,sky_fraction,flicker,seconds,problems\n";
   int failed = 0;

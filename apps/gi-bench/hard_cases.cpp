@@ -10,6 +10,7 @@
 
 #include "gi/effect.h"
 #include "gi/effect_config.h"
+#include "gi/engine_settings.h"
 #include "gi/environment.h"
 #include "gi/errors.h"
 #include "gi/gbuffer.h"
@@ -350,6 +351,21 @@ std::vector<HardCaseRun> runHardCases(vk::Context& ctx, const EffectRegistry& re
     cases = std::move(chosen);
   }
 
+  // Every --set names the engine or an effect that runs, and a key and value it takes: checked
+  // now through the frame set-up every run uses, so none is dropped or fails half-way.
+  for (const std::string& set : options.sets) {
+    const std::string owner = set.substr(0, set.find('.'));
+    if (owner != kEngineSettingsOwner &&
+        std::find(effects.begin(), effects.end(), owner) == effects.end())
+      throw Error(ErrorKind::Usage, "--set",
+                  "'" + set + "': '" + owner + "' is neither 'engine' nor an effect of the sweep");
+    RenderRequest check;
+    check.overrides.effects = owner == kEngineSettingsOwner ? std::vector<std::string>{}
+                                                            : std::vector<std::string>{owner};
+    check.overrides.sets = {set};
+    configureRender(cases.front().build(), registry, check);
+  }
+
   Environment map;
   if (!options.environmentMap.empty()) loadEnvironmentMap(map, options.environmentMap);
 
@@ -362,9 +378,11 @@ std::vector<HardCaseRun> runHardCases(vk::Context& ctx, const EffectRegistry& re
       HardCaseRun run{hc.name, effect};
       EffectOverrides ov;
       ov.effects = effect == "none" ? std::vector<std::string>{} : std::vector{effect};
-      // Only the settings of the effect that runs (the others' are refused).
+      // The engine's settings, and those of the effect that runs (the others' are refused).
       for (const std::string& set : options.sets)
-        if (set.rfind(effect + ".", 0) == 0) ov.sets.push_back(set);
+        if (set.rfind(effect + ".", 0) == 0 ||
+            set.rfind(kEngineSettingsOwner + std::string("."), 0) == 0)
+          ov.sets.push_back(set);
       RenderSettings base;
       base.width = options.width;
       base.height = options.height;

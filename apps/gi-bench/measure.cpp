@@ -18,6 +18,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "gi/errors.h"
 #include "stats.h"
 
 namespace gi_bench {
@@ -219,7 +220,7 @@ std::vector<unsigned char> comparedMask(const Measurement& m, const Reference& r
 }
 
 Scores score(const Measurement& m, const ReferenceSpec& spec, const Reference& reference,
-             const Options& o) {
+             const Options& o, const std::string& scene) {
   const size_t n = size_t(o.width) * size_t(o.height);
   const std::vector<unsigned char> mask = comparedMask(m, reference, o);
   const int w = int(o.width), h = int(o.height);
@@ -236,6 +237,10 @@ Scores score(const Measurement& m, const ReferenceSpec& spec, const Reference& r
     s.metrics.ssim =
         gi::bench::ssim(gi::bench::reinhard(test), gi::bench::reinhard(truth), mask, 1.0);
   }
+  if (s.metrics.pixels == 0)
+    throw gi::Error(gi::ErrorKind::InvalidData, scene,
+                    "no pixel is geometry in both the frame and the reference (an empty scene, or "
+                    "a camera that sees nothing): there is nothing to score");
   return s;
 }
 

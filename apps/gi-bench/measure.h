@@ -47,8 +47,10 @@ std::vector<Measurement> measureAll(
     gi::vk::Context& ctx, const gi::EffectRegistry& registry, const std::vector<RenderJob>& jobs,
     const Options& o, bool floorPass,
     const std::function<void(size_t, const Measurement&)>& scoreNow);
+// Throws gi::Error naming `scene` when no pixel is geometry in both the frame and the
+// reference (an empty scene, a camera that sees nothing): nothing would be scored.
 Scores score(const Measurement& m, const ReferenceSpec& spec, const Reference& reference,
-             const Options& o);
+             const Options& o, const std::string& scene);
 // The part of the error against the target that the declared quantity's own distance from it
 // explains (metrics.h QuantityGap); nullopt when the effect declares its target.
 std::optional<gi::bench::QuantityGap> gapOf(const Measurement& m, const Comparison& cmp,

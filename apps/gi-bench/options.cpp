@@ -67,7 +67,8 @@ const char* kUsage =
     "                        sees noise and interleave patterns that a biased estimator's\n"
     "                        NRMSE hides (SSAO's NRMSE is ~flat from 1 to 64 samples)\n"
     "  --cases A,B           --hard-cases: only these cases (default: all)\n"
-    "  --set E.K=V           --hard-cases: a setting of effect E for its runs (repeatable)\n"
+    "  --set E.K=V           --hard-cases: a setting of effect E for its runs, or of the\n"
+    "                        engine (engine.K=V) for every run (repeatable)\n"
     "  --environment-map F   --hard-cases: every case under this equirect HDR map\n"
     "  --no-progress         no progress lines on stderr\n"
     "  --validation          Vulkan validation layers (also GI_VALIDATION=1)\n"
@@ -148,9 +149,10 @@ Options parseArgs(int argc, char** argv) {
       o.quick = true;
     else if (a.is("--hard-cases"))
       o.hardCases = true;
-    else if (a.is("--cases"))
+    else if (a.is("--cases")) {
       o.cases = a.list();
-    else if (a.is("--set"))
+      if (o.cases.empty()) a.fail("no case given (leave the option out for every case)");
+    } else if (a.is("--set"))
       o.sets.push_back(a.value());
     else if (a.is("--environment-map"))
       o.environmentMap = a.value();

@@ -185,6 +185,9 @@ std::vector<std::string> effectItems(const Options& o, const gi::EffectRegistry&
     items = {registry.has("ssao") ? "ssao" : "none"};
   if (items.empty()) items = {"none"};
   for (const std::string& item : items) {
+    if (item != "none" && (item.empty() || item.front() == '+' || item.back() == '+' ||
+                           item.find("++") != std::string::npos))
+      usageError("--effects", "'" + item + "' has an empty effect name (sets join names with '+')");
     const std::vector<std::string> set = splitPlus(item);
     for (size_t k = 0; k < set.size(); ++k)
       if (std::find(set.begin(), set.begin() + long(k), set[k]) != set.begin() + long(k))

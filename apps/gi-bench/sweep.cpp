@@ -191,10 +191,11 @@ int runSweep(const Options& o) {
   const std::vector<Measurement> measured =
       measureAll(ctx, s.registry, jobs, o, true, [&](size_t i, const Measurement& m) {
         const Config& c = configs[i];
-        vsTargets[i] =
-            score(m, c.comparison.target, refs.at(ReferenceKey{c.scene, c.comparison.target}), o);
+        const std::string& scene = s.scenes[c.scene].name;
+        vsTargets[i] = score(m, c.comparison.target,
+                             refs.at(ReferenceKey{c.scene, c.comparison.target}), o, scene);
         vsDeclareds[i] = score(m, c.comparison.declared,
-                               refs.at(ReferenceKey{c.scene, c.comparison.declared}), o);
+                               refs.at(ReferenceKey{c.scene, c.comparison.declared}), o, scene);
         gaps[i] = gapOf(m, c.comparison, refs.at(ReferenceKey{c.scene, c.comparison.target}),
                         refs.at(ReferenceKey{c.scene, c.comparison.declared}), o);
         bar.step(s.scenes[c.scene].name + " " + c.effectLabel + " " + c.params);
