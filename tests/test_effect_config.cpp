@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <stdexcept>
 
 #include "gi/effect.h"
 #include "gi/effect_config.h"
@@ -330,6 +331,71 @@ TEST_F(EffectGraphTest, UniformOnlySettingsDoNotRecompile) {
   EXPECT_EQ(ConstantAO::prepares, preparesBefore + 1);
   r->renderFrame();
   EXPECT_EQ(r->readTarget("ao").width, 32);
+}
+
+// Plugin code that throws, of any type, in any call the renderer makes: a gi::Error naming the
+// effect and the call, and the renderer keeps its previous configuration and goes on.
+class Thrower : public Effect {
+ public:
+  EffectInfo info() const override {
+    return {"thrower", "1", "throws where told (test)", EffectStage::BeforeLighting, {}, {}, ""};
+  }
+  std::vector<SettingDesc> settings() const override {
+    SettingDesc where = SettingDesc::enumeration(
+        "where", {"nowhere", "prepare", "addPasses", "update"}, 0, "where it throws", true);
+    return {where, {"an_int", SettingType::Bool, 0, 0, 1, "throw an int", true}};
+  }
+  void prepare(EffectContext&, const SettingValues& s) override { maybeThrow(s, "prepare"); }
+  void addPasses(FrameGraph&, EffectContext&, const SettingValues& s) override {
+    maybeThrow(s, "addPasses");
+  }
+  void update(EffectContext&, const SettingValues& s) override { maybeThrow(s, "update"); }
+
+ private:
+  static void maybeThrow(const SettingValues& s, const std::string& call) {
+    if (s.option("where") != call) return;
+    if (s.flag("an_int")) throw 42;
+    throw std::runtime_error("out of cheese");
+  }
+};
+
+TEST_F(EffectGraphTest, AnEffectThatThrowsIsAnErrorNamingItAndTheCall) {
+  EffectRegistry reg = testRegistry();
+  reg.add([] { return std::make_unique<Thrower>(); }, "test");
+  const Scene scene = loadScene("default");
+  auto config = [&](const std::string& where, bool anInt) {
+    SettingValues v = reg.defaultSettings("thrower");
+    v.set("where", where, "test");
+    v.set("an_int", anInt, "test");
+    return EffectConfig{"thrower", v};
+  };
+  RenderSettings rs;
+  rs.width = 32;
+  rs.height = 24;
+  for (const bool anInt : {false, true}) {
+    const std::string why = anInt ? "not a std::exception" : "out of cheese";
+    rs.effects = {config("prepare", anInt)};
+    test::expectError([&] { Renderer(ctx(), scene, rs, &reg); }, ErrorKind::InvalidData,
+                      {"effect 'thrower' failed in prepare()", why});
+    rs.effects = {config("addPasses", anInt)};
+    test::expectError([&] { Renderer(ctx(), scene, rs, &reg); }, ErrorKind::InvalidData,
+                      {"effect 'thrower' failed in addPasses()", why});
+    rs.effects = {config("update", anInt)};
+    Renderer updating(ctx(), scene, rs, &reg);
+    test::expectError([&] { updating.renderFrame(); }, ErrorKind::InvalidData,
+                      {"effect 'thrower' failed in update()", why});
+    // Switched in live, it is refused and the renderer keeps what it had.
+    rs.effects = {{"const_ao", reg.defaultSettings("const_ao")}};
+    Renderer live(ctx(), scene, rs, &reg);
+    live.renderFrame();
+    test::expectError([&] { live.setEffects({config("prepare", anInt)}); }, ErrorKind::InvalidData,
+                      {"failed in prepare()"});
+    test::expectError([&] { live.setEffects({config("addPasses", anInt)}); },
+                      ErrorKind::InvalidData, {"failed in addPasses()"});
+    live.renderFrame();
+    EXPECT_EQ(live.settings().effects.size(), 1u);
+    EXPECT_EQ(live.settings().effects[0].name, "const_ao");
+  }
 }
 
 TEST_F(EffectGraphTest, UnknownViewListsTheAvailableOnes) {

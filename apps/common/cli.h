@@ -119,6 +119,9 @@ int runMain(const char* app, Body&& body) {
   } catch (const std::exception& e) {
     std::fprintf(stderr, "%s: error: %s\n", app, e.what());
     return 1;
+  } catch (...) {  // never terminate() with a core dump, whatever was thrown
+    std::fprintf(stderr, "%s: error: an unexpected exception (not a std::exception)\n", app);
+    return 1;
   }
 }
 

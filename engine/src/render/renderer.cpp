@@ -173,11 +173,37 @@ struct Renderer::Impl : EffectContext {
 
   // ---- state --------------------------------------------------------------------------------
 
+  // Runs `call` of an effect's code: whatever it throws (of any type) becomes a gi::Error naming
+  // the effect, its module and the call, so a plugin cannot take the app down; the callers'
+  // undo paths then keep the previous configuration.
+  template <class F>
+  void guarded(const std::string& effect, const char* call, F&& f) {
+    auto fail = [&](const std::string& why) {
+      const std::string origin =
+          registry && registry->has(effect) ? registry->origin(effect) : "built-in";
+      throw Error(ErrorKind::InvalidData, origin,
+                  "effect '" + effect + "' failed in " + call + ": " + why);
+    };
+    try {
+      f();
+    } catch (const Error&) {
+      throw;  // the engine's own errors name what they are about
+    } catch (const std::exception& e) {
+      fail(e.what());
+    } catch (...) {
+      fail("it threw something that is not a std::exception");
+    }
+  }
+  void prepareEffect(ActiveEffect& a, const SettingValues& values) {
+    guarded(a.info.name, "prepare()", [&] { a.effect->prepare(*this, values); });
+  }
+
   ActiveEffect createEffect(const EffectConfig& e) {
     if (!registry)
       throw Error(ErrorKind::Usage, "", "effect '" + e.name + "' requested but no registry given");
-    ActiveEffect a{registry->create(e.name), registry->info(e.name), e.settings};
-    a.effect->prepare(*this, a.settings);
+    ActiveEffect a{nullptr, registry->info(e.name), e.settings};
+    guarded(e.name, "its constructor", [&] { a.effect = registry->create(e.name); });
+    prepareEffect(a, a.settings);
     return a;
   }
 
@@ -238,7 +264,7 @@ struct Renderer::Impl : EffectContext {
   void addChecked(Effect& e, const EffectInfo& info, const SettingValues& values) {
     Blackboard& bb = graph.blackboard();
     bb.startTracking();
-    e.addPasses(graph, *this, values);
+    guarded(info.name, "addPasses()", [&] { e.addPasses(graph, *this, values); });
     // An optional lighting input may stay unpublished: its neutral fallback stands in (e.g.
     // SSDO's contact_shadow when off).
     checkEffectResources(info, bb.lookedUp(), bb.published(), isOptionalInput);
@@ -351,7 +377,8 @@ struct Renderer::Impl : EffectContext {
     sceneGpu->setCulling(settings.cullDraws);
     sceneGpu->beginFrame();
     updateFrameUniforms();
-    for (ActiveEffect& a : effects) a.effect->update(*this, a.settings);
+    for (ActiveEffect& a : effects)
+      guarded(a.info.name, "update()", [&] { a.effect->update(*this, a.settings); });
     updateViews();
     descriptors.reset();
     timings = submission->run(graph, descriptors, *timer, settings.isolatePasses);
@@ -379,9 +406,9 @@ struct Renderer::Impl : EffectContext {
         dropGraph();
         const SettingValues old = a.settings;
         try {
-          a.effect->prepare(*this, values);
+          prepareEffect(a, values);
         } catch (...) {
-          a.effect->prepare(*this, old);  // the previous settings worked
+          prepareEffect(a, old);  // the previous settings worked
           throw;
         }
       }
@@ -417,7 +444,7 @@ struct Renderer::Impl : EffectContext {
       settings.effects = oldConfigs;
       for (size_t i = 0; i < effects.size(); ++i) {
         effects[i].settings = oldConfigs[i].settings;
-        effects[i].effect->prepare(*this, effects[i].settings);
+        prepareEffect(effects[i], effects[i].settings);
       }
       buildGraph();
     };
@@ -430,7 +457,7 @@ struct Renderer::Impl : EffectContext {
           effects.push_back(createEffect(c));
           continue;
         }
-        if (it->settings.graphDiffers(c.settings)) it->effect->prepare(*this, c.settings);
+        if (it->settings.graphDiffers(c.settings)) prepareEffect(*it, c.settings);
         it->settings = c.settings;
         effects.push_back(std::move(*it));
         it->effect.reset();
