@@ -726,6 +726,9 @@ TEST(SceneInputs, OnlyRegularFilesAreRead) {
   const std::string obj = dir.write("withlib.obj", std::string(kTriangleObj) + "mtllib lib.mtl\n");
   expectError([&] { gi::loadScene(obj); }, gi::ErrorKind::FileNotFound, "lib.mtl",
               "is not a regular file");
+  // ... and so is the OBJ that names it, with its line (both files in the one message).
+  expectError([&] { gi::loadScene(obj); }, gi::ErrorKind::FileNotFound,
+              obj + ": line 5: mtllib lib.mtl: ", "lib.mtl: is not a regular file");
 }
 
 TEST(SceneInputs, SizeLimitAndReader) {

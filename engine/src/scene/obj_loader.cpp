@@ -259,7 +259,14 @@ class ObjReader {
     } else if (kw == "usemtl") {
       currentMaterial_ = materialIndex(restOfLine(line, "usemtl"));
     } else if (kw == "mtllib") {
-      for (size_t i = 1; i < tok.size(); ++i) loadMtl(std::string(tok[i]));
+      // A broken library names the OBJ and its line as well as the library.
+      for (size_t i = 1; i < tok.size(); ++i) {
+        try {
+          loadMtl(std::string(tok[i]));
+        } catch (const Error& e) {
+          err.fail(e.kind(), "mtllib " + std::string(tok[i]) + ": " + e.what());
+        }
+      }
     } else if (kw == "s") {
       long group = 0;
       smoothing_ = (tok.size() >= 2 && parseInt(tok[1], group)) ? group : 0;  // "s off" -> 0
