@@ -398,6 +398,35 @@ TEST_F(EffectGraphTest, AnEffectThatThrowsIsAnErrorNamingItAndTheCall) {
   }
 }
 
+TEST_F(EffectGraphTest, ReadingWhatNobodyPublishedNamesTheEffectPassAndResource) {
+  // An effect that declares and looks up a resource no pass publishes: the error says which
+  // effect, which pass and which name, not just "invalid resource handle".
+  struct Reader : Effect {
+    EffectInfo info() const override {
+      return {
+          "reader", "1", "reads what nobody writes (test)", EffectStage::BeforeLighting, {"nosuch"},
+          {},       ""};
+    }
+    std::vector<SettingDesc> settings() const override { return {}; }
+    void prepare(EffectContext&, const SettingValues&) override {}
+    void addPasses(FrameGraph& g, EffectContext&, const SettingValues&) override {
+      g.addPass(
+          "reader_pass", [&](PassBuilder& b) { b.read(g.blackboard().texture("nosuch")); },
+          [](PassContext&) {});
+    }
+  };
+  EffectRegistry reg;
+  reg.add([] { return std::make_unique<Reader>(); }, "test");
+  const Scene scene = loadScene("default");
+  RenderSettings rs;
+  rs.width = 32;
+  rs.height = 24;
+  rs.effects = {{"reader", reg.defaultSettings("reader")}};
+  test::expectError(
+      [&] { Renderer(ctx(), scene, rs, &reg); }, ErrorKind::Usage,
+      {"effect 'reader', addPasses()", "pass 'reader_pass'", "published by no pass: 'nosuch'"});
+}
+
 TEST_F(EffectGraphTest, UnknownViewListsTheAvailableOnes) {
   expectError([&] { make(scene, {}, "nope"); }, ErrorKind::Usage,
               {"unknown view 'nope'", "normal", "depth"});

@@ -128,7 +128,20 @@ uint32_t FrameGraph::addResource(const std::string& name, bool texture) {
   return uint32_t(resources_.size() - 1);
 }
 
-void FrameGraph::checkCurrent(uint32_t id, uint32_t version, const char* what) const {
+void FrameGraph::checkCurrent(uint32_t id, uint32_t version, const char* what,
+                              const std::string& pass) const {
+  if (id >= resources_.size()) {
+    // Most often a blackboard look-up that found nothing: name what was missing.
+    std::string missing;
+    for (const std::string& name : blackboard_.lookedUp())
+      if (!blackboard_.has(name)) missing += (missing.empty() ? "'" : ", '") + name + "'";
+    throw Error(ErrorKind::Usage, "",
+                "frame graph: pass '" + pass + "' uses an invalid resource handle for " + what +
+                    (missing.empty() ? std::string(" (never created or published)")
+                                     : " (looked up on the blackboard but published by no "
+                                       "pass: " +
+                                           missing + ")"));
+  }
   const Resource& r = resource(id);
   if (version != r.version)
     throw Error(ErrorKind::Usage, "",
@@ -166,7 +179,7 @@ BufferHandle PassBuilder::create(const std::string& name, const BufferDesc& desc
 }
 
 TextureHandle PassBuilder::read(TextureHandle h, TextureUsage usage, const Subresource& sub) {
-  graph_.checkCurrent(h.id, h.version, "a read");
+  graph_.checkCurrent(h.id, h.version, "a read", graph_.passes_[pass_]->name);
   FrameGraph::Access a;
   a.resource = h.id;
   a.version = h.version;
@@ -177,7 +190,7 @@ TextureHandle PassBuilder::read(TextureHandle h, TextureUsage usage, const Subre
 }
 
 BufferHandle PassBuilder::read(BufferHandle h, BufferUsage usage) {
-  graph_.checkCurrent(h.id, h.version, "a read");
+  graph_.checkCurrent(h.id, h.version, "a read", graph_.passes_[pass_]->name);
   FrameGraph::Access a;
   a.resource = h.id;
   a.version = h.version;
@@ -187,7 +200,7 @@ BufferHandle PassBuilder::read(BufferHandle h, BufferUsage usage) {
 }
 
 TextureHandle PassBuilder::write(TextureHandle h, TextureUsage usage, const Subresource& sub) {
-  graph_.checkCurrent(h.id, h.version, "a write");
+  graph_.checkCurrent(h.id, h.version, "a write", graph_.passes_[pass_]->name);
   FrameGraph::Resource& r = *graph_.resources_[h.id];
   if (r.fallback)
     throw Error(ErrorKind::Usage, "",
@@ -204,7 +217,7 @@ TextureHandle PassBuilder::write(TextureHandle h, TextureUsage usage, const Subr
 }
 
 BufferHandle PassBuilder::write(BufferHandle h, BufferUsage usage) {
-  graph_.checkCurrent(h.id, h.version, "a write");
+  graph_.checkCurrent(h.id, h.version, "a write", graph_.passes_[pass_]->name);
   FrameGraph::Access a;
   a.resource = h.id;
   a.version = ++graph_.resources_[h.id]->version;

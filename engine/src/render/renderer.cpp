@@ -186,8 +186,14 @@ struct Renderer::Impl : EffectContext {
     };
     try {
       f();
-    } catch (const Error&) {
-      throw;  // the engine's own errors name what they are about
+    } catch (const Error& e) {
+      // The engine's own errors (a frame-graph or declaration check) get the effect's name
+      // when they do not say it already.
+      const std::string what = e.what();
+      if (what.find("'" + effect + "'") != std::string::npos) throw;
+      const std::string problem =
+          e.file().empty() ? what : what.substr(std::min(what.size(), e.file().size() + 2));
+      throw Error(e.kind(), e.file(), "effect '" + effect + "', " + call + ": " + problem);
     } catch (const std::exception& e) {
       fail(e.what());
     } catch (...) {

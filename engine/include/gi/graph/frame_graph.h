@@ -251,7 +251,7 @@ class FrameGraph {
   struct Owned;  // a persistent or fallback image
 
   uint32_t addResource(const std::string& name, bool texture);
-  void checkCurrent(uint32_t id, uint32_t version, const char* what) const;
+  void checkCurrent(uint32_t id, uint32_t version, const char* what, const std::string& pass) const;
   VkExtent2D resolveExtent(uint32_t id) const;
   void resolveTextures();
   void allocateTransients();
