@@ -13,7 +13,10 @@ std::vector<SettingDesc> engineSettingDescs() {
   };
   return {
       hints({"shadow_map_size", SettingType::Int, double(d.shadowMapSize), 16, 8192,
-             "texels per side of each shadow map (point lights: per cube face)", true},
+             "texels per side of each shadow map (point lights: per cube face); the device "
+             "limits it further: a point light's faces share one 3x2 atlas, which must fit its "
+             "largest image (3 x size <= maxImageDimension2D, e.g. 5461 at 16384)",
+             true},
             0, true),
       {"pcf_radius", SettingType::Int, double(d.pcfRadius), 0, 3,
        "shadow filter: (2r+1)^2 texels per lookup (0: one hard-edged tap)"},
