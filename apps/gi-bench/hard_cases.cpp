@@ -353,6 +353,7 @@ std::vector<HardCaseRun> runHardCases(vk::Context& ctx, const EffectRegistry& re
 
   // Every --set names the engine or an effect that runs, and a key and value it takes: checked
   // now through the frame set-up every run uses, so none is dropped or fails half-way.
+  const Scene sample = cases.front().build();
   for (const std::string& set : options.sets) {
     const std::string owner = set.substr(0, set.find('.'));
     if (owner != kEngineSettingsOwner &&
@@ -363,7 +364,7 @@ std::vector<HardCaseRun> runHardCases(vk::Context& ctx, const EffectRegistry& re
     check.overrides.effects = owner == kEngineSettingsOwner ? std::vector<std::string>{}
                                                             : std::vector<std::string>{owner};
     check.overrides.sets = {set};
-    configureRender(cases.front().build(), registry, check);
+    configureRender(sample, registry, check);
   }
 
   Environment map;

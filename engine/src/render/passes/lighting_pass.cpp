@@ -38,9 +38,11 @@ class LightingPass final : public Effect {
     if (!spirv_.empty()) return;
     spirv_ = vk::loadSpirv("lighting.comp");
     constants_ = vk::reflectSpecializationConstants(spirv_, kShader);
+    const vk::ShaderInterface shader =
+        vk::reflectShader(spirv_, VK_SHADER_STAGE_COMPUTE_BIT, kShader);
     for (const LightingInput& in : kLightingInputs) {
       constant(in.constant);  // the shader must declare each input's constant ...
-      if (!vk::reflectShader(spirv_, VK_SHADER_STAGE_COMPUTE_BIT, kShader).find(in.texture))
+      if (!shader.find(in.texture))
         throw Error(ErrorKind::ShaderInterface, "",  // ... and its sampler
                     std::string(kShader) + " has no sampler '" + in.texture +
                         "' for the optional input '" + in.resource + "'");
