@@ -121,11 +121,7 @@ struct PaddedPush {
 TEST(ShaderInterface, APushConstantMismatchNamesTheOwnerBlockAndMember) {
   const vk::ShaderInterface s = reflected();
   const std::string m = messageOf([&] {
-    vk::checkBlockLayout(
-        s.pushConstants,
-        vk::cppBlock<PackedPush>("PackedPush", {GI_BLOCK_MEMBER(PackedPush, strength),
-                                                GI_BLOCK_MEMBER(PackedPush, tint)}),
-        "my_effect");
+    vk::checkBlockLayout(s.pushConstants, GI_CPP_BLOCK(PackedPush, strength, tint), "my_effect");
   });
   EXPECT_TRUE(contains(m, "my_effect")) << m;
   EXPECT_TRUE(contains(m, "'Push'")) << m;
@@ -137,6 +133,27 @@ TEST(ShaderInterface, APushConstantMismatchNamesTheOwnerBlockAndMember) {
       vk::cppBlock<PaddedPush>(
           "PaddedPush", {GI_BLOCK_MEMBER(PaddedPush, strength), GI_BLOCK_MEMBER(PaddedPush, tint)}),
       "my_effect"));
+}
+
+// GI_CPP_BLOCK is the explicit list: the type's name and size, each named member's offset and
+// size in the order given.
+TEST(ShaderInterface, CppBlockFromMemberNames) {
+  const vk::CppBlock b = GI_CPP_BLOCK(PaddedPush, tint, strength);
+  EXPECT_EQ(b.type, "PaddedPush");
+  EXPECT_EQ(b.size, sizeof(PaddedPush));
+  ASSERT_EQ(b.members.size(), 2u);
+  EXPECT_EQ(b.members[0].name, "tint");
+  EXPECT_EQ(b.members[0].offset, offsetof(PaddedPush, tint));
+  EXPECT_EQ(b.members[0].size, sizeof(glm::vec3));
+  EXPECT_EQ(b.members[1].name, "strength");
+  EXPECT_EQ(b.members[1].offset, 0u);
+  struct Sixteen {
+    float a, b, c, d, e, f, g, h, i, j, k, l, m, n, o, p;
+  };
+  const vk::CppBlock all = GI_CPP_BLOCK(Sixteen, a, b, c, d, e, f, g, h, i, j, k, l, m, n, o, p);
+  ASSERT_EQ(all.members.size(), 16u);
+  EXPECT_EQ(all.members[15].name, "p");
+  EXPECT_EQ(all.members[15].offset, 60u);
 }
 
 TEST(ShaderInterface, MissingExtraAndMissizedMembersAreErrors) {

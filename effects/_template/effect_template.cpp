@@ -2,15 +2,14 @@
 //
 // An effect declares, in one place, what it is (info), what can be tuned (settings) and the
 // frame-graph passes it adds (addPasses). It sees only the engine's public headers. This one
-// runs after lighting: it reads the lit colour, writes a desaturated copy into its own texture
-// and publishes that as the new "lit", so tonemapping (and any later effect) uses it. An
-// effect that runs before lighting would instead publish gi::resources::kAO (ambient
+// has the lit-filter shape (gi/image_pass.h): after lighting, it reads the lit colour, writes a
+// desaturated copy and publishes it as the new "lit", which tonemapping (and any later effect)
+// then uses. Other shapes: an effect before lighting publishes gi::resources::kAO (ambient
 // visibility; gi/screen_space_ao.h has that shape ready), kAmbient (a replacement of the
-// environment term) or kIndirect (indirect light added), which the lighting pass composes.
-// Beyond the G-buffer, EffectContext offers the scene on the GPU (ctx.scene(): draw it from any
-// view), extra views (ctx.createView()), the lights (ctx.lights(), buffers "lights"/
-// "shadow_views", texture "shadow_maps", lights.glsl) and the environment ("environment_map",
-// environment.glsl): see effects/README.md.
+// environment term) or kIndirect (indirect light added), which the lighting pass composes; any
+// pass can be written with gi::addImagePass or FrameGraph::addPass. Beyond the G-buffer,
+// EffectContext offers the scene on the GPU (ctx.scene(): draw it from any view), extra views
+// (ctx.createView()), the lights and the environment: see effects/README.md.
 #include "gi/effect_registry.h"
 #include "gi/effect_shader.h"
 #include "gi/image_pass.h"
@@ -22,18 +21,12 @@ namespace {
 
 class EffectTemplate : public gi::Effect {
  public:
-  // `name` is used by --effects, --view, --set, scenes and presets. `reads` and `writes` list
-  // every blackboard resource the passes look up or publish, checked by the engine on each
-  // graph build; they also order effects (a reader runs after the producer). `gi-render --view
-  // effect_template` shows `debugView`.
+  // The name is used by --effects, --view, --set, scenes and presets. litFilterInfo declares
+  // the reads and writes (checked on every graph build; they also order effects) and the debug
+  // view: `gi-render --view effect_template`. Spelled out, it is an EffectInfo{...}.
   gi::EffectInfo info() const override {
-    return {.name = "effect_template",
-            .version = "0.1",
-            .description = "desaturates the lit colour (template effect)",
-            .stage = gi::EffectStage::AfterLighting,
-            .reads = {gi::resources::kLit},
-            .writes = {gi::resources::kLit, "effect_template"},
-            .debugView = "effect_template"};
+    return gi::litFilterInfo("effect_template", "0.1",
+                             "desaturates the lit colour (template effect)");
   }
 
   // Typed settings (bool, int, float, enum, vec3, color): name, type, default, range, help, and
@@ -52,31 +45,20 @@ class EffectTemplate : public gi::Effect {
   void prepare(gi::EffectContext& ctx, const gi::SettingValues& settings) override {
     pipeline_ = gi::vk::Pipeline::compute(
         ctx.vulkan(),
-        gi::computeShader(
-            "effect_template: effect_template.comp", effect_template_comp, {},
-            {gi::vk::cppBlock<Params>("Params", {GI_BLOCK_MEMBER(Params, strength)})}));
+        gi::computeShader("effect_template: effect_template.comp", effect_template_comp, {},
+                          {GI_CPP_BLOCK(Params, strength)}));
     strength_ = settings.handle<double>("strength");
   }
 
-  // Declares the passes on every graph build: one compute pass over a new texture the size of
-  // the output, reading "lit" as the shader's `litColor` (gi/image_pass.h; FrameGraph::addPass
-  // for anything else), published under both names. `settings` outlives the graph: uniform-only
-  // values are read as the pass records, every frame.
+  // Declares the passes on every graph build. `settings` outlive the graph: uniform-only values
+  // are read as the pass records, every frame.
   void addPasses(gi::FrameGraph& graph, gi::EffectContext& ctx,
                  const gi::SettingValues& settings) override {
-    gi::addImagePass(
-        graph, ctx,
-        {.name = "effect_template",
-         .pipeline = &pipeline_,
-         .inputs = {{gi::resources::kLit, "litColor"}},
-         .output = "effect_template",
-         .outputDesc = {VK_FORMAT_R16G16B16A16_SFLOAT},
-         .outputBinding = "outColor",
-         .bind =
-             [this, values = &settings](gi::vk::DescriptorWriter&, gi::PassContext& pc) {
-               pipeline_.push(pc.cmd(), Params{float((*values)[strength_])});
-             },
-         .publish = {"effect_template", gi::resources::kLit}});
+    gi::addLitFilterPass(
+        graph, ctx, "effect_template", pipeline_,
+        [this, values = &settings](gi::vk::DescriptorWriter&, gi::PassContext& pc) {
+          pipeline_.push(pc.cmd(), Params{float((*values)[strength_])});
+        });
   }
 
  private:

@@ -109,14 +109,8 @@ class AlchemyEffect : public gi::Effect {
               blur = s.integer("blur_radius");
     const gi::vk::BlockChecks params{
         {},
-        {{"params",
-          gi::vk::cppBlock<Uniforms>(
-              "gi::alchemy::Uniforms",
-              {GI_BLOCK_MEMBER(Uniforms, radius), GI_BLOCK_MEMBER(Uniforms, bias),
-               GI_BLOCK_MEMBER(Uniforms, scale), GI_BLOCK_MEMBER(Uniforms, contrast),
-               GI_BLOCK_MEMBER(Uniforms, epsilon), GI_BLOCK_MEMBER(Uniforms, blurTolerance),
-               GI_BLOCK_MEMBER(Uniforms, radius2), GI_BLOCK_MEMBER(Uniforms, pad),
-               GI_BLOCK_MEMBER(Uniforms, taps)})}}};
+        {{"params", GI_CPP_BLOCK(Uniforms, radius, bias, scale, contrast, epsilon, blurTolerance,
+                                 radius2, pad, taps)}}};
     ao_ = gi::vk::Pipeline::compute(vk,
                                     gi::computeShader("alchemy: alchemy.comp", alchemy_comp,
                                                       {uint32_t(samples), uint32_t(band)}, params));
@@ -128,7 +122,12 @@ class AlchemyEffect : public gi::Effect {
           vk, gi::computeShader("alchemy: alchemy_blur_y.comp", alchemy_blur_y_comp,
                                 {uint32_t(blur)}, params));
     }
-    uniforms_.prepare(vk, s, {"radius", "bias", "intensity", "contrast", "epsilon", "samples"});
+    uniforms_.prepare(vk, s, {"radius", "bias", "intensity", "contrast", "epsilon", "samples"},
+                      [](const auto& k) {
+                        return gi::alchemy::makeUniforms(k[0], k[1], k[2], k[3],
+                                                         gi::alchemy::absoluteEpsilon(k[4], k[0]),
+                                                         int(k[5]));
+                      });
     if (band > 0 && !view_) view_ = ctx.createView();
   }
 
@@ -204,10 +203,7 @@ class AlchemyEffect : public gi::Effect {
         },
         [this, io, values = &settings, frame, nearest](gi::PassContext& pc) {
           // The epsilon setting is relative to r^2: the block holds the absolute one.
-          const VkBuffer params = uniforms_.upload(*values, [](const auto& k) {
-            return gi::alchemy::makeUniforms(k[0], k[1], k[2], k[3],
-                                             gi::alchemy::absoluteEpsilon(k[4], k[0]), int(k[5]));
-          });
+          const VkBuffer params = uniforms_.upload(*values);
           gi::vk::DescriptorWriter w(ao_);
           w.buffer("Frame", frame)
               .buffer("params", params)

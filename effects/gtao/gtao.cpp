@@ -86,14 +86,13 @@ class GtaoEffect : public gi::Effect {
                            s.flag("bent_normals") ? 1u : 0u, s.flag("multi_bounce") ? 1u : 0u,
                            uint32_t(s.integer("downsample"))});
     desc.blocks.uniforms = {
-        {"gtao", gi::vk::cppBlock<Uniforms>(
-                     "gi::gtao::Uniforms",
-                     {GI_BLOCK_MEMBER(Uniforms, radius), GI_BLOCK_MEMBER(Uniforms, falloffSlope),
-                      GI_BLOCK_MEMBER(Uniforms, thickness), GI_BLOCK_MEMBER(Uniforms, pad),
-                      GI_BLOCK_MEMBER(Uniforms, noise)})}};
+        {"gtao", GI_CPP_BLOCK(Uniforms, radius, falloffSlope, thickness, pad, noise)}};
     // At a reduced resolution the blur also upsamples, even with radius 0.
     ao_.prepare(ctx, s, "gtao", desc, gi::gtao::kBlurDepthTolerance, s.integer("downsample"));
-    uniforms_.prepare(ctx.vulkan(), s, {"radius", "falloff", "thickness", "interleave", "slices"});
+    uniforms_.prepare(ctx.vulkan(), s, {"radius", "falloff", "thickness", "interleave", "slices"},
+                      [](const auto& k) {
+                        return gi::gtao::makeUniforms(k[0], k[1], k[2], k[3] != 0.0, int(k[4]));
+                      });
     if (!unusedBent_) {
       gi::vk::ImageDesc d;
       d.format = kBentFormat;
@@ -136,9 +135,7 @@ class GtaoEffect : public gi::Effect {
         },
         [this, io, values = &settings, frame, nearest, bentNormals](gi::PassContext& pc) {
           if (!bentNormals) prepareUnusedBent(pc.cmd());
-          const VkBuffer params = uniforms_.upload(*values, [](const auto& k) {
-            return gi::gtao::makeUniforms(k[0], k[1], k[2], k[3] != 0.0, int(k[4]));
-          });
+          const VkBuffer params = uniforms_.upload(*values);
           const gi::vk::Pipeline& gtao = ao_.pipeline();
           gi::vk::DescriptorWriter w(gtao);
           w.buffer("Frame", frame)

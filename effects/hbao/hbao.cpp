@@ -52,26 +52,17 @@ class HbaoEffect : public gi::Effect {
         gi::computeShader("hbao: hbao.comp", hbao_comp,
                           {uint32_t(s.integer("directions")), uint32_t(s.integer("steps"))});
     desc.blocks.uniforms = {
-        {"hbao", gi::vk::cppBlock<Uniforms>(
-                     "gi::hbao::Uniforms",
-                     {GI_BLOCK_MEMBER(Uniforms, radius), GI_BLOCK_MEMBER(Uniforms, invRadius2),
-                      GI_BLOCK_MEMBER(Uniforms, cosBias), GI_BLOCK_MEMBER(Uniforms, sinBias),
-                      GI_BLOCK_MEMBER(Uniforms, noise)})}};
+        {"hbao", GI_CPP_BLOCK(Uniforms, radius, invRadius2, cosBias, sinBias, noise)}};
     ao_.prepare(ctx, s, "hbao", desc, gi::hbao::kBlurDepthTolerance);
-    uniforms_.prepare(ctx.vulkan(), s, {"radius", "angle_bias", "interleave", "directions"});
+    uniforms_.prepare(
+        ctx.vulkan(), s, {"radius", "angle_bias", "interleave", "directions"},
+        [](const auto& k) { return gi::hbao::makeUniforms(k[0], k[1], k[2] != 0.0, int(k[3])); });
   }
 
   // Uniform-only settings are read (and the block rebuilt when one changed) as the pass records.
   void addPasses(gi::FrameGraph& graph, gi::EffectContext& ctx,
                  const gi::SettingValues& settings) override {
-    ao_.addPasses(
-        graph, ctx,
-        [this, values = &settings](gi::vk::DescriptorWriter& w) {
-          w.buffer("hbao", uniforms_.upload(*values, [](const auto& k) {
-            return gi::hbao::makeUniforms(k[0], k[1], k[2] != 0.0, int(k[3]));
-          }));
-        },
-        settings);
+    ao_.addPasses(graph, ctx, uniforms_.binding("hbao", settings), settings);
   }
 
  private:

@@ -57,12 +57,7 @@ gi::vk::ComputeDesc shader(const char* name, const uint32_t (&words)[N],
       gi::computeShader(std::string("ism: ") + name, words, std::move(constants));
   if (readsParams)
     d.blocks.uniforms = {
-        {"ism", gi::vk::cppBlock<Uniforms>(
-                    "gi::ism::Uniforms",
-                    {GI_BLOCK_MEMBER(Uniforms, rsm), GI_BLOCK_MEMBER(Uniforms, atlas),
-                     GI_BLOCK_MEMBER(Uniforms, bias), GI_BLOCK_MEMBER(Uniforms, pull),
-                     GI_BLOCK_MEMBER(Uniforms, gather), GI_BLOCK_MEMBER(Uniforms, blur),
-                     GI_BLOCK_MEMBER(Uniforms, envSphere), GI_BLOCK_MEMBER(Uniforms, envVpls)})}};
+        {"ism", GI_CPP_BLOCK(Uniforms, rsm, atlas, bias, pull, gather, blur, envSphere, envVpls)}};
   return d;
 }
 
@@ -269,17 +264,13 @@ class IsmEffect : public gi::Effect {
       d.blocks.pushConstants = std::move(push);
       return gi::vk::Pipeline::compute(vk, d);
     };
-    const auto splatPush = cppBlock<SplatPush>(
-        "SplatPush", {GI_BLOCK_MEMBER(SplatPush, base), GI_BLOCK_MEMBER(SplatPush, firstTile)});
-    const auto irsmPush = cppBlock<IrsmPush>("IrsmPush", {GI_BLOCK_MEMBER(IrsmPush, base)});
+    const auto splatPush = GI_CPP_BLOCK(SplatPush, base, firstTile);
+    const auto irsmPush = GI_CPP_BLOCK(IrsmPush, base);
     vpl_ = make(shader("ism_vpl.comp", ism_vpl_comp));
     if (c.classic) {
       auto views = [&](bool ortho) {
         return make(shader("ism_classic_views.comp", ism_classic_views_comp, {uint32_t(ortho)}),
-                    cppBlock<ClassicViewsPush>("ClassicViewsPush",
-                                               {GI_BLOCK_MEMBER(ClassicViewsPush, first),
-                                                GI_BLOCK_MEMBER(ClassicViewsPush, count),
-                                                GI_BLOCK_MEMBER(ClassicViewsPush, firstTile)}));
+                    GI_CPP_BLOCK(ClassicViewsPush, first, count, firstTile));
       };
       classicViews_ = views(false);
       if (c.env > 0) envClassicViews_ = views(true);
@@ -293,11 +284,8 @@ class IsmEffect : public gi::Effect {
                                 {uint32_t(c.splat), uint32_t(wrap ? 1 : 0), 1u}),
                          splatPush);
       if (c.levels > 0)
-        pullPush_ = make(
-            shader("ism_pull_push.comp", ism_pull_push_comp, {uint32_t(c.levels)}),
-            cppBlock<PullPushPush>("PullPushPush", {GI_BLOCK_MEMBER(PullPushPush, tileBegin),
-                                                    GI_BLOCK_MEMBER(PullPushPush, tileEnd),
-                                                    GI_BLOCK_MEMBER(PullPushPush, firstBlockRow)}));
+        pullPush_ = make(shader("ism_pull_push.comp", ism_pull_push_comp, {uint32_t(c.levels)}),
+                         GI_CPP_BLOCK(PullPushPush, tileBegin, tileEnd, firstBlockRow));
     }
     if (c.env > 0) envVpl_ = make(shader("ism_env_vpl.comp", ism_env_vpl_comp));
     if (c.bounces > 1) {
@@ -307,7 +295,7 @@ class IsmEffect : public gi::Effect {
                          irsmPush)
                   : make(shader("ism_irsm.comp", ism_irsm_comp, {entries, wraps}), irsmPush);
       bounce_ = make(shader("ism_bounce.comp", ism_bounce_comp, {uint32_t(c.vpls), entries, wraps}),
-                     cppBlock<BouncePush>("BouncePush", {GI_BLOCK_MEMBER(BouncePush, bounce)}));
+                     GI_CPP_BLOCK(BouncePush, bounce));
     }
     atlasView_ =
         c.classic

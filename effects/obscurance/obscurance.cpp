@@ -120,11 +120,7 @@ class ObscuranceEffect : public gi::Effect {
           vk, gi::computeShader("obscurance: obscurance_radiance.comp", obscurance_radiance_comp));
     const gi::vk::BlockChecks params{
         {},
-        {{"obs", gi::vk::cppBlock<Uniforms>(
-                     "gi::obscurance::Uniforms",
-                     {GI_BLOCK_MEMBER(Uniforms, radius), GI_BLOCK_MEMBER(Uniforms, bias),
-                      GI_BLOCK_MEMBER(Uniforms, filterTolerance), GI_BLOCK_MEMBER(Uniforms, guard),
-                      GI_BLOCK_MEMBER(Uniforms, rotation), GI_BLOCK_MEMBER(Uniforms, kernel)})}}};
+        {{"obs", GI_CPP_BLOCK(Uniforms, radius, bias, filterTolerance, guard, rotation, kernel)}}};
     main_ = gi::vk::Pipeline::compute(
         vk, gi::computeShader("obscurance: obscurance.comp", obscurance_comp,
                               {uint32_t(s.integer("samples")),
@@ -140,7 +136,10 @@ class ObscuranceEffect : public gi::Effect {
                                           obscurance_resolve_ambient_comp, filterSpec, params)
                       : gi::computeShader("obscurance: obscurance_resolve.comp",
                                           obscurance_resolve_comp, filterSpec, params));
-    uniforms_.prepare(vk, s, {"radius", "bias", "membership", "samples", "interleave"});
+    uniforms_.prepare(
+        vk, s, {"radius", "bias", "membership", "samples", "interleave"}, [](const auto& k) {
+          return obs::makeUniforms(k[0], k[1], obs::Membership(int(k[2])), int(k[3]), k[4] != 0.0);
+        });
     uniforms_.block().invalidate();  // the sample count may have changed
   }
 
@@ -192,10 +191,7 @@ class ObscuranceEffect : public gi::Effect {
         },
         [this, io, values = &settings, frame, nearest](gi::PassContext& pc) {
           // The sample set is rebuilt only when a setting it depends on changed.
-          const VkBuffer params = uniforms_.upload(*values, [](const auto& k) {
-            return obs::makeUniforms(k[0], k[1], obs::Membership(int(k[2])), int(k[3]),
-                                     k[4] != 0.0);
-          });
+          const VkBuffer params = uniforms_.upload(*values);
           gi::vk::DescriptorWriter w(main_);
           w.buffer("Frame", frame)
               .buffer("obs", params)

@@ -50,28 +50,19 @@ class SsaoEffect : public gi::Effect {
 
   void prepare(gi::EffectContext& ctx, const gi::SettingValues& settings) override {
     gi::vk::ComputeDesc desc = gi::computeShader("ssao: ssao.comp", ssao_comp);
-    desc.blocks.uniforms = {
-        {"ssao", gi::vk::cppBlock<Uniforms>(
-                     "gi::ssao::Uniforms",
-                     {GI_BLOCK_MEMBER(Uniforms, params), GI_BLOCK_MEMBER(Uniforms, counts),
-                      GI_BLOCK_MEMBER(Uniforms, rotation), GI_BLOCK_MEMBER(Uniforms, kernel)})}};
+    desc.blocks.uniforms = {{"ssao", GI_CPP_BLOCK(Uniforms, params, counts, rotation, kernel)}};
     ao_.prepare(ctx, settings, "ssao", desc, gi::ssao::kBlurDepthTolerance);
     uniforms_.prepare(ctx.vulkan(), settings,
-                      {"radius", "bias", "intensity", "samples", "interleave"});
+                      {"radius", "bias", "intensity", "samples", "interleave"}, [](const auto& k) {
+                        return gi::ssao::makeUniforms(k[0], k[1], k[2], int(k[3]), k[4] != 0.0);
+                      });
   }
 
   // `settings` lives as long as the graph and is updated in place: uniform-only settings are
   // read (and the kernel rebuilt when one changed) when the pass records, every frame.
   void addPasses(gi::FrameGraph& graph, gi::EffectContext& ctx,
                  const gi::SettingValues& settings) override {
-    ao_.addPasses(
-        graph, ctx,
-        [this, values = &settings](gi::vk::DescriptorWriter& w) {
-          w.buffer("ssao", uniforms_.upload(*values, [](const auto& k) {
-            return gi::ssao::makeUniforms(k[0], k[1], k[2], int(k[3]), k[4] != 0.0);
-          }));
-        },
-        settings);
+    ao_.addPasses(graph, ctx, uniforms_.binding("ssao", settings), settings);
   }
 
  private:

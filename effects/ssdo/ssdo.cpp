@@ -69,14 +69,8 @@ gi::vk::ComputeDesc shader(const char* name, const uint32_t (&words)[N],
       gi::computeShader(std::string("ssdo: ") + name, words, std::move(constants));
   if (readsParams)
     d.blocks.uniforms = {
-        {"ssdo",
-         gi::vk::cppBlock<Uniforms>(
-             "gi::ssdo::Uniforms",
-             {GI_BLOCK_MEMBER(Uniforms, radius), GI_BLOCK_MEMBER(Uniforms, bias),
-              GI_BLOCK_MEMBER(Uniforms, bounceScale), GI_BLOCK_MEMBER(Uniforms, distanceClamp2),
-              GI_BLOCK_MEMBER(Uniforms, blurTolerance), GI_BLOCK_MEMBER(Uniforms, blurMinCos),
-              GI_BLOCK_MEMBER(Uniforms, pad0), GI_BLOCK_MEMBER(Uniforms, pad1),
-              GI_BLOCK_MEMBER(Uniforms, cameras), GI_BLOCK_MEMBER(Uniforms, samples)})}};
+        {"ssdo", GI_CPP_BLOCK(Uniforms, radius, bias, bounceScale, distanceClamp2, blurTolerance,
+                              blurMinCos, pad0, pad1, cameras, samples)}};
   return d;
 }
 

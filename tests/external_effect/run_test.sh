@@ -117,6 +117,29 @@ render both vignette,ext_grey
 expect "$tmp/both.log" "^  \[run\] +vignette$" "vignette pass not executed"
 expect "$tmp/both.log" "^  \[run\] +ext_grey$" "ext_grey pass not executed"
 render grey_view ext_grey --view ext_grey
+# Its debug view as linear floats: strength 1 is grey (R = G = B), strength 0 keeps the room's
+# coloured walls.
+for strength in 0 1; do
+  "$gi" --scene default --effects ext_grey --view ext_grey --set "ext_grey.strength=$strength" \
+    --validation --width 160 --height 120 --out "$tmp/grey$strength.pfm" >"$tmp/grey$strength.log" \
+    2>&1 || { cat "$tmp/grey$strength.log" >&2; fail "gi-render ext_grey.strength=$strength"; }
+done
+python3 - "$tmp/grey0.pfm" "$tmp/grey1.pfm" <<'PY' || fail "the copied template does not desaturate"
+import struct, sys
+def chroma(path):  # the largest |R - G| or |G - B| relative to the pixel's brightest channel
+    data = open(path, "rb").read()
+    header = data.split(b"\n", 3)
+    w, h = map(int, header[1].split())
+    px = struct.unpack("<%df" % (3 * w * h), header[3][: 12 * w * h])
+    worst = 0.0
+    for i in range(0, len(px), 3):
+        r, g, b = px[i : i + 3]
+        worst = max(worst, max(abs(r - g), abs(g - b)) / max(r, g, b, 1e-6))
+    return worst
+kept, grey = chroma(sys.argv[1]), chroma(sys.argv[2])
+print(f"chroma: strength 0 {kept:.4f}, strength 1 {grey:.6f}")
+sys.exit(0 if grey < 1e-3 and kept > 0.1 else 1)
+PY
 
 step "second_view: the scene drawn again through GpuScene equals the main G-buffer's depth"
 render_pfm() {  # NAME VIEW: the second_view effect, that view as linear floats

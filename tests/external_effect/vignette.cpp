@@ -34,8 +34,7 @@ class VignetteEffect : public gi::Effect {
   void prepare(gi::EffectContext& ctx, const gi::SettingValues&) override {
     gi::vk::ComputeDesc desc{"vignette: vignette.comp",
                              {std::begin(vignette_comp), std::end(vignette_comp)}};
-    desc.blocks.pushConstants = gi::vk::cppBlock<Params>(
-        "Params", {GI_BLOCK_MEMBER(Params, strength), GI_BLOCK_MEMBER(Params, radius)});
+    desc.blocks.pushConstants = GI_CPP_BLOCK(Params, strength, radius);
     pipeline_ = gi::vk::Pipeline::compute(ctx.vulkan(), desc);
   }
 

@@ -18,7 +18,8 @@
 // 12: vk::Pipeline holds its shader's reflected interface (bindings by name, checked blocks);
 //     SettingValues stores values per declaration index (typed Setting<T> handles).
 // 13: ImagePass gained `publish` (its layout grew).
-#define GI_EFFECT_ABI_VERSION 13u
+// 14: litFilterInfo and addLitFilterPass (gi/image_pass.h), used by the template.
+#define GI_EFFECT_ABI_VERSION 14u
 
 namespace gi {
 

@@ -37,4 +37,14 @@ struct ImagePass {
 // Adds the pass and returns the output texture.
 TextureHandle addImagePass(FrameGraph& graph, EffectContext& ctx, ImagePass pass);
 
+// The shape of an effect that filters the lit colour (tone, colour grading, vignette, ...): it
+// runs after lighting, reads "lit" and publishes a new "lit", which is also its debug view under
+// the effect's name.
+EffectInfo litFilterInfo(std::string name, std::string version, std::string description);
+// Its pass, named `effect`: an ImagePass whose shader reads "lit" as `litColor` and writes
+// `outColor` (RGBA16F, 8x8 groups), published as `effect` and "lit".
+TextureHandle addLitFilterPass(FrameGraph& graph, EffectContext& ctx, const std::string& effect,
+                               const vk::Pipeline& pipeline,
+                               std::function<void(vk::DescriptorWriter&, PassContext&)> bind = {});
+
 }  // namespace gi

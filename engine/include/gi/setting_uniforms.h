@@ -5,9 +5,13 @@
 
 #include <array>
 #include <cstddef>
+#include <functional>
+#include <string>
+#include <utility>
 
 #include "gi/settings.h"
 #include "gi/uniform_block.h"
+#include "gi/vk/pipeline.h"
 
 namespace gi {
 
@@ -18,24 +22,35 @@ class SettingUniforms {
   // value (an enum's index).
   using Values = std::array<double, N>;
 
+  // `make` builds the block from the values; it runs only when one of them changed.
   void prepare(vk::Context& ctx, const SettingValues& settings,
-               const std::array<const char*, N>& names) {
+               const std::array<const char*, N>& names, std::function<T(const Values&)> make) {
     block_.create(ctx);
     for (size_t i = 0; i < N; ++i) handles_[i] = settings.handle<double>(names[i]);
+    make_ = std::move(make);
   }
-  // Writes make(values) when the values differ from the last upload's; returns the buffer.
-  template <class Make>
-  VkBuffer upload(const SettingValues& settings, Make&& make) {
+  // Rebuilds and writes the block when the values differ from the last upload's; returns the
+  // buffer. `settings` are the ones prepare() took the handles from (or the graph's copy).
+  VkBuffer upload(const SettingValues& settings) {
     Values v;
     for (size_t i = 0; i < N; ++i) v[i] = settings[handles_[i]];
-    block_.update(v, [&] { return make(v); });
+    block_.update(v, [&] { return make_(v); });
     return block_.handle();
+  }
+  // Binds the uploaded block as the shader's `block` as a pass records: for passes whose
+  // `bind` takes a DescriptorWriter (ScreenSpaceAO::addPasses). `settings` must outlive it.
+  std::function<void(vk::DescriptorWriter&)> binding(std::string block,
+                                                     const SettingValues& settings) {
+    return [this, block = std::move(block), values = &settings](vk::DescriptorWriter& w) {
+      w.buffer(block, upload(*values));
+    };
   }
   VkBuffer handle() const { return block_.handle(); }
   UniformBlock<T>& block() { return block_; }  // writePart, invalidate
 
  private:
   UniformBlock<T> block_;
+  std::function<T(const Values&)> make_;
   std::array<Setting<double>, N> handles_{};
 };
 

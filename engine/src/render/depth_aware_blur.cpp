@@ -25,8 +25,7 @@ void DepthAwareBlur::prepare(EffectContext& ctx, int radius, int scale) {
   auto make = [&](const char* shader, std::vector<uint32_t> spec) {
     vk::ComputeDesc d{std::string("depth-aware blur: ") + shader, vk::loadSpirv(shader),
                       std::move(spec)};
-    d.blocks.pushConstants =
-        vk::cppBlock<Push>("DepthAwareBlur::Push", {GI_BLOCK_MEMBER(Push, tolerance)});
+    d.blocks.pushConstants = GI_CPP_BLOCK(Push, tolerance);
     return vk::Pipeline::compute(vk, d);
   };
   if (radius_ > 0) {

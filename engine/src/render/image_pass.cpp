@@ -1,6 +1,7 @@
 #include "gi/image_pass.h"
 
 #include <memory>
+#include <utility>
 
 namespace gi {
 
@@ -30,6 +31,31 @@ TextureHandle addImagePass(FrameGraph& graph, EffectContext& ctx, ImagePass pass
       });
   for (const std::string& name : p->publish) bb.put(name, io->out);
   return io->out;
+}
+
+EffectInfo litFilterInfo(std::string name, std::string version, std::string description) {
+  EffectInfo info{.name = std::move(name),
+                  .version = std::move(version),
+                  .description = std::move(description),
+                  .stage = EffectStage::AfterLighting,
+                  .reads = {resources::kLit}};
+  info.writes = {resources::kLit, info.name};
+  info.debugView = info.name;
+  return info;
+}
+
+TextureHandle addLitFilterPass(FrameGraph& graph, EffectContext& ctx, const std::string& effect,
+                               const vk::Pipeline& pipeline,
+                               std::function<void(vk::DescriptorWriter&, PassContext&)> bind) {
+  return addImagePass(graph, ctx,
+                      {.name = effect,
+                       .pipeline = &pipeline,
+                       .inputs = {{resources::kLit, "litColor"}},
+                       .output = effect,
+                       .outputDesc = {VK_FORMAT_R16G16B16A16_SFLOAT},
+                       .outputBinding = "outColor",
+                       .bind = std::move(bind),
+                       .publish = {effect, resources::kLit}});
 }
 
 }  // namespace gi

@@ -304,10 +304,8 @@ void SceneGpu::upload() {
 void SceneGpu::createPipelines() {
   // Descriptor layouts come from the shaders; the per-draw push constants are checked against
   // DrawPush (the depth shaders take only its model matrix: DepthPush).
-  const CppBlock drawPush = cppBlock<DrawPush>(
-      "DrawPush", {GI_BLOCK_MEMBER(DrawPush, model), GI_BLOCK_MEMBER(DrawPush, normalMatrix),
-                   GI_BLOCK_MEMBER(DrawPush, instance)});
-  const CppBlock depthPush = cppBlock<DepthPush>("DepthPush", {GI_BLOCK_MEMBER(DepthPush, model)});
+  const CppBlock drawPush = GI_CPP_BLOCK(DrawPush, model, normalMatrix, instance);
+  const CppBlock depthPush = GI_CPP_BLOCK(DepthPush, model);
   const std::vector<VkVertexInputAttributeDescription> fullVertex = {
       {0, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, position)},
       {1, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(Vertex, normal)},

@@ -52,13 +52,10 @@ SurfacePointsPass::SurfacePointsPass(vk::Context& ctx, const Scene& scene, uint3
                              VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
   vk::ComputeDesc update{"surface points: surface_points.comp",
                          vk::loadSpirv("surface_points.comp")};
-  update.blocks.pushConstants = vk::cppBlock<UpdatePush>(
-      "UpdatePush",
-      {GI_BLOCK_MEMBER(UpdatePush, count), GI_BLOCK_MEMBER(UpdatePush, areaPerPoint)});
+  update.blocks.pushConstants = GI_CPP_BLOCK(UpdatePush, count, areaPerPoint);
   update_ = vk::Pipeline::compute(ctx, update);
   vk::ComputeDesc view{"surface points: points_view.comp", vk::loadSpirv("points_view.comp")};
-  view.blocks.pushConstants = vk::cppBlock<ViewPush>(
-      "ViewPush", {GI_BLOCK_MEMBER(ViewPush, count), GI_BLOCK_MEMBER(ViewPush, clear)});
+  view.blocks.pushConstants = GI_CPP_BLOCK(ViewPush, count, clear);
   view_ = vk::Pipeline::compute(ctx, view);
 }
 

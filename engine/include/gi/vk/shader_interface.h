@@ -92,6 +92,36 @@ CppBlock cppBlock(std::string type, std::vector<BlockMember> members) {
 #m, uint32_t(offsetof(T, m)), uint32_t(sizeof(T::m)) \
   }
 
+// The whole CppBlock of a struct from its members' names, in any order, at most 16:
+// GI_CPP_BLOCK(Params, strength, tint) ->
+//   cppBlock<Params>("Params", {GI_BLOCK_MEMBER(Params, strength), GI_BLOCK_MEMBER(Params, tint)})
+#define GI_CPP_BLOCK(T, ...) \
+  ::gi::vk::cppBlock<T>(     \
+      #T, {GI_DETAIL_CAT(GI_DETAIL_MEMBERS_, GI_DETAIL_COUNT(__VA_ARGS__))(T, __VA_ARGS__)})
+#define GI_DETAIL_CAT(a, b) GI_DETAIL_CAT_(a, b)
+#define GI_DETAIL_CAT_(a, b) a##b
+#define GI_DETAIL_COUNT(...) \
+  GI_DETAIL_COUNT_(__VA_ARGS__, 16, 15, 14, 13, 12, 11, 10, 9, 8, 7, 6, 5, 4, 3, 2, 1)
+#define GI_DETAIL_COUNT_(_1, _2, _3, _4, _5, _6, _7, _8, _9, _10, _11, _12, _13, _14, _15, _16, n, \
+                         ...)                                                                      \
+  n
+#define GI_DETAIL_MEMBERS_1(T, m) GI_BLOCK_MEMBER(T, m)
+#define GI_DETAIL_MEMBERS_2(T, m, ...) GI_BLOCK_MEMBER(T, m), GI_DETAIL_MEMBERS_1(T, __VA_ARGS__)
+#define GI_DETAIL_MEMBERS_3(T, m, ...) GI_BLOCK_MEMBER(T, m), GI_DETAIL_MEMBERS_2(T, __VA_ARGS__)
+#define GI_DETAIL_MEMBERS_4(T, m, ...) GI_BLOCK_MEMBER(T, m), GI_DETAIL_MEMBERS_3(T, __VA_ARGS__)
+#define GI_DETAIL_MEMBERS_5(T, m, ...) GI_BLOCK_MEMBER(T, m), GI_DETAIL_MEMBERS_4(T, __VA_ARGS__)
+#define GI_DETAIL_MEMBERS_6(T, m, ...) GI_BLOCK_MEMBER(T, m), GI_DETAIL_MEMBERS_5(T, __VA_ARGS__)
+#define GI_DETAIL_MEMBERS_7(T, m, ...) GI_BLOCK_MEMBER(T, m), GI_DETAIL_MEMBERS_6(T, __VA_ARGS__)
+#define GI_DETAIL_MEMBERS_8(T, m, ...) GI_BLOCK_MEMBER(T, m), GI_DETAIL_MEMBERS_7(T, __VA_ARGS__)
+#define GI_DETAIL_MEMBERS_9(T, m, ...) GI_BLOCK_MEMBER(T, m), GI_DETAIL_MEMBERS_8(T, __VA_ARGS__)
+#define GI_DETAIL_MEMBERS_10(T, m, ...) GI_BLOCK_MEMBER(T, m), GI_DETAIL_MEMBERS_9(T, __VA_ARGS__)
+#define GI_DETAIL_MEMBERS_11(T, m, ...) GI_BLOCK_MEMBER(T, m), GI_DETAIL_MEMBERS_10(T, __VA_ARGS__)
+#define GI_DETAIL_MEMBERS_12(T, m, ...) GI_BLOCK_MEMBER(T, m), GI_DETAIL_MEMBERS_11(T, __VA_ARGS__)
+#define GI_DETAIL_MEMBERS_13(T, m, ...) GI_BLOCK_MEMBER(T, m), GI_DETAIL_MEMBERS_12(T, __VA_ARGS__)
+#define GI_DETAIL_MEMBERS_14(T, m, ...) GI_BLOCK_MEMBER(T, m), GI_DETAIL_MEMBERS_13(T, __VA_ARGS__)
+#define GI_DETAIL_MEMBERS_15(T, m, ...) GI_BLOCK_MEMBER(T, m), GI_DETAIL_MEMBERS_14(T, __VA_ARGS__)
+#define GI_DETAIL_MEMBERS_16(T, m, ...) GI_BLOCK_MEMBER(T, m), GI_DETAIL_MEMBERS_15(T, __VA_ARGS__)
+
 // Throws gi::Error naming `owner`, the block and the first member that differs when `cpp` does
 // not match `shader`: every member of each must be in the other by name, at the same offset and
 // of the same size, and the C++ struct must hold the whole block (trailing padding allowed).

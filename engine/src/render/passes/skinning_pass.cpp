@@ -18,10 +18,7 @@ class SkinningPass final : public Effect {
   void prepare(EffectContext& ctx, const SettingValues&) override {
     if (s_.scene.deformed().empty() || pipeline_.handle()) return;
     vk::ComputeDesc d{"skinning: skinning.comp", vk::loadSpirv("skinning.comp")};
-    d.blocks.pushConstants = vk::cppBlock<Push>(
-        "Push", {GI_BLOCK_MEMBER(Push, srcFirst), GI_BLOCK_MEMBER(Push, dstFirst),
-                 GI_BLOCK_MEMBER(Push, count), GI_BLOCK_MEMBER(Push, jointFirst),
-                 GI_BLOCK_MEMBER(Push, jointCount)});
+    d.blocks.pushConstants = GI_CPP_BLOCK(Push, srcFirst, dstFirst, count, jointFirst, jointCount);
     pipeline_ = vk::Pipeline::compute(ctx.vulkan(), d);
   }
   void addPasses(FrameGraph& graph, EffectContext&, const SettingValues&) override {
