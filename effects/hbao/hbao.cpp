@@ -7,7 +7,6 @@
 #include "gi/effect_registry.h"
 #include "gi/effect_shader.h"
 #include "gi/screen_space_ao.h"
-#include "gi/setting_uniforms.h"
 #include "hbao.comp.h"  // const uint32_t hbao_comp[]
 #include "hbao_params.h"
 
@@ -15,7 +14,7 @@ namespace {
 
 using gi::hbao::Uniforms;
 
-class HbaoEffect : public gi::Effect {
+class HbaoEffect : public gi::ScreenSpaceAOEffect<Uniforms, 4> {
  public:
   // Declares AO of `radius` (the default estimatedQuantity): its own quantity (README: no
   // cosine term, elevations from the image plane, attenuation W(r) = 1 - r^2 / R^2 instead
@@ -46,28 +45,19 @@ class HbaoEffect : public gi::Effect {
     };
   }
 
+  // Graph-changing settings are specialization constants (the loops unroll); uniform-only ones
+  // are read (and the block rebuilt when one changed) as the pass records.
   void prepare(gi::EffectContext& ctx, const gi::SettingValues& s) override {
-    // Graph-changing settings are specialization constants: the loops unroll.
-    gi::vk::ComputeDesc desc =
+    prepareAO(
+        ctx, s, "hbao",
         gi::computeShader("hbao: hbao.comp", hbao_comp,
-                          {uint32_t(s.integer("directions")), uint32_t(s.integer("steps"))});
-    desc.blocks.uniforms = {
-        {"hbao", GI_CPP_BLOCK(Uniforms, radius, invRadius2, cosBias, sinBias, noise)}};
-    ao_.prepare(ctx, s, "hbao", desc, gi::hbao::kBlurDepthTolerance);
-    uniforms_.prepare(
-        ctx.vulkan(), s, {"radius", "angle_bias", "interleave", "directions"},
-        [](const auto& k) { return gi::hbao::makeUniforms(k[0], k[1], k[2] != 0.0, int(k[3])); });
+                          {uint32_t(s.integer("directions")), uint32_t(s.integer("steps"))}),
+        gi::hbao::kBlurDepthTolerance,
+        {"hbao",
+         GI_CPP_BLOCK(Uniforms, radius, invRadius2, cosBias, sinBias, noise),
+         {"radius", "angle_bias", "interleave", "directions"},
+         [](const auto& k) { return gi::hbao::makeUniforms(k[0], k[1], k[2] != 0.0, int(k[3])); }});
   }
-
-  // Uniform-only settings are read (and the block rebuilt when one changed) as the pass records.
-  void addPasses(gi::FrameGraph& graph, gi::EffectContext& ctx,
-                 const gi::SettingValues& settings) override {
-    ao_.addPasses(graph, ctx, uniforms_.binding("hbao", settings), settings);
-  }
-
- private:
-  gi::ScreenSpaceAO ao_;
-  gi::SettingUniforms<Uniforms, 4> uniforms_;
 };
 
 }  // namespace

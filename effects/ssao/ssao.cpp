@@ -7,7 +7,6 @@
 #include "gi/effect_registry.h"
 #include "gi/effect_shader.h"
 #include "gi/screen_space_ao.h"
-#include "gi/setting_uniforms.h"
 #include "ssao.comp.h"  // const uint32_t ssao_comp[]
 #include "ssao_kernel.h"
 
@@ -16,7 +15,7 @@ namespace {
 using gi::SettingType;
 using gi::ssao::Uniforms;
 
-class SsaoEffect : public gi::Effect {
+class SsaoEffect : public gi::ScreenSpaceAOEffect<Uniforms, 5> {
  public:
   gi::EffectInfo info() const override {
     return gi::aoEffectInfo(
@@ -48,26 +47,18 @@ class SsaoEffect : public gi::Effect {
     };
   }
 
+  // Uniform-only settings are read (and the kernel rebuilt when one changed) as the pass
+  // records, every frame.
   void prepare(gi::EffectContext& ctx, const gi::SettingValues& settings) override {
-    gi::vk::ComputeDesc desc = gi::computeShader("ssao: ssao.comp", ssao_comp);
-    desc.blocks.uniforms = {{"ssao", GI_CPP_BLOCK(Uniforms, params, counts, rotation, kernel)}};
-    ao_.prepare(ctx, settings, "ssao", desc, gi::ssao::kBlurDepthTolerance);
-    uniforms_.prepare(ctx.vulkan(), settings,
-                      {"radius", "bias", "intensity", "samples", "interleave"}, [](const auto& k) {
-                        return gi::ssao::makeUniforms(k[0], k[1], k[2], int(k[3]), k[4] != 0.0);
-                      });
+    prepareAO(ctx, settings, "ssao", gi::computeShader("ssao: ssao.comp", ssao_comp),
+              gi::ssao::kBlurDepthTolerance,
+              {"ssao",
+               GI_CPP_BLOCK(Uniforms, params, counts, rotation, kernel),
+               {"radius", "bias", "intensity", "samples", "interleave"},
+               [](const auto& k) {
+                 return gi::ssao::makeUniforms(k[0], k[1], k[2], int(k[3]), k[4] != 0.0);
+               }});
   }
-
-  // `settings` lives as long as the graph and is updated in place: uniform-only settings are
-  // read (and the kernel rebuilt when one changed) when the pass records, every frame.
-  void addPasses(gi::FrameGraph& graph, gi::EffectContext& ctx,
-                 const gi::SettingValues& settings) override {
-    ao_.addPasses(graph, ctx, uniforms_.binding("ssao", settings), settings);
-  }
-
- private:
-  gi::ScreenSpaceAO ao_;
-  gi::SettingUniforms<Uniforms, 5> uniforms_;
 };
 
 }  // namespace

@@ -4,12 +4,16 @@
 // An AO effect with another shape (its own outputs, its own blur) can still take the pieces.
 #pragma once
 
+#include <array>
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <utility>
 
 #include "gi/depth_aware_blur.h"
 #include "gi/effect.h"
+#include "gi/setting_uniforms.h"
 
 namespace gi {
 
@@ -60,6 +64,40 @@ class ScreenSpaceAO {
   bool blurred_ = false;
   double tolerance_ = 0.0;
   Setting<double> radius_;
+};
+
+// The whole effect when the producer reads one uniform block made from a few settings (SSAO,
+// HBAO): the effect declares info() and settings() and calls prepareAO() from prepare(); the
+// passes follow.
+template <class T, size_t N>
+class ScreenSpaceAOEffect : public Effect {
+ public:
+  void addPasses(FrameGraph& graph, EffectContext& ctx, const SettingValues& settings) override {
+    ao_.addPasses(graph, ctx, uniforms_.binding(block_, settings), settings);
+  }
+
+ protected:
+  // The producer's uniform block: its name in the shader and its checked C++ layout, the
+  // settings it is made from and how (SettingUniforms: rebuilt only when one changed).
+  struct Block {
+    std::string name;
+    vk::CppBlock layout;
+    std::array<const char*, N> settings;
+    std::function<T(const typename SettingUniforms<T, N>::Values&)> make;
+  };
+  // ScreenSpaceAO::prepare with `block` checked against the producer and bound to it.
+  void prepareAO(EffectContext& ctx, const SettingValues& settings, const std::string& effect,
+                 vk::ComputeDesc producer, double tolerance, Block block) {
+    producer.blocks.uniforms = {{block.name, std::move(block.layout)}};
+    ao_.prepare(ctx, settings, effect, producer, tolerance);
+    uniforms_.prepare(ctx.vulkan(), settings, block.settings, std::move(block.make));
+    block_ = std::move(block.name);
+  }
+
+ private:
+  ScreenSpaceAO ao_;
+  SettingUniforms<T, N> uniforms_;
+  std::string block_;
 };
 
 }  // namespace gi
