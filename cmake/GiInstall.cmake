@@ -44,6 +44,7 @@ install(FILES ${CMAKE_SOURCE_DIR}/engine/shaders/common.glsl
   ${CMAKE_SOURCE_DIR}/engine/shaders/environment.glsl
   ${CMAKE_SOURCE_DIR}/engine/shaders/lights.glsl
   ${CMAKE_SOURCE_DIR}/engine/shaders/depth_aware_blur.glsl
+  ${CMAKE_SOURCE_DIR}/engine/shaders/normal_codec.glsl
   ${CMAKE_SOURCE_DIR}/engine/shaders/gbuffer.glsl DESTINATION ${GI_INSTALL_SHADERDIR})
 install(EXPORT giTargets NAMESPACE gi:: DESTINATION ${GI_INSTALL_CMAKEDIR})
 

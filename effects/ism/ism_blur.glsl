@@ -9,6 +9,7 @@
 #include "common.glsl"
 #include "ism_common.glsl"
 #include "ism_glossy.glsl"
+#include "normal_codec.glsl"  // the raw texel's normal
 
 layout(constant_id = 0) const int LO = -2;
 layout(constant_id = 1) const int HI = 1;
@@ -25,14 +26,6 @@ layout(set = 0, binding = 3, rgba32ui) uniform writeonly uimage2D outRaw;
 layout(set = 0, binding = 5, rgba16f) uniform writeonly image2D outIndirect;
 #endif
 
-vec2 signNotZero(vec2 v) { return vec2(v.x >= 0.0 ? 1.0 : -1.0, v.y >= 0.0 ? 1.0 : -1.0); }
-vec3 unpackNormal(uint q) {
-  vec2 e = unpackSnorm2x16(q);
-  vec3 n = vec3(e, 1.0 - abs(e.x) - abs(e.y));
-  float t = max(-n.z, 0.0);
-  n.xy -= t * signNotZero(n.xy);
-  return safeNormalize(n, vec3(0.0, 0.0, 1.0));
-}
 vec3 unpackValue(uvec4 t) {
   return GLOSSY ? ismUnpackRgb9e5(t.x) : vec3(unpackHalf2x16(t.x), unpackHalf2x16(t.y).x);
 }
@@ -49,7 +42,7 @@ void main() {
   if (p.x >= size.x || p.y >= size.y) return;
   uvec4 c = texelFetch(inRaw, p, 0);
   float z = uintBitsToFloat(c.z);
-  vec3 n = unpackNormal(c.w);
+  vec3 n = giDecodeNormal(c.w);
   vec3 centre = viewPoint(p, z);
   vec3 sum = vec3(0.0), specSum = vec3(0.0);
   float wsum = 0.0;
@@ -60,7 +53,7 @@ void main() {
     float zt = uintBitsToFloat(t.z);
     // Same surface: the neighbour lies near the centre's tangent plane and faces alike.
     float plane = abs(dot(n, viewPoint(q, zt) - centre));
-    float w = (zt > 0.0 && plane <= ism.blur.x * z && dot(unpackNormal(t.w), n) >= ism.blur.y)
+    float w = (zt > 0.0 && plane <= ism.blur.x * z && dot(giDecodeNormal(t.w), n) >= ism.blur.y)
                   ? 1.0 : 0.0;
     sum += w * unpackValue(t);
     if (GLOSSY) specSum += w * ismUnpackRgb9e5(t.y);

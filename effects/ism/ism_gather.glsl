@@ -41,12 +41,6 @@ void reflectVpl(Vpl v, uint tile, vec3 x, vec3 n, vec3 view, float exponent, ino
   if (GLOSSY) spec += ei * ismPhongLobe(x - v.position.xyz, n, view, exponent);
 }
 
-vec2 signNotZero(vec2 v) { return vec2(v.x >= 0.0 ? 1.0 : -1.0, v.y >= 0.0 ? 1.0 : -1.0); }
-uint packNormal(vec3 n) {
-  n /= max(abs(n.x) + abs(n.y) + abs(n.z), 1e-30);
-  vec2 e = n.z >= 0.0 ? n.xy : (1.0 - abs(n.yx)) * signNotZero(n.xy);
-  return packSnorm2x16(e);
-}
 
 void main() {
   uint phase = gl_WorkGroupID.z;
@@ -85,5 +79,5 @@ void main() {
   spec = min(spec * (ism.gather.z * ism.gather.w) + envSpec * ism.gather.z, vec3(65000.0));
   uvec2 value = GLOSSY ? uvec2(ismPackRgb9e5(e), ismPackRgb9e5(spec))
                        : uvec2(packHalf2x16(e.rg), packHalf2x16(vec2(e.b, 0.0)));
-  imageStore(outRaw, p, uvec4(value, floatBitsToUint(length(viewPos)), packNormal(viewN)));
+  imageStore(outRaw, p, uvec4(value, floatBitsToUint(length(viewPos)), giEncodeNormal(viewN)));
 }

@@ -21,14 +21,6 @@ layout(set = 0, binding = 3) uniform sampler2D gDepth;
 #include "gbuffer.glsl"  // the packed G-buffer (normal, albedo, metallic)
 layout(set = 0, binding = 7, rgba16f) uniform writeonly image2D outIndirect;
 
-vec2 signNotZero(vec2 v) { return vec2(v.x >= 0.0 ? 1.0 : -1.0, v.y >= 0.0 ? 1.0 : -1.0); }
-vec3 unpackNormal(uint q) {
-  vec2 e = unpackSnorm2x16(q);
-  vec3 n = vec3(e, 1.0 - abs(e.x) - abs(e.y));
-  float t = max(-n.z, 0.0);
-  n.xy -= t * signNotZero(n.xy);
-  return safeNormalize(n, vec3(0.0, 0.0, 1.0));
-}
 
 void main() {
   ivec2 p = ivec2(gl_GlobalInvocationID.xy);
@@ -54,7 +46,7 @@ void main() {
     vec2 uvq = (vec2(min(q * SCALE, size - 1)) + 0.5) * frame.viewport.zw;
     vec3 pt = normalize(viewPositionFromDepth(frame.invProj, uvq, 0.5)) * zt;
     bool same = zt > 0.0 && abs(dot(n, pt - viewPos)) <= ism.blur.x * z &&
-                dot(unpackNormal(t.w), n) >= ism.blur.y;
+                dot(giDecodeNormal(t.w), n) >= ism.blur.y;
     vec3 e = GLOSSY ? ismUnpackRgb9e5(t.x) : vec3(unpackHalf2x16(t.x), unpackHalf2x16(t.y).x);
     vec3 s = GLOSSY ? ismUnpackRgb9e5(t.y) : vec3(0.0);
     float w = same ? bil + 1e-6 : 0.0;  // + 1e-6: a passing sample at bilinear weight 0 counts

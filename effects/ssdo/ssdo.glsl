@@ -145,7 +145,7 @@ void main() {
   uvec4 gTexel = giGBufferLoad(p);
   float izG = inverseDistance(texelFetch(gDepth, p, 0).r, frame.proj[2][2], frame.proj[3][2]);
   uvec4 centre = uvec4(floatBitsToUint(giGBufferIsGeometry(gTexel) ? izG : 0.0),
-                       packNormal(giGBufferNormal(gTexel)), 0u, 0u);
+                       giEncodeNormal(giGBufferNormal(gTexel)), 0u, 0u);
 #else
   uvec4 centre = texelFetch(gSurface, p, 0);
 #endif
@@ -163,7 +163,7 @@ void main() {
   float depthP32 = proj[3][2];  // unguarded: inverseDistance guards it as ssdo_surface does
   vec2 invSize = frame.viewport.zw;
   vec3 P = ssdoViewPosition(vec2(p) + 0.5, iz, invSize, p00, p11, p20, p21);
-  vec3 N = unpackNormal(centre.y);
+  vec3 N = giDecodeNormal(centre.y);
 
   // Tangent frame (Duff et al. 2017): never degenerate.
   float sg = N.z >= 0.0 ? 1.0 : -1.0;
@@ -299,7 +299,7 @@ void main() {
     if (kBounce) {
       vec3 S = ssdoViewPosition(vec2(t) + 0.5, max(iS, 1e-30), invSize, p00, p11, p20, p21);
       vec3 Ls = vec3(unpackHalf2x16(surface.z), unpackHalf2x16(surface.w).x);
-      send = blocked ? sendFrom(S, unpackNormal(surface.y), Ls, P, N, dMin2) : vec3(0.0);
+      send = blocked ? sendFrom(S, giDecodeNormal(surface.y), Ls, P, N, dMin2) : vec3(0.0);
     }
     for (int cam = 0; cam < kCameras; ++cam) {
       // The same test in camera `cam`'s image (one layer, range guard, texel-centre slide).
@@ -331,7 +331,7 @@ void main() {
                                    q.z, q.w);
         mat4 fromC = camFrom[cam];
         vec3 S = (fromC * vec4(Sc, 1.0)).xyz;
-        vec3 Ns = mat3(fromC) * unpackNormal(sc.y);
+        vec3 Ns = mat3(fromC) * giDecodeNormal(sc.y);
         vec3 Ls = vec3(unpackHalf2x16(sc.z), unpackHalf2x16(sc.w).x);
         send = (!blocked && blockedC) ? sendFrom(S, Ns, Ls, P, N, dMin2) : send;
       }

@@ -11,6 +11,8 @@
 #ifndef SSDO_COMMON_GLSL
 #define SSDO_COMMON_GLSL
 
+#include "normal_codec.glsl"  // giEncodeNormal, giDecodeNormal: the ssdo_surface normal
+
 // An additional camera (seed 000 §4): its view space relative to the main one and its image.
 struct SsdoCamera {
   mat4 toCamera;    // main view space -> this camera's view space
@@ -30,21 +32,6 @@ layout(set = 0, binding = 1, std140) uniform SsdoParams {
   SsdoCamera cameras[4];  // the `cameras` first are valid (gi::ssdo::kMaxCameras)
   uvec4 samples[128];  // [phase][i] at flat phase * 32 + i (gi::ssdo::pack)
 } ssdo;
-
-vec2 ssdoSignNotZero(vec2 v) { return vec2(v.x >= 0.0 ? 1.0 : -1.0, v.y >= 0.0 ? 1.0 : -1.0); }
-
-uint packNormal(vec3 n) {
-  n /= max(abs(n.x) + abs(n.y) + abs(n.z), 1e-30);
-  vec2 e = n.z >= 0.0 ? n.xy : (1.0 - abs(n.yx)) * ssdoSignNotZero(n.xy);
-  return packSnorm2x16(e);
-}
-vec3 unpackNormal(uint p) {
-  vec2 e = unpackSnorm2x16(p);
-  vec3 n = vec3(e, 1.0 - abs(e.x) - abs(e.y));
-  float t = max(-n.z, 0.0);
-  n.xy -= t * ssdoSignNotZero(n.xy);
-  return safeNormalize(n, vec3(0.0, 0.0, 1.0));
-}
 
 // The blur's normal (raw texel w): 10-bit snorm x, y, z, decoded per tap in a third of the
 // octahedral decode's instructions. Unnormalized on decode (within 1/511 of unit length).

@@ -98,6 +98,6 @@ void main() {
     iz1 = geometry && d1 > 0.0 && iz1 > 0.0 && iz1 < 65000.0 ? iz1 : 0.0;
   }
   imageStore(outSurface, p,
-             uvec4(floatBitsToUint(iz), packNormal(n), packHalf2x16(radiance.rg),
+             uvec4(floatBitsToUint(iz), giEncodeNormal(n), packHalf2x16(radiance.rg),
                    packHalf2x16(vec2(radiance.b, iz1))));
 }
