@@ -18,8 +18,8 @@
 #include "gi/effect_registry.h"
 #include "gi/effect_shader.h"
 #include "gi/screen_space_ao.h"
+#include "gi/separable_dispatch.h"
 #include "gi/setting_uniforms.h"
-#include "gi/vk/resources.h"
 
 namespace {
 
@@ -227,21 +227,19 @@ class AlchemyEffect : public gi::Effect {
                              gi::TextureUsage::StorageWrite);
           },
           [this, io, nearest](gi::PassContext& pc) {
-            const VkExtent2D e = pc.extent(io->ao);
-            auto axis = [&](const gi::vk::Pipeline& p, VkImageView in, VkImageLayout inLayout,
-                            VkImageView out) {
-              gi::vk::DescriptorWriter w(p);
-              w.buffer("params", uniforms_.handle())
-                  .texture("inAO", in, nearest, inLayout)
-                  .image("outAO", out);
-              pc.dispatch(p, w, e, kGroupX, kGroupY);
-            };
-            axis(blurX_, pc.view(io->raw), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                 pc.view(io->half));
-            // The graph orders passes, not dispatches inside one: the y dispatch reads what the
-            // x dispatch wrote (the image stays GENERAL, as storage images are).
-            gi::vk::storageWriteToSampledRead(pc.cmd(), pc.image(io->half));
-            axis(blurY_, pc.view(io->half), VK_IMAGE_LAYOUT_GENERAL, pc.view(io->ao));
+            gi::dispatchSeparable(
+                pc,
+                {.x = &blurX_,
+                 .y = &blurY_,
+                 .input = "inAO",
+                 .output = "outAO",
+                 .sampler = nearest,
+                 .bind = [this](
+                             gi::vk::DescriptorWriter& w,
+                             const gi::vk::Pipeline&) { w.buffer("params", uniforms_.handle()); },
+                 .groupX = kGroupX,
+                 .groupY = kGroupY},
+                io->raw, io->half, io->ao);
           });
     }
     bb.put(res::kAO, io->ao);

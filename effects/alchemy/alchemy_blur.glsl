@@ -13,6 +13,9 @@
 // plane is affine in screen space, so the prediction is exact along a plane at any angle; the
 // plane comes from the centre's normal). Across a depth edge or once a crease leaves the plane,
 // the neighbour is rejected; sky neighbours (1/z = 0) always are.
+#include "common.glsl"
+#include "depth_aware_blur.glsl"  // depthAwareBlurWeight
+
 layout(local_size_x = 32, local_size_y = 16) in;
 
 layout(constant_id = 0) const int kRadius = 4;  // 1..gi::alchemy::kMaxBlurRadius
@@ -51,10 +54,7 @@ void main() {
     ivec2 q = p + o * kAxis;
     bool inside = q.x >= 0 && q.y >= 0 && q.x < size.x && q.y < size.y;
     vec4 n = texelFetch(inAO, clamp(q, ivec2(0), size - 1), 0);
-    float pred = ic + slope * float(o);
-    // |1/n.y - 1/pred| < tol, without a division (n.y, pred > 0).
-    bool sameSurface = inside && pred > 0.0 && abs(pred - n.y) < tol * n.y * pred;
-    float w = sameSurface ? (abs(o) == kRadius ? 0.5 : 1.0) : 0.0;
+    float w = inside ? depthAwareBlurWeight(o, kRadius, ic, slope, n.y, tol) : 0.0;
     sum += w * n.x;
     weights += w;
   }

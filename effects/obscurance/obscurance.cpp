@@ -15,8 +15,8 @@
 #include "gi/effect_shader.h"
 #include "gi/lit_surface.h"
 #include "gi/screen_space_ao.h"
+#include "gi/separable_dispatch.h"
 #include "gi/setting_uniforms.h"
-#include "gi/vk/resources.h"
 #include "obscurance.comp.h"         // const uint32_t obscurance_comp[]
 #include "obscurance_filter.comp.h"  // const uint32_t obscurance_filter_comp[]
 #include "obscurance_kernel.h"
@@ -218,27 +218,19 @@ class ObscuranceEffect : public gi::Effect {
                             gi::TextureUsage::StorageWrite);
         },
         [this, io, frame, nearest, filter](gi::PassContext& pc) {
-          const VkExtent2D e = pc.extent(io->out);
-          auto axis = [&](const gi::vk::Pipeline& p, VkImageView in, VkImageLayout inLayout,
-                          VkImageView out) {
-            gi::vk::DescriptorWriter w(p);
-            w.buffer("Frame", frame)
-                .buffer("obs", uniforms_.handle())
-                .texture("inSums", in, nearest, inLayout)
-                .image("outImage", out);
-            pc.dispatch(p, w, e, kGroupX, kGroupY);
-          };
-          if (!filter) {
-            axis(resolve_, pc.view(io->sums), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-                 pc.view(io->out));
-            return;
-          }
-          axis(filterX_, pc.view(io->sums), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-               pc.view(io->half));
-          // The graph orders passes, not dispatches inside one: the y dispatch reads what the
-          // x dispatch wrote (the image stays GENERAL, as storage images are).
-          gi::vk::storageWriteToSampledRead(pc.cmd(), pc.image(io->half));
-          axis(resolve_, pc.view(io->half), VK_IMAGE_LAYOUT_GENERAL, pc.view(io->out));
+          gi::dispatchSeparable(pc,
+                                {.x = filter ? &filterX_ : nullptr,
+                                 .y = &resolve_,
+                                 .input = "inSums",
+                                 .output = "outImage",
+                                 .sampler = nearest,
+                                 .bind =
+                                     [&](gi::vk::DescriptorWriter& w, const gi::vk::Pipeline&) {
+                                       w.buffer("Frame", frame).buffer("obs", uniforms_.handle());
+                                     },
+                                 .groupX = kGroupX,
+                                 .groupY = kGroupY},
+                                io->sums, io->half, io->out);
         });
     bb.put(radiance ? res::kAmbient : res::kAO, io->out);
     if (radiance) bb.put(res::kDirectLight, io->direct);

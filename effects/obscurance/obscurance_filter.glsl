@@ -14,6 +14,8 @@
 // along x and y per pixel, w (MODE 3) = half2 of the colour numerator's g, b (x then holds
 // its r and D + eta). One fetch per tap, no G-buffer reads. MODE 3 resolves to the RGBA16F
 // "ambient" (GI_AMBIENT), the other modes to the R16F "ao".
+#include "depth_aware_blur.glsl"  // depthAwareBlurWeight
+
 layout(local_size_x = 32, local_size_y = 16) in;
 
 // 0 obscurance, 1 W (albedo), 2 W (emission), 3 ambient radiance (RGB)
@@ -84,10 +86,7 @@ void main() {
     bool inside = q.x >= 0 && q.y >= 0 && q.x < size.x && q.y < size.y;
     uvec4 t = texelFetch(inSums, clamp(q, ivec2(0), size - 1), 0);
     float iq = uintBitsToFloat(t.y);
-    float pred = ic + slope * float(o);
-    // |1/iq - 1/pred| < tol without a division (iq, pred > 0); sky (iq = 0) is rejected.
-    bool sameSurface = inside && pred > 0.0 && abs(pred - iq) < tol * iq * pred;
-    float w = sameSurface ? (abs(o) == RADIUS ? 0.5 : 1.0) : 0.0;
+    float w = inside ? depthAwareBlurWeight(o, RADIUS, ic, slope, iq, tol) : 0.0;
     sum += w * vec4(unpackHalf2x16(t.x), MODE == 3 ? unpackHalf2x16(t.w) : vec2(0.0));
     weights += w;
   }

@@ -14,6 +14,7 @@ layout(local_size_x = 32, local_size_y = 16) in;
 
 layout(set = 0, binding = 0) uniform Frame { FrameUniforms frame; };
 #include "ssdo_common.glsl"
+#include "depth_aware_blur.glsl"  // depthAwareBlurWeight
 layout(set = 0, binding = 2) uniform usampler2D inRaw;
 layout(constant_id = 0) const int kRadius = 2;  // 0..gi::ssdo::kMaxBlurRadius: the loop unrolls
 // The bounce term (off: `bounce` is 0, never decoded: the blur then costs what one term does).
@@ -49,17 +50,16 @@ void ssdoBlur(ivec2 p, ivec2 size, uvec4 centre, out vec3 direct, out vec3 bounc
     ivec2 q = p + o * axis;
     bool inside = q.x >= 0 && q.y >= 0 && q.x < size.x && q.y < size.y;
     uvec4 t = texelFetch(inRaw, clamp(q, ivec2(0), size - 1), 0);
-    float iq = uintBitsToFloat(t.z);  // sky: 0, rejected
-    float pred = ic + slope * float(o);
-    // |1/iq - 1/pred| < tol without a division (iq, pred > 0); the normals within acos(min
-    // cosine), without normalizing the neighbour's: (N.n)^2 > c^2 |n|^2.
-    bool same = inside && pred > 0.0 && iq > 0.0 && abs(pred - iq) < tol * iq * pred;
+    // The normals within acos(min cosine), without normalizing the neighbour's:
+    // (N.n)^2 > c^2 |n|^2.
+    bool sameNormal = true;
     if (kNormalTest) {
       vec3 n = unpackBlurNormal(t.w);
       float c = dot(N, n);
-      same = same && c > 0.0 && c * c > minCos2 * dot(n, n);
+      sameNormal = c > 0.0 && c * c > minCos2 * dot(n, n);
     }
-    float w = same ? (abs(o) == kRadius ? 0.5 : 1.0) : 0.0;
+    float iq = uintBitsToFloat(t.z);  // sky: 0, no weight
+    float w = inside && sameNormal ? depthAwareBlurWeight(o, kRadius, ic, slope, iq, tol) : 0.0;
     direct += w * unpackRgb9e5(t.x);
     if (kBounceTerm) bounce += w * unpackRgb9e5(t.y);
     weights += w;

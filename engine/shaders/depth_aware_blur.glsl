@@ -34,6 +34,17 @@ vec4 depthAwareBlurPack(FrameUniforms f, float value, vec3 P, vec3 N) {
   return vec4(value, iz, slopes);
 }
 
+// The blur's weight of the neighbour `o` pixels along the axis (0 < |o| <= radius): the box's
+// (half at the ends) when its 1 / view distance `iq` lies within `tol` (world units) of the
+// centre's tangent plane (1 / view distance `ic`, `slope` d(1/z)/dpixel along the axis), else 0.
+// |1/iq - 1/pred| < tol without a division (iq, pred > 0): sky (iq = 0) and a plane that does not
+// reach the neighbour (pred <= 0) get no weight. Effects with a blur of their own share it.
+float depthAwareBlurWeight(int o, int radius, float ic, float slope, float iq, float tol) {
+  float pred = ic + slope * float(o);
+  bool samePlane = pred > 0.0 && iq > 0.0 && abs(pred - iq) < tol * iq * pred;
+  return samePlane ? (abs(o) == radius ? 0.5 : 1.0) : 0.0;
+}
+
 // The texel of a producer at 1 / scale of the frame's resolution (gi::DepthAwareBlur's
 // `scale`): P and N are those of the frame pixel it stands for, the slopes per low-resolution
 // pixel.

@@ -5,6 +5,9 @@
 // memory: on llvmpipe every shared-memory access is gathered lane by lane and barriers are
 // costly. Include after defining GI_BLUR_AXIS (0: x, 1: y), GI_BLUR_KEEP_PACKED where the
 // packed texel is kept, and declaring `outValue` (binding 1).
+#include "common.glsl"
+#include "depth_aware_blur.glsl"  // depthAwareBlurWeight
+
 layout(local_size_x = 32, local_size_y = 16) in;
 
 layout(set = 0, binding = 0) uniform sampler2D inPacked;  // depthAwareBlurPack texels
@@ -27,11 +30,7 @@ void main() {
     ivec2 q = p + o * axis;
     bool inside = q.x >= 0 && q.y >= 0 && q.x < size.x && q.y < size.y;
     vec4 t = texelFetch(inPacked, clamp(q, ivec2(0), size - 1), 0);
-    float iq = t.y;  // sky: 0, rejected below
-    float pred = ic + slope * float(o);
-    // |1/iq - 1/pred| < tolerance, without a division (iq, pred > 0).
-    bool sameSurface = inside && pred > 0.0 && iq > 0.0 && abs(pred - iq) < push.tolerance * iq * pred;
-    float w = sameSurface ? (abs(o) == kRadius ? 0.5 : 1.0) : 0.0;
+    float w = inside ? depthAwareBlurWeight(o, kRadius, ic, slope, t.y, push.tolerance) : 0.0;
     sum += w * t.x;
     weights += w;
   }

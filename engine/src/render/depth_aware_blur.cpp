@@ -5,7 +5,7 @@
 
 #include "gi/errors.h"
 #include "gi/image_pass.h"
-#include "gi/vk/resources.h"
+#include "gi/separable_dispatch.h"
 
 namespace gi {
 namespace {
@@ -61,18 +61,18 @@ TextureHandle DepthAwareBlur::addPass(FrameGraph& graph, EffectContext& ctx,
               b.write(b.create(scale_ > 1 ? name + "_y" : output, out), TextureUsage::StorageWrite);
         },
         [this, io, tolerance, nearest](PassContext& pc) {
-          const VkExtent2D e = pc.extent(io->out);
           const Push push{tolerance()};
-          auto axis = [&](const vk::Pipeline& p, VkImageView in, VkImageLayout inLayout,
-                          VkImageView out) {
-            vk::DescriptorWriter w(p);
-            w.texture("inPacked", in, nearest, inLayout).image("outValue", out);
-            pc.dispatch(p, w, e, kGroupX, kGroupY, push);
-          };
-          axis(x_, pc.view(io->packed), VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-               pc.view(io->half));
-          vk::storageWriteToSampledRead(pc.cmd(), pc.image(io->half));
-          axis(y_, pc.view(io->half), VK_IMAGE_LAYOUT_GENERAL, pc.view(io->out));
+          dispatchSeparable(pc,
+                            {.x = &x_,
+                             .y = &y_,
+                             .input = "inPacked",
+                             .output = "outValue",
+                             .sampler = nearest,
+                             .bind = [&](vk::DescriptorWriter&,
+                                         const vk::Pipeline& p) { p.push(pc.cmd(), push); },
+                             .groupX = kGroupX,
+                             .groupY = kGroupY},
+                            io->packed, io->half, io->out);
         });
     blurred = io->out;
     if (scale_ == 1) return blurred;
