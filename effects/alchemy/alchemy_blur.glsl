@@ -51,9 +51,8 @@ void main() {
   float sum = c.x, weights = 1.0;
   for (int o = -kRadius; o <= kRadius; ++o) {
     if (o == 0) continue;
-    ivec2 q = p + o * kAxis;
-    bool inside = q.x >= 0 && q.y >= 0 && q.x < size.x && q.y < size.y;
-    vec4 n = texelFetch(inAO, clamp(q, ivec2(0), size - 1), 0);
+    bool inside;
+    vec4 n = texelFetch(inAO, depthAwareBlurTap(p, o, kAxis, size, inside), 0);
     float w = inside ? depthAwareBlurWeight(o, kRadius, ic, slope, n.y, tol) : 0.0;
     sum += w * n.x;
     weights += w;

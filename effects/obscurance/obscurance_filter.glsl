@@ -82,9 +82,8 @@ void main() {
   float weights = 1.0;
   for (int o = -RADIUS; o <= RADIUS; ++o) {
     if (o == 0) continue;
-    ivec2 q = p + o * axis;
-    bool inside = q.x >= 0 && q.y >= 0 && q.x < size.x && q.y < size.y;
-    uvec4 t = texelFetch(inSums, clamp(q, ivec2(0), size - 1), 0);
+    bool inside;
+    uvec4 t = texelFetch(inSums, depthAwareBlurTap(p, o, axis, size, inside), 0);
     float iq = uintBitsToFloat(t.y);
     float w = inside ? depthAwareBlurWeight(o, RADIUS, ic, slope, iq, tol) : 0.0;
     sum += w * vec4(unpackHalf2x16(t.x), MODE == 3 ? unpackHalf2x16(t.w) : vec2(0.0));

@@ -47,9 +47,8 @@ void ssdoBlur(ivec2 p, ivec2 size, uvec4 centre, out vec3 direct, out vec3 bounc
   float weights = 1.0;
   for (int o = -kRadius; o <= kRadius; ++o) {
     if (o == 0) continue;
-    ivec2 q = p + o * axis;
-    bool inside = q.x >= 0 && q.y >= 0 && q.x < size.x && q.y < size.y;
-    uvec4 t = texelFetch(inRaw, clamp(q, ivec2(0), size - 1), 0);
+    bool inside;
+    uvec4 t = texelFetch(inRaw, depthAwareBlurTap(p, o, axis, size, inside), 0);
     // The normals within acos(min cosine), without normalizing the neighbour's:
     // (N.n)^2 > c^2 |n|^2.
     bool sameNormal = true;

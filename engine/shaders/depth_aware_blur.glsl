@@ -34,6 +34,14 @@ vec4 depthAwareBlurPack(FrameUniforms f, float value, vec3 P, vec3 N) {
   return vec4(value, iz, slopes);
 }
 
+// The neighbour `o` pixels along `axis` from p, clamped into the image; `inside`: it was in it
+// (a clamped tap is fetched, for a uniform loop, and given no weight).
+ivec2 depthAwareBlurTap(ivec2 p, int o, ivec2 axis, ivec2 size, out bool inside) {
+  ivec2 q = p + o * axis;
+  inside = q.x >= 0 && q.y >= 0 && q.x < size.x && q.y < size.y;
+  return clamp(q, ivec2(0), size - 1);
+}
+
 // The blur's weight of the neighbour `o` pixels along the axis (0 < |o| <= radius): the box's
 // (half at the ends) when its 1 / view distance `iq` lies within `tol` (world units) of the
 // centre's tangent plane (1 / view distance `ic`, `slope` d(1/z)/dpixel along the axis), else 0.

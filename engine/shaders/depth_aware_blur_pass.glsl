@@ -27,9 +27,8 @@ void main() {
   float sum = centre.x, weights = 1.0;
   for (int o = -kRadius; o <= kRadius; ++o) {
     if (o == 0) continue;
-    ivec2 q = p + o * axis;
-    bool inside = q.x >= 0 && q.y >= 0 && q.x < size.x && q.y < size.y;
-    vec4 t = texelFetch(inPacked, clamp(q, ivec2(0), size - 1), 0);
+    bool inside;
+    vec4 t = texelFetch(inPacked, depthAwareBlurTap(p, o, axis, size, inside), 0);
     float w = inside ? depthAwareBlurWeight(o, kRadius, ic, slope, t.y, push.tolerance) : 0.0;
     sum += w * t.x;
     weights += w;
