@@ -2,8 +2,11 @@
 // decimal and finite, ranges are printed as written, lists refuse empty and repeated items,
 // outputs are checked before any work and written atomically.
 #include <sys/stat.h>
+#include <sys/sysmacros.h>
 #include <unistd.h>
 
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -214,24 +217,24 @@ TEST(CliArgs, OutputsAreCheckedBeforeAnyWork) {
   cli::checkOutputWritable(dir.path("nodir/deeper/x.png"));
   EXPECT_FALSE(fs::exists(dir.path("nodir"))) << "the check leaves nothing behind";
   std::string msg =
-      errorOf([] { cli::checkOutputWritable("/sys/gi-nodir/x.png"); }, ErrorKind::FileNotFound);
+      errorOf([] { cli::checkOutputWritable("/sys/gi-nodir/x.png"); }, ErrorKind::Output);
   EXPECT_NE(msg.find("cannot write in the output folder /sys: "), std::string::npos) << msg;
   const std::string plain = dir.write("plain", "x");
-  msg = errorOf([&] { cli::checkOutputWritable(plain + "/x.png"); }, ErrorKind::FileNotFound);
+  msg = errorOf([&] { cli::checkOutputWritable(plain + "/x.png"); }, ErrorKind::Output);
   EXPECT_NE(msg.find("is not a folder"), std::string::npos) << msg;
   fs::create_directories(dir.path("folder.png"));
-  msg = errorOf([&] { cli::checkOutputWritable(dir.path("folder.png")); }, ErrorKind::FileNotFound);
+  msg = errorOf([&] { cli::checkOutputWritable(dir.path("folder.png")); }, ErrorKind::Output);
   EXPECT_NE(msg.find("output path is a folder"), std::string::npos) << msg;
   // A folder that exists but cannot be written (also as root: /sys refuses new files).
-  msg = errorOf([] { cli::checkOutputWritable("/sys/gi-test.png"); }, ErrorKind::FileNotFound);
+  msg = errorOf([] { cli::checkOutputWritable("/sys/gi-test.png"); }, ErrorKind::Output);
   EXPECT_NE(msg.find("cannot write in the output folder /sys: "), std::string::npos) << msg;
   EXPECT_EQ(msg.find("does the folder exist"), std::string::npos) << msg;
   // Folders to be created: the nearest existing ancestor must be writable.
   cli::checkOutputFolder(dir.path("new/deeper"));
   EXPECT_FALSE(fs::exists(dir.path("new")));
-  errorOf([] { cli::checkOutputFolder("/sys/gi-test-dir"); }, ErrorKind::FileNotFound);
+  errorOf([] { cli::checkOutputFolder("/sys/gi-test-dir"); }, ErrorKind::Output);
   const std::string file = dir.write("file", "x");
-  msg = errorOf([&] { cli::checkOutputFolder(file); }, ErrorKind::FileNotFound);
+  msg = errorOf([&] { cli::checkOutputFolder(file); }, ErrorKind::Output);
   EXPECT_NE(msg.find("exists and is not a folder"), std::string::npos) << msg;
 }
 
@@ -245,24 +248,42 @@ TEST(CliArgs, OutputsNeverReplaceWhatIsNotARegularFile) {
     EXPECT_TRUE(fs::is_fifo(fifo)) << "replaced";
     EXPECT_FALSE(fs::exists(fifo + ".partial"));
   };
-  const std::string msg = errorOf([&] { cli::checkOutputWritable(fifo); }, ErrorKind::FileNotFound);
+  const std::string msg = errorOf([&] { cli::checkOutputWritable(fifo); }, ErrorKind::Output);
   EXPECT_NE(msg.find("not a regular file"), std::string::npos) << msg;
-  errorOf([&] { cli::writeFileAtomic(fifo, "digraph {}\n"); }, ErrorKind::FileNotFound);
+  errorOf([&] { cli::writeFileAtomic(fifo, "digraph {}\n"); }, ErrorKind::Output);
   stillAFifo();
   ImageRGBA8 image;
   image.width = image.height = 1;
   image.pixels = {1, 2, 3, 255};
-  errorOf([&] { writePng(fifo, image); }, ErrorKind::FileNotFound);
+  errorOf([&] { writePng(fifo, image); }, ErrorKind::Output);
   stillAFifo();
   // Through a symbolic link too; a link to a regular file is an ordinary output.
   const std::string link = dir.path("link.png");
   fs::create_symlink(fifo, link);
-  errorOf([&] { cli::checkOutputWritable(link); }, ErrorKind::FileNotFound);
+  errorOf([&] { cli::checkOutputWritable(link); }, ErrorKind::Output);
   stillAFifo();
   EXPECT_TRUE(fs::is_symlink(link));
   const std::string plain = dir.write("plain.png", "x"), plainLink = dir.path("plain_link.png");
   fs::create_symlink(plain, plainLink);
   cli::checkOutputWritable(plainLink);
+}
+
+TEST(CliArgs, OutputsNeverReplaceADeviceNode) {
+  // A private character device (the null device's numbers) in a temporary folder, never the
+  // system's: refused before any work and at commit; it stays a device node.
+  test::TempDir dir("test_cli_args_node");
+  const std::string node = dir.path("node.png");
+  if (::mknod(node.c_str(), S_IFCHR | 0600, makedev(1, 3)) != 0)
+    GTEST_SKIP() << "mknod is not permitted here: " << std::strerror(errno);
+  const std::string msg = errorOf([&] { cli::checkOutputWritable(node); }, ErrorKind::Output);
+  EXPECT_NE(msg.find("not a regular file"), std::string::npos) << msg;
+  errorOf([&] { cli::writeFileAtomic(node, "digraph {}\n"); }, ErrorKind::Output);
+  ImageRGBA8 image;
+  image.width = image.height = 1;
+  image.pixels = {1, 2, 3, 255};
+  errorOf([&] { writePng(node, image); }, ErrorKind::Output);
+  EXPECT_TRUE(fs::is_character_file(node)) << "replaced";
+  EXPECT_FALSE(fs::exists(node + ".partial"));
 }
 
 TEST(CliArgs, AtomicWritesLeaveNothingOnFailure) {
@@ -278,7 +299,7 @@ TEST(CliArgs, AtomicWritesLeaveNothingOnFailure) {
   cli::writeFileAtomic(dir.path("nodir/deeper/a.txt"), "x");
   EXPECT_TRUE(fs::is_regular_file(dir.path("nodir/deeper/a.txt")));
   const std::string plain = dir.write("plain", "x");
-  errorOf([&] { cli::writeFileAtomic(plain + "/a.txt", "x"); }, ErrorKind::FileNotFound);
+  errorOf([&] { cli::writeFileAtomic(plain + "/a.txt", "x"); }, ErrorKind::Output);
   EXPECT_FALSE(fs::exists(plain + "/a.txt.partial"));
 }
 

@@ -218,11 +218,11 @@ void checkWritableFolder(const fs::path& folder, const std::string& path, const 
   if (!fs::exists(dir, ec))
     throw Error(ErrorKind::FileNotFound, path, "output folder " + dir.string() + " does not exist");
   if (!fs::is_directory(dir, ec))
-    throw Error(ErrorKind::FileNotFound, path, dir.string() + " is not a folder");
+    throw Error(ErrorKind::Output, path, dir.string() + " is not a folder");
   const fs::path file = dir / probe;
   const int fd = ::open(file.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
   if (fd < 0 && errno != EEXIST)
-    throw Error(ErrorKind::FileNotFound, path,
+    throw Error(ErrorKind::Output, path,
                 "cannot write in the output folder " + dir.string() + ": " + std::strerror(errno));
   if (fd >= 0) {
     ::close(fd);
@@ -244,14 +244,14 @@ void checkOutputWritable(const std::string& path) {
   }
   checkWritableFolder(folder, path, fs::path(path).filename().string() + ".partial");
   if (fs::exists(path, ec) && ::access(path.c_str(), W_OK) != 0)
-    throw Error(ErrorKind::FileNotFound, path, "output file exists and is not writable");
+    throw Error(ErrorKind::Output, path, "output file exists and is not writable");
 }
 
 void checkOutputFolder(const std::string& dir) {
   std::error_code ec;
   if (fs::exists(dir, ec)) {
     if (!fs::is_directory(dir, ec))
-      throw Error(ErrorKind::FileNotFound, dir, "output path exists and is not a folder");
+      throw Error(ErrorKind::Output, dir, "output path exists and is not a folder");
     checkWritableFolder(dir, dir, ".gi-write-check-" + std::to_string(::getpid()));
     return;
   }
@@ -272,7 +272,7 @@ void writeFileAtomic(const std::string& path, const std::string& text) {
     out.flush();
     if (!out) {
       fs::remove(tmp, ec);
-      throw Error(ErrorKind::FileNotFound, path, "cannot write the file");
+      throw Error(ErrorKind::Output, path, "cannot write the file");
     }
   }
   try {
@@ -284,7 +284,7 @@ void writeFileAtomic(const std::string& path, const std::string& text) {
   fs::rename(tmp, path, ec);
   if (ec) {
     fs::remove(tmp, ec);
-    throw Error(ErrorKind::FileNotFound, path, "cannot write the file: " + ec.message());
+    throw Error(ErrorKind::Output, path, "cannot write the file: " + ec.message());
   }
 }
 

@@ -21,6 +21,8 @@ enum class ErrorKind {
   Vulkan,           // Vulkan call failed
   Usage,            // bad command-line argument
   ShaderInterface,  // a shader's bindings or blocks disagree with the C++ that uses them
+  Output,           // an output path that cannot be written: not a folder, not a regular file,
+                    // no permission, the write failed (a missing file to read is FileNotFound)
 };
 
 const char* errorKindName(ErrorKind kind);

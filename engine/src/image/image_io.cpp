@@ -29,7 +29,7 @@ void commitFile(const std::string& tmp, const std::string& path) {
   std::filesystem::rename(tmp, path, ec);
   if (ec) {
     std::filesystem::remove(tmp, ec);
-    throw Error(ErrorKind::FileNotFound, path, "cannot write output file");
+    throw Error(ErrorKind::Output, path, "cannot write output file");
   }
 }
 // The temporary file beside `path`, whose missing folders are made first (an output named
@@ -46,7 +46,7 @@ void checkReplaceableOutput(const std::string& path) {
   std::error_code ec;
   const std::filesystem::file_status st = std::filesystem::status(path, ec);
   if (ec || !std::filesystem::exists(st) || std::filesystem::is_regular_file(st)) return;
-  throw Error(ErrorKind::FileNotFound, path,
+  throw Error(ErrorKind::Output, path,
               std::filesystem::is_directory(st)
                   ? "output path is a folder, not a file"
                   : "output path is not a regular file (a device, FIFO or socket): it is never "
@@ -61,7 +61,7 @@ void writePng(const std::string& path, const ImageRGBA8& image) {
     const int err = errno;  // stb opens the file with fopen
     std::error_code ec;
     std::filesystem::remove(tmp, ec);
-    throw Error(ErrorKind::FileNotFound, path,
+    throw Error(ErrorKind::Output, path,
                 std::string("cannot write PNG: ") + (err ? std::strerror(err) : "write failed"));
   }
   commitFile(tmp, path);
@@ -87,7 +87,7 @@ void writePfm(const std::string& path, const ImageRGBA32F& image) {
     std::ofstream out(tmp, std::ios::binary);
     if (!out)
       throw Error(
-          ErrorKind::FileNotFound, path,
+          ErrorKind::Output, path,
           std::string("cannot write PFM: ") + (errno ? std::strerror(errno) : "open failed"));
     out << "PF\n" << image.width << " " << image.height << "\n-1.0\n";  // -1: little-endian
     std::vector<float> row(size_t(image.width) * 3);
@@ -102,7 +102,7 @@ void writePfm(const std::string& path, const ImageRGBA32F& image) {
       out.close();
       std::error_code ec;
       std::filesystem::remove(tmp, ec);
-      throw Error(ErrorKind::FileNotFound, path, "write failed");
+      throw Error(ErrorKind::Output, path, "write failed");
     }
   }
   commitFile(tmp, path);

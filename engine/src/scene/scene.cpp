@@ -174,6 +174,8 @@ const char* errorKindName(ErrorKind kind) {
       return "usage error";
     case ErrorKind::ShaderInterface:
       return "shader interface mismatch";
+    case ErrorKind::Output:
+      return "output error";
   }
   return "error";
 }
