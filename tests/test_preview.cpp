@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include "gi/effect.h"
 #include "preview.h"
@@ -42,6 +43,16 @@ TEST(Preview, OneChannelTargetsAreGrey) {
   EXPECT_EQ(ao.pixels[1], 64);
   EXPECT_EQ(ao.pixels[2], 64);
   EXPECT_EQ(ao.pixels[3], 255);
+}
+
+// A float view of a one-channel resource holds its R alone (the AO family's unblurred texel
+// has 1/z and signed slopes in G..A); other views keep every channel.
+TEST(Preview, FloatViewsOfOneChannelTargetsHoldOnlyTheirChannel) {
+  const gi::ImageRGBA32F ao =
+      gi::app::definedChannels(onePixel(0.25f, 3.0f, -0.5f, 0.1f), gi::resources::kAO);
+  EXPECT_EQ(ao.pixels, (std::vector<float>{0.25f, 0.25f, 0.25f, 1.0f}));
+  const gi::ImageRGBA32F lit = gi::app::definedChannels(onePixel(0.25f, 3.0f, -0.5f, 0.1f), "lit");
+  EXPECT_EQ(lit.pixels, (std::vector<float>{0.25f, 3.0f, -0.5f, 0.1f}));
 }
 
 }  // namespace

@@ -12,4 +12,10 @@ namespace gi::app {
 // non-finite float to a byte (undefined behaviour).
 ImageRGBA8 previewOf(const ImageRGBA32F& image, const std::string& view);
 
+// What a float view (--out F.pfm) holds: the target's channels, except for the one-channel
+// resources (depth, ao), whose R is copied to G and B and alpha set to 1. Their other channels
+// are the producer's own: the AO family's unblurred texel (blur_radius = 0) carries 1 / view
+// distance and the tangent plane's signed slopes there, which no view should show as data.
+ImageRGBA32F definedChannels(ImageRGBA32F image, const std::string& view);
+
 }  // namespace gi::app

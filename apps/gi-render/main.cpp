@@ -113,7 +113,8 @@ Options parseArgs(int argc, char** argv) {
 void writeImage(const std::string& path, const std::string& view, gi::Renderer& renderer) {
   const bool output = view == gi::resources::kOutput;
   if (std::filesystem::path(path).extension() == ".pfm")
-    gi::writePfm(path, renderer.readTarget(output ? gi::resources::kLit : view));
+    gi::writePfm(path, output ? renderer.readTarget(gi::resources::kLit)
+                              : gi::app::definedChannels(renderer.readTarget(view), view));
   else if (output)
     gi::writePng(path, renderer.readOutput());
   else
