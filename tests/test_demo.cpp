@@ -404,6 +404,38 @@ TEST(Demo, HotReloadOfARebuiltPlugin) {
   EXPECT_EQ(b.pixels, c.pixels) << "a broken module must leave the running one in place";
 }
 
+// A plugin whose pass throws while it records, in the middle of a run (a uniform-only setting
+// set by the script makes it fail): the demo turns it off, says why on one line naming the
+// effect, the pass and the module, and goes on drawing the frame without it, exactly as
+// gi-render draws the scene with no effect.
+TEST(Demo, APluginThatFailsWhileRecordingIsTurnedOffAndTheDemoGoesOn) {
+  REQUIRE_DEMO();
+  const std::string dir = test::makeTempDir("demo_plugin_fails");
+  const std::string plugins = dir + "/plugins", plugin = plugins + "/gi_effect_reloadable.so";
+  fs::create_directories(plugins);
+  fs::copy_file(std::string(GI_TEST_MODULE_DIR) + "/gi_test_reloadable_fails.so", plugin);
+  const std::string script = writeScript(
+      dir, "pause on\nframes 2\nscreenshot " + dir + "/a.png\n" +
+               "set reloadable.value=1\nframes 2\nprint passes\nscreenshot " + dir + "/b.png\n");
+  auto r = runDemo(" --scene default --effects reloadable" + kSize + " --script " + script,
+                   "GI_PLUGIN_PATH=" + plugins);
+  ASSERT_EQ(r.exitCode, 0) << r.output;
+  EXPECT_EQ(r.output.find("validation"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find(plugin + ": effect 'reloadable', pass 'reloadable' failed while "
+                                   "recording: value above 0.9 (turned off)"),
+            std::string::npos)
+      << r.output;
+  const auto passes = listsAfter(r.output, "passes");
+  ASSERT_EQ(passes.size(), 1u) << r.output;
+  EXPECT_FALSE(anyStartsWith(passes[0], "reloadable")) << r.output;
+  auto h = test::runCommand(test::binPath("gi-render") + " --scene default --effects ''" + kSize +
+                            " --out " + dir + "/none.png");
+  ASSERT_EQ(h.exitCode, 0) << h.output;
+  EXPECT_EQ(readPng(dir + "/b.png").pixels, readPng(dir + "/none.png").pixels);
+  EXPECT_NE(readPng(dir + "/a.png").pixels, readPng(dir + "/b.png").pixels)
+      << "the effect's AO of 0.25 must show before it fails";
+}
+
 // Hot reload: a copy of ssao.comp in --shader-dir is broken (the compiler's message is reported,
 // the last good pipeline keeps giving the same image), changed to a constant AO of 0.5 (every
 // pixel of the AO view is 128), then restored (the first image again, bit for bit); no

@@ -338,16 +338,29 @@ TEST_F(EffectGraphTest, UniformOnlySettingsDoNotRecompile) {
 class Thrower : public Effect {
  public:
   EffectInfo info() const override {
-    return {"thrower", "1", "throws where told (test)", EffectStage::BeforeLighting, {}, {}, ""};
+    return {"thrower",        "1", "throws where told (test)", EffectStage::BeforeLighting, {},
+            {resources::kAO}, ""};
   }
   std::vector<SettingDesc> settings() const override {
-    SettingDesc where = SettingDesc::enumeration(
-        "where", {"nowhere", "prepare", "addPasses", "update"}, 0, "where it throws", true);
+    SettingDesc where =
+        SettingDesc::enumeration("where", {"nowhere", "prepare", "addPasses", "update", "record"},
+                                 0, "where it throws", true);
     return {where, {"an_int", SettingType::Bool, 0, 0, 1, "throw an int", true}};
   }
   void prepare(EffectContext&, const SettingValues& s) override { maybeThrow(s, "prepare"); }
-  void addPasses(FrameGraph&, EffectContext&, const SettingValues& s) override {
+  void addPasses(FrameGraph& graph, EffectContext&, const SettingValues& s) override {
     maybeThrow(s, "addPasses");
+    if (s.option("where") != "record") return;
+    // A pass that feeds the lighting (so it is not culled) and throws as it records.
+    auto out = std::make_shared<TextureHandle>();
+    graph.addPass(
+        "thrower_pass",
+        [&](PassBuilder& b) {
+          *out = b.write(b.create("thrower_ao", TextureDesc{VK_FORMAT_R8_UNORM}),
+                         TextureUsage::StorageWrite);
+        },
+        [values = &s](PassContext&) { maybeThrow(*values, "record"); });
+    graph.blackboard().put(resources::kAO, *out);
   }
   void update(EffectContext&, const SettingValues& s) override { maybeThrow(s, "update"); }
 
@@ -395,6 +408,27 @@ TEST_F(EffectGraphTest, AnEffectThatThrowsIsAnErrorNamingItAndTheCall) {
     live.renderFrame();
     EXPECT_EQ(live.settings().effects.size(), 1u);
     EXPECT_EQ(live.settings().effects[0].name, "const_ao");
+    // A pass of the effect that throws while it records: an EffectError naming the effect
+    // (what an app needs to turn it off), the pass and why, every frame it stays on; once it is
+    // off, the same renderer draws again (validation clean: nothing half-recorded remains).
+    rs.effects = {config("record", anInt)};
+    Renderer recording(ctx(), scene, rs, &reg);
+    for (int frame = 0; frame < 2; ++frame) {
+      try {
+        recording.renderFrame();
+        ADD_FAILURE() << "a pass that throws while recording did not fail the frame";
+      } catch (const EffectError& e) {
+        EXPECT_EQ(e.effect(), "thrower");
+        const std::string what = e.what();
+        EXPECT_NE(what.find("effect 'thrower', pass 'thrower_pass' failed while recording: "),
+                  std::string::npos)
+            << what;
+        EXPECT_NE(what.find(why), std::string::npos) << what;
+      }
+    }
+    recording.setEffects({{"const_ao", reg.defaultSettings("const_ao")}});
+    recording.renderFrame();
+    EXPECT_NEAR(recording.readTarget("ao").pixels[0], 0.5f, 1.0f / 255);  // const_ao's default
   }
 }
 

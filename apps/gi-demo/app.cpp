@@ -180,7 +180,15 @@ void App::frame() {
   if (!state_.paused || state_.stepOnce) state_.time += dt;
   state_.stepOnce = false;
   renderer.setTime(state_.time);
-  renderer.renderFrame();
+  try {
+    renderer.renderFrame();
+  } catch (const gi::EffectError& e) {
+    // A plugin that fails while the frame renders is turned off (the panel says why) and the
+    // frame is drawn without it; the demo goes on.
+    if (!controller_->turnOffFailed(e)) throw;
+    std::fprintf(stderr, "gi-demo: %s\n", controller_->lastError().c_str());
+    renderer.renderFrame();
+  }
   stats_.passes = renderer.lastTimings();
   stats_.deviceBytes = ctx_->allocator().bytesInUse();
 

@@ -88,6 +88,18 @@ bool Controller::setEnabled(const std::string& effect, bool on) {
   });
 }
 
+bool Controller::turnOffFailed(const gi::EffectError& failure) {
+  const std::string& effect = failure.effect();
+  if (!enabled(effect)) return false;
+  // Its debug view goes with it.
+  if (view_ != gi::resources::kOutput && registry_.has(effect) &&
+      (view_ == effect || view_ == registry_.info(effect).debugView))
+    setView(gi::resources::kOutput);
+  if (!setEnabled(effect, false)) return false;
+  error_ = std::string(failure.what()) + " (turned off)";
+  return true;
+}
+
 bool Controller::reloadEffects() {
   return attempt([&] {
     // Without its effects the renderer cannot show an effect's output: the view waits outside.

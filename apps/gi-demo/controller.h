@@ -13,6 +13,7 @@
 
 #include "gi/effect_config.h"
 #include "gi/effect_registry.h"
+#include "gi/errors.h"
 #include "gi/renderer.h"
 #include "gi/scene.h"
 
@@ -38,6 +39,9 @@ class Controller {
   const std::vector<std::string>& effects() const { return order_; }
   bool enabled(const std::string& effect) const;
   bool setEnabled(const std::string& effect, bool on);
+  // An effect whose code failed while a frame rendered (`failure` names it): turned off, with
+  // the failure kept as lastError() for the panel. False when it could not be turned off.
+  bool turnOffFailed(const gi::EffectError& failure);
   // Settings of an effect or of the engine (gi::kEngineSettingsOwner).
   const gi::SettingValues& settings(const std::string& owner) const;
   bool setSetting(const std::string& owner, const std::string& key, const nlohmann::json& value);

@@ -4,6 +4,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace gi {
 
@@ -39,6 +40,19 @@ class Error : public std::runtime_error {
  private:
   ErrorKind kind_;
   std::string file_;
+};
+
+// An error in an effect's code, or raised on its behalf (a check of what it declared, a pass it
+// added that failed while recording): `effect()` names it, so an app can turn that effect off
+// and go on.
+class EffectError : public Error {
+ public:
+  EffectError(ErrorKind kind, std::string file, const std::string& problem, std::string effect)
+      : Error(kind, std::move(file), problem), effect_(std::move(effect)) {}
+  const std::string& effect() const { return effect_; }
+
+ private:
+  std::string effect_;
 };
 
 }  // namespace gi

@@ -34,6 +34,7 @@ void FrameGraph::reset() {
   for (Slot& s : slots_) ctx_.allocator().free(s.allocation);
   slots_.clear();
   passes_.clear();
+  passOwner_.clear();
   outputs_.clear();
   blackboard_.clear();
   fallbackIds_.clear();
@@ -157,6 +158,7 @@ void FrameGraph::addPass(const std::string& name, const std::function<void(PassB
                 "frame graph: cannot add pass '" + name + "' after compile()");
   auto p = std::make_unique<Pass>();
   p->name = name;
+  p->owner = passOwner_;
   p->execute = std::move(execute);
   passes_.push_back(std::move(p));
   PassBuilder builder(*this, uint32_t(passes_.size() - 1));

@@ -1,6 +1,10 @@
 // Frame graph: recording a frame (per-subresource barriers, clears of persistent and fallback
 // images) and what a pass sees of its resources (PassContext).
 
+#include <algorithm>
+#include <exception>
+#include <string>
+
 #include "frame_graph_internal.h"
 #include "gi/vk/gpu_timer.h"
 #include "gi/vk/pipeline.h"
@@ -31,6 +35,31 @@ void afterBarrier(SyncState& state, SyncState& lastWrite, SyncState& visible, co
 }
 
 // What one pass needs of one subresource: all its accesses there, combined.
+
+// Records a pass: whatever its code throws (of any type) becomes an error naming the pass and,
+// for an effect's pass, an EffectError naming the effect, so an app can turn it off and go on.
+void recordGuarded(const std::string& pass, const std::string& owner, const PassExecute& execute,
+                   PassContext& pc) {
+  auto fail = [&](ErrorKind kind, const std::string& file, const std::string& why) {
+    const std::string where = "pass '" + pass + "' failed while recording: " + why;
+    if (owner.empty()) throw Error(kind, file, where);
+    throw EffectError(kind, file, "effect '" + owner + "', " + where, owner);
+  };
+  try {
+    execute(pc);
+  } catch (const EffectError&) {
+    throw;
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    fail(e.kind(), e.file(),
+         e.file().empty() ? what : what.substr(std::min(what.size(), e.file().size() + 2)));
+  } catch (const std::exception& e) {
+    fail(ErrorKind::InvalidData, "", e.what());
+  } catch (...) {
+    fail(ErrorKind::InvalidData, "", "it threw something that is not a std::exception");
+  }
+}
+
 }  // namespace
 
 // Persistent and fallback images start cleared (zero, or the fallback's value): recorded at the
@@ -190,7 +219,7 @@ void FrameGraph::execute(VkCommandBuffer cmd, vk::DescriptorArena& descriptors, 
       vkCmdPipelineBarrier2(cmd, &dep);
     }
     if (timer) timer->begin(cmd, p->name);
-    p->execute(pc);
+    recordGuarded(p->name, p->owner, p->execute, pc);
     if (timer) timer->end(cmd);
     if (afterPass) pc.cmd_ = cmd = afterPass(cmd);
   }

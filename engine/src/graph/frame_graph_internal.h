@@ -161,6 +161,7 @@ struct FrameGraph::Access {
 
 struct FrameGraph::Pass {
   std::string name;
+  std::string owner;  // the effect that added it ("": the engine)
   std::vector<Access> accesses;
   // Resolved by compile(): per texture the pass uses, its combined need of every subresource
   // (indexed mip * layers + layer), so coinciding ranges share one barrier in execute().

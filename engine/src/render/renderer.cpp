@@ -181,8 +181,8 @@ struct Renderer::Impl : EffectContext {
     auto fail = [&](const std::string& why) {
       const std::string origin =
           registry && registry->has(effect) ? registry->origin(effect) : "built-in";
-      throw Error(ErrorKind::InvalidData, origin,
-                  "effect '" + effect + "' failed in " + call + ": " + why);
+      throw EffectError(ErrorKind::InvalidData, origin,
+                        "effect '" + effect + "' failed in " + call + ": " + why, effect);
     };
     try {
       f();
@@ -190,10 +190,12 @@ struct Renderer::Impl : EffectContext {
       // The engine's own errors (a frame-graph or declaration check) get the effect's name
       // when they do not say it already.
       const std::string what = e.what();
-      if (what.find("'" + effect + "'") != std::string::npos) throw;
       const std::string problem =
           e.file().empty() ? what : what.substr(std::min(what.size(), e.file().size() + 2));
-      throw Error(e.kind(), e.file(), "effect '" + effect + "', " + call + ": " + problem);
+      const bool named = what.find("'" + effect + "'") != std::string::npos;
+      throw EffectError(e.kind(), e.file(),
+                        named ? problem : "effect '" + effect + "', " + call + ": " + problem,
+                        effect);
     } catch (const std::exception& e) {
       fail(e.what());
     } catch (...) {
@@ -266,11 +268,15 @@ struct Renderer::Impl : EffectContext {
                        [&](const LightingInput& in) { return name == in.resource; });
   }
 
-  // Adds one effect's (or built-in's) passes and checks them against its declaration.
-  void addChecked(Effect& e, const EffectInfo& info, const SettingValues& values) {
+  // Adds one effect's (or built-in's) passes and checks them against its declaration. A
+  // plugin effect owns its passes: one that fails while recording names it (EffectError).
+  void addChecked(Effect& e, const EffectInfo& info, const SettingValues& values,
+                  bool plugin = true) {
     Blackboard& bb = graph.blackboard();
     bb.startTracking();
+    graph.setPassOwner(plugin ? info.name : "");
     guarded(info.name, "addPasses()", [&] { e.addPasses(graph, *this, values); });
+    graph.setPassOwner("");
     // An optional lighting input may stay unpublished: its neutral fallback stands in (e.g.
     // SSDO's contact_shadow when off).
     checkEffectResources(info, bb.lookedUp(), bb.published(), isOptionalInput);
@@ -278,7 +284,7 @@ struct Renderer::Impl : EffectContext {
 
   void addBuiltin(Effect& e) {
     const std::vector<std::string> before = graph.passNames();
-    addChecked(e, e.info(), SettingValues());
+    addChecked(e, e.info(), SettingValues(), false);
     const std::vector<std::string> after = graph.passNames();
     for (size_t i = before.size(); i < after.size(); ++i) enginePasses.insert(after[i]);
   }
@@ -387,7 +393,17 @@ struct Renderer::Impl : EffectContext {
       guarded(a.info.name, "update()", [&] { a.effect->update(*this, a.settings); });
     updateViews();
     descriptors.reset();
-    timings = submission->run(graph, descriptors, *timer, settings.isolatePasses);
+    try {
+      timings = submission->run(graph, descriptors, *timer, settings.isolatePasses);
+    } catch (const EffectError& e) {
+      forgetFailedFrame();
+      if (!e.file().empty() || !registry || !registry->has(e.effect())) throw;
+      throw EffectError(e.kind(), registry->origin(e.effect()), e.what(),
+                        e.effect());  // its module
+    } catch (...) {
+      forgetFailedFrame();
+      throw;
+    }
     prevViewProj = cameraView.proj * cameraView.view;
     clock.previousSeconds = clock.seconds;
     ++clock.framesRendered;
@@ -401,6 +417,12 @@ struct Renderer::Impl : EffectContext {
     vkDeviceWaitIdle(ctx.device());
     graph.reset();
     graphDirty = true;
+  }
+  // A frame whose recording failed was not (or only partly) submitted, but the graph's record
+  // of its images' layouts moved on: start again from a new graph and cleared history.
+  void forgetFailedFrame() {
+    dropGraph();
+    graph.releasePersistent();
   }
 
   void setEffectSettings(const std::string& name, const SettingValues& values) {

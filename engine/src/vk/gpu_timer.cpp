@@ -18,6 +18,7 @@ GpuTimer::~GpuTimer() {
 
 void GpuTimer::beginFrame(VkCommandBuffer cmd) {
   names_.clear();
+  open_ = false;  // a frame whose recording failed left a scope open
   vkCmdResetQueryPool(cmd, pool_, 0, maxScopes_ * 3);
 }
 

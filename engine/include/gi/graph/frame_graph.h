@@ -161,6 +161,9 @@ class FrameGraph {
   // be added in an order where every read refers to an earlier write (setup order).
   void addPass(const std::string& name, const std::function<void(PassBuilder&)>& setup,
                PassExecute execute);
+  // The effect that adds the next passes ("" for the engine's own): a pass whose recording
+  // throws is then an EffectError naming it. Cleared by reset().
+  void setPassOwner(std::string effect) { passOwner_ = std::move(effect); }
 
   // External resources (created and owned elsewhere). `finalLayout` is the layout the image
   // is left in after execute() (UNDEFINED: wherever its last use left it).
@@ -249,6 +252,8 @@ class FrameGraph {
   struct Transient;
   struct Slot;
   struct Owned;  // a persistent or fallback image
+
+  std::string passOwner_;
 
   uint32_t addResource(const std::string& name, bool texture);
   void checkCurrent(uint32_t id, uint32_t version, const char* what, const std::string& pass) const;
