@@ -2,6 +2,7 @@
 // input fails before rendering and writes nothing; --calibrate writes a preset gi-render loads,
 // whose configuration measures within the budget.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <algorithm>
 #include <cmath>
@@ -351,6 +352,21 @@ TEST(BenchCli, BadInputFailsBeforeRendering) {
     EXPECT_NE(r.output.find("cannot write in the output folder /sys"), std::string::npos)
         << r.output;
     EXPECT_FALSE(fs::exists(dir + "/cache")) << bad << ": references computed";
+  }
+  // A FIFO where a result file goes, or in plots/: refused before the sweep, nothing written
+  // beside it, the FIFO kept.
+  for (const char* file : {"results.csv", "report.md", "plots/default_ssao.png"}) {
+    const std::string full = out + "/" + file;
+    fs::create_directories(fs::path(full).parent_path());
+    ASSERT_EQ(::mkfifo(full.c_str(), 0600), 0) << full;
+    auto r = test::runCommand(bench("--quick --cache '" + dir + "/cache' --out '" + out + "'"));
+    EXPECT_EQ(r.exitCode, 1) << file << ": " << r.output;
+    EXPECT_NE(r.output.find(full + ": output path is not a regular file"), std::string::npos)
+        << r.output;
+    EXPECT_TRUE(fs::is_fifo(full)) << file << ": replaced";
+    EXPECT_FALSE(fs::exists(dir + "/cache")) << file << ": references computed";
+    EXPECT_FALSE(fs::exists(out + "/results.json")) << file << ": results written";
+    fs::remove_all(out);
   }
   if (hasSsao()) {
     for (const char* grid : {"ssao.no_such_key=1", "ssao.samples=100000", "ssao.samples=abc"}) {

@@ -3,6 +3,8 @@
 #include <cstdlib>
 
 #include "cli.h"
+#include "gi/errors.h"
+#include "gi/image_io.h"
 #include "gi/vk/context.h"
 
 namespace gi_bench {
@@ -213,10 +215,23 @@ Options parseArgs(int argc, char** argv) {
   }
   if (o.cache.empty()) o.cache = defaultCacheDir();
   // Where results go is checked now, not after the sweep and its references.
-  if (o.calibrate)
+  if (o.calibrate) {
     gi::cli::checkOutputWritable(o.out);
-  else
+  } else {
     gi::cli::checkOutputFolder(o.out);
+    // The files the run will replace (report.cpp, hard_case_sweep.cpp), and whatever plots/
+    // already holds: none may be a folder, device, FIFO or socket.
+    for (const char* file :
+         {"results.csv", "repetitions.csv", "results.json", "report.md", "hard_cases.csv"})
+      gi::checkReplaceableOutput((fs::path(o.out) / file).string());
+    const fs::path plots = fs::path(o.out) / "plots";
+    std::error_code ec;
+    if (fs::exists(plots, ec) && !fs::is_directory(plots, ec))
+      throw gi::Error(gi::ErrorKind::Output, plots.string(), "exists and is not a folder");
+    if (fs::is_directory(plots, ec))
+      for (const fs::directory_entry& e : fs::directory_iterator(plots, ec))
+        gi::checkReplaceableOutput(e.path().string());
+  }
   gi::cli::checkOutputFolder(o.cache);
   return o;
 }

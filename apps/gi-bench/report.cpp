@@ -625,9 +625,7 @@ void writeResults(const std::string& dir, const std::vector<Row>& rows, const Ru
   std::vector<std::pair<std::string, std::string>> plots;
   auto write = [&](const std::string& file, const Plot& plot) {
     writeFileAtomic((fs::path(dir) / (file + ".svg")).string(), svgPlot(plot));
-    const std::string png = (fs::path(dir) / (file + ".png")).string();
-    writePng(png + ".partial", rasterPlot(plot));
-    fs::rename(png + ".partial", png);
+    writePng((fs::path(dir) / (file + ".png")).string(), rasterPlot(plot));  // atomic, checked
     plots.emplace_back(plot.title, file);
   };
   // A scene swept with several effects first gets one chart of all of them against the same
