@@ -74,3 +74,43 @@ TEST(EffectContract, LookUpsAndPublicationsMustBeDeclared) {
 
 }  // namespace
 }  // namespace gi
+
+namespace gi {
+namespace {
+
+TEST(EffectContract, AnOutputReplacedWithoutBeingReadNamesBothEffects) {
+  const std::vector<Masking> none;
+  // b publishes "ao" after a did, without looking it up: a's would reach nothing.
+  test::expectError(
+      [&] {
+        checkComposition({{"a", {"depth"}, {"ao"}}, {"b", {"depth"}, {"ao"}}}, none);
+      },
+      ErrorKind::Usage, {"effects 'a' and 'b' both write 'ao'", "'b' does not read it"});
+  // A chain (each reads "lit" and writes it anew) composes.
+  EXPECT_NO_THROW(checkComposition(
+      {{"a", {"depth"}, {"x"}}, {"f1", {"lit"}, {"lit"}}, {"f2", {"lit"}, {"lit"}}}, none));
+  // One effect may publish a name twice in a build; different names never clash.
+  EXPECT_NO_THROW(checkComposition({{"a", {}, {"ao", "x"}}, {"b", {}, {"indirect"}}}, none));
+}
+
+TEST(EffectContract, AnOutputMaskedByAnotherEffectsNeedsItsReader) {
+  const std::vector<Masking> masks = {
+      {"ambient", "replaces the environment term", "ao", "multiplies the environment term"}};
+  // Whatever the order, the masked effect is named with the one that masks it.
+  for (bool aoFirst : {true, false}) {
+    std::vector<EffectPublications> list = {{"occ", {"depth"}, {"ao"}},
+                                            {"gi", {"depth"}, {"ambient", "indirect"}}};
+    if (!aoFirst) std::swap(list[0], list[1]);
+    test::expectError([&] { checkComposition(list, masks); }, ErrorKind::Usage,
+                      {"effect 'gi' writes 'ambient' (replaces the environment term)",
+                       "'occ''s 'ao' (multiplies the environment term)"});
+  }
+  // An effect that reads "ao" composes the two itself; one effect may publish both.
+  EXPECT_NO_THROW(
+      checkComposition({{"occ", {"depth"}, {"ao"}}, {"gi", {"depth", "ao"}, {"ambient"}}}, masks));
+  EXPECT_NO_THROW(checkComposition({{"both", {"depth"}, {"ao", "ambient"}}}, masks));
+  EXPECT_NO_THROW(checkComposition({{"gi", {"depth"}, {"ambient"}}}, masks));
+}
+
+}  // namespace
+}  // namespace gi

@@ -289,6 +289,69 @@ TEST_F(EffectGraphTest, RequestedEffectWhoseOutputReachesNothingIsCulled) {
   EXPECT_EQ(r->passNames(), (Passes{"gbuffer", "shadow_0", "const_ao", "lighting", "tonemap"}));
   EXPECT_EQ(r->culledPassNames(), (Passes{"gbuffer_normal", "gbuffer_albedo", "gbuffer_material",
                                           "gbuffer_emission", "orphan", "floor"}));
+  // Said, naming it: an enabled effect that runs no pass costs nothing but does nothing.
+  ASSERT_EQ(r->warnings().size(), 1u);
+  EXPECT_NE(r->warnings()[0].find("effect 'orphan' runs no pass"), std::string::npos)
+      << r->warnings()[0];
+  EXPECT_TRUE(make(scene, {"const_ao"})->warnings().empty());
+}
+
+TEST_F(EffectGraphTest, EffectsThatWouldEraseEachOtherAreRefusedNamingBoth) {
+  // Two writers of "ao" where the second does not read it: the first's passes would be culled.
+  EffectRegistry reg = testRegistry();
+  struct Ambient : Effect {  // replaces the environment term that "ao" multiplies
+    EffectInfo info() const override {
+      return {"const_ambient",
+              "1",
+              "constant environment term (test)",
+              EffectStage::BeforeLighting,
+              {},
+              {"ambient"},
+              "ambient"};
+    }
+    std::vector<SettingDesc> settings() const override { return {}; }
+    void prepare(EffectContext&, const SettingValues&) override {}
+    void addPasses(FrameGraph& g, EffectContext&, const SettingValues&) override {
+      g.addPass(
+          "const_ambient",
+          [&](PassBuilder& b) {
+            out_ = b.write(b.create("ambient", TextureDesc{VK_FORMAT_R16G16B16A16_SFLOAT}),
+                           TextureUsage::TransferDst);
+          },
+          [this](PassContext& pc) {
+            const VkClearColorValue c{.float32 = {0.25f, 0.25f, 0.25f, 1.0f}};
+            const VkImageSubresourceRange all{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+            vkCmdClearColorImage(pc.cmd(), pc.image(out_), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &c,
+                                 1, &all);
+          });
+      g.blackboard().put("ambient", out_);
+    }
+    TextureHandle out_;  // read by the recording, after addPasses returned
+  };
+  reg.add([] { return std::make_unique<Ambient>(); }, "test");
+  const Scene scene = loadScene("default");
+  RenderSettings rs;
+  rs.width = 32;
+  rs.height = 24;
+  // Alone, each renders.
+  rs.effects = {{"const_ambient", reg.defaultSettings("const_ambient")}};
+  Renderer(ctx(), scene, rs, &reg).renderFrame();
+  // Together, the environment term const_ao would darken is replaced: refused, both named.
+  rs.effects.push_back({"const_ao", reg.defaultSettings("const_ao")});
+  test::expectError([&] { Renderer(ctx(), scene, rs, &reg); }, ErrorKind::Usage,
+                    {"effect 'const_ambient' writes 'ambient' (replaces the environment term)",
+                     "'const_ao''s 'ao' (multiplies the environment term)", "reach nothing"});
+  // Switched in live, refused; the renderer keeps what it had.
+  rs.effects.pop_back();
+  Renderer live(ctx(), scene, rs, &reg);
+  test::expectError(
+      [&] {
+        live.setEffects({{"const_ao", reg.defaultSettings("const_ao")},
+                         {"const_ambient", reg.defaultSettings("const_ambient")}});
+      },
+      ErrorKind::Usage, {"'const_ambient'", "'const_ao'"});
+  live.renderFrame();
+  EXPECT_EQ(live.settings().effects.size(), 1u);
 }
 
 TEST_F(EffectGraphTest, DebugViewKeepsOnlyWhatFeedsIt) {

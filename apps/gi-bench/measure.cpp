@@ -162,6 +162,8 @@ std::vector<Measurement> measureAll(
       if (o.excludeEmitters) settings.keepForReadback.push_back(gi::resources::kEmission);
       renderers.push_back(std::make_unique<gi::Renderer>(ctx, *jobs[i].scene, settings, &registry));
       renderers.back()->renderFrame();  // first-use costs stay out of every repetition
+      for (const std::string& w : renderers.back()->warnings())
+        std::fprintf(stderr, "gi-bench: warning: %s\n", w.c_str());
     }
     std::vector<Timing> timings(last - first);
     for (int r = 0; r < o.reps; ++r)

@@ -172,6 +172,8 @@ int run(const Options& o) {
   gi::vk::Context ctx(ctxOptions);
 
   gi::Renderer renderer(ctx, scene, settings, &registry);
+  for (const std::string& w : renderer.warnings())
+    std::fprintf(stderr, "gi-render: warning: %s\n", w.c_str());
   if (o.printGraph) std::printf("%s", renderer.graphDescription().c_str());
   if (!o.graphDot.empty()) gi::cli::writeFileAtomic(o.graphDot, renderer.graphDot());
   std::optional<gi::vk::Swapchain> swapchain;

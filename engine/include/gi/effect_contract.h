@@ -27,4 +27,27 @@ void checkEffectResources(const EffectInfo& info, const std::set<std::string>& l
                           const std::set<std::string>& published,
                           const std::function<bool(const std::string&)>& optional);
 
+// What one effect's passes looked up and published on the blackboard in one graph build.
+struct EffectPublications {
+  std::string effect;
+  std::set<std::string> lookedUp, published;
+};
+
+// An input of a later stage that makes another reach nothing where it is published: e.g.
+// "ambient" replaces the environment term that "ao" multiplies. `resourceDoes` and
+// `maskedDoes` say what each does, for the error.
+struct Masking {
+  std::string resource, resourceDoes, masked, maskedDoes;
+};
+
+// Effects in the order their passes were added. Refused, with a gi::Error naming both effects
+// and the resource, because one effect's work would reach nothing with no word to the user:
+// - an effect publishes a resource an earlier effect published, without looking it up (the
+//   earlier version is replaced and the frame graph culls its passes); reading it first (a
+//   chain, e.g. filters of "lit") is composition, not loss;
+// - an effect publishes a `Masking::resource` while another publishes what it masks, and the
+//   masking effect did not look that up (an effect that reads it composes the two itself).
+void checkComposition(const std::vector<EffectPublications>& inOrder,
+                      const std::vector<Masking>& masks);
+
 }  // namespace gi

@@ -63,6 +63,9 @@ class Renderer {
   const std::vector<PassTiming>& lastTimings() const;
   std::vector<std::string> passNames() const;        // passes the graph executes, in order
   std::vector<std::string> culledPassNames() const;  // passes declared but culled
+  // Said on the last graph build, one line each: an enabled effect every pass of which was
+  // culled (nothing it writes reaches the view or a kept output). Apps print them.
+  const std::vector<std::string>& warnings() const;
   // True for passes the engine's built-in stages added (G-buffer, skinning, surface points,
   // shadows, lighting, tonemap, floor), false for effects' passes.
   bool isEnginePass(const std::string& pass) const;

@@ -1,6 +1,7 @@
 #include "gi/effect_contract.h"
 
 #include <algorithm>
+#include <map>
 
 #include "gi/errors.h"
 
@@ -64,6 +65,35 @@ void checkEffectResources(const EffectInfo& info, const std::set<std::string>& l
         throw Error(ErrorKind::Usage, "",
                     "effect '" + info.name + "' declares it writes '" + name +
                         "' but published nothing under that name");
+}
+
+void checkComposition(const std::vector<EffectPublications>& inOrder,
+                      const std::vector<Masking>& masks) {
+  std::map<std::string, std::string> lastWriter;  // resource -> effect
+  for (const EffectPublications& e : inOrder) {
+    for (const std::string& name : e.published) {
+      auto it = lastWriter.find(name);
+      if (it != lastWriter.end() && it->second != e.effect && !e.lookedUp.count(name))
+        throw Error(ErrorKind::Usage, "",
+                    "effects '" + it->second + "' and '" + e.effect + "' both write '" + name +
+                        "' and '" + e.effect + "' does not read it: '" + it->second +
+                        "''s would be lost (its passes culled); enable one of them");
+    }
+    for (const std::string& name : e.published) lastWriter[name] = e.effect;
+  }
+  for (const Masking& m : masks) {
+    auto masker = lastWriter.find(m.resource), masked = lastWriter.find(m.masked);
+    if (masker == lastWriter.end() || masked == lastWriter.end() ||
+        masker->second == masked->second)
+      continue;
+    const auto by = std::find_if(inOrder.begin(), inOrder.end(),
+                                 [&](const auto& e) { return e.effect == masker->second; });
+    if (by->lookedUp.count(m.masked)) continue;  // it composes the two itself
+    throw Error(ErrorKind::Usage, "",
+                "effect '" + masker->second + "' writes '" + m.resource + "' (" + m.resourceDoes +
+                    "), so '" + masked->second + "''s '" + m.masked + "' (" + m.maskedDoes +
+                    ") would cost time and reach nothing; enable one of them");
+  }
 }
 
 }  // namespace gi

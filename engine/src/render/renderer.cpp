@@ -83,7 +83,10 @@ struct Renderer::Impl : EffectContext {
   std::unique_ptr<Effect> skinningPass, gbufferPass, surfacePointsPass, shadowPass, lightingPass,
       tonemapPass, floorPass;
   std::vector<ActiveEffect> effects;
-  std::set<std::string> enginePasses;  // names of the passes the built-ins added
+  std::set<std::string> enginePasses;            // names of the passes the built-ins added
+  std::vector<EffectPublications> publications;  // this build's, effect by effect in order
+  std::map<std::string, std::vector<std::string>> effectPasses;  // effect -> its passes
+  std::vector<std::string> graphWarnings;
 
   FrameGraph graph;
   bool graphDirty = true, recompiledByLastChange = false;
@@ -275,11 +278,30 @@ struct Renderer::Impl : EffectContext {
     Blackboard& bb = graph.blackboard();
     bb.startTracking();
     graph.setPassOwner(plugin ? info.name : "");
+    const size_t passesBefore = graph.passNames().size();
     guarded(info.name, "addPasses()", [&] { e.addPasses(graph, *this, values); });
     graph.setPassOwner("");
+    if (plugin) {
+      publications.push_back({info.name, bb.lookedUp(), bb.published()});
+      const std::vector<std::string> all = graph.passNames();
+      effectPasses[info.name].assign(all.begin() + std::ptrdiff_t(passesBefore), all.end());
+    }
     // An optional lighting input may stay unpublished: its neutral fallback stands in (e.g.
     // SSDO's contact_shadow when off).
     checkEffectResources(info, bb.lookedUp(), bb.published(), isOptionalInput);
+  }
+
+  // What lighting.comp ignores when another input is published (kLightingInputs).
+  static std::vector<Masking> lightingMasks() {
+    std::vector<Masking> masks;
+    auto does = [](const std::string& name) {
+      for (const LightingInput& in : kLightingInputs)
+        if (name == in.resource) return std::string(in.does);
+      return std::string();
+    };
+    for (const LightingInput& in : kLightingInputs)
+      if (*in.maskedBy) masks.push_back({in.maskedBy, does(in.maskedBy), in.resource, in.does});
+    return masks;
   }
 
   void addBuiltin(Effect& e) {
@@ -296,6 +318,9 @@ struct Renderer::Impl : EffectContext {
     graph.setAliasing(settings.aliasTransients);
     sceneGpu->setVertices({});
     enginePasses.clear();
+    publications.clear();
+    effectPasses.clear();
+    graphWarnings.clear();
     Blackboard& bb = graph.blackboard();
     // The neutral value of each optional lighting input, declared in this one place.
     for (const LightingInput& in : kLightingInputs)
@@ -326,6 +351,7 @@ struct Renderer::Impl : EffectContext {
     addBuiltin(*lightingPass);
     for (ActiveEffect* a : orderedEffects(EffectStage::AfterLighting))
       addChecked(*a->effect, a->info, a->settings);
+    checkComposition(publications, lightingMasks());  // no effect's work silently lost
     addBuiltin(*tonemapPass);
     addBuiltin(*floorPass);
     if (!bb.has(settings.view)) {
@@ -343,6 +369,7 @@ struct Renderer::Impl : EffectContext {
     if (settings.floorPass) graph.markOutput(bb.texture(res::kFloor));
     graph.compile();
     graphDirty = false;
+    warnAboutCulledEffects();
     // One timestamp scope per executed pass (any number of shadow-casting lights).
     const uint32_t scopes = std::max(uint32_t(graph.executedPasses().size()) + 8, 64u);
     if (!timer || timerScopes < scopes) {
@@ -351,6 +378,19 @@ struct Renderer::Impl : EffectContext {
     }
     compileMs =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  }
+
+  // An enabled effect whose every pass the graph culled costs nothing but does nothing either:
+  // said, naming it, instead of left for the user to find in --print-graph.
+  void warnAboutCulledEffects() {
+    const std::vector<std::string> culled = graph.culledPasses();
+    const std::set<std::string> culledSet(culled.begin(), culled.end());
+    for (const auto& [effect, passes] : effectPasses)
+      if (!passes.empty() && std::all_of(passes.begin(), passes.end(),
+                                         [&](const auto& p) { return culledSet.count(p) != 0; }))
+        graphWarnings.push_back("effect '" + effect +
+                                "' runs no pass: nothing it writes reaches the view '" +
+                                settings.view + "'");
   }
 
   // Rebuilds now; if the new configuration fails, restores `undo` and rethrows (the renderer
@@ -621,6 +661,9 @@ std::vector<std::string> Renderer::passNames() const {
 }
 std::vector<std::string> Renderer::culledPassNames() const {
   return impl_->graph.culledPasses();
+}
+const std::vector<std::string>& Renderer::warnings() const {
+  return impl_->graphWarnings;
 }
 bool Renderer::isEnginePass(const std::string& pass) const {
   return impl_->enginePasses.count(pass) > 0;

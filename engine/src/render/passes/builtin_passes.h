@@ -52,17 +52,45 @@ struct LightingInput {
   std::array<float, 4> neutral;
   const char* texture;
   const char* constant;
+  const char* does;      // what lighting.comp does with it, for errors
+  const char* maskedBy;  // the input that, published, leaves this one unused ("" none)
 };
 inline const std::array<LightingInput, 5> kLightingInputs = {{
-    {resources::kAO, VK_FORMAT_R8G8B8A8_UNORM, {1.0f, 1.0f, 1.0f, 1.0f}, "aoTexture", "kAoInput"},
-    {resources::kAmbient, VK_FORMAT_R16G16B16A16_SFLOAT, {}, "ambientTexture", "kAmbientInput"},
-    {resources::kIndirect, VK_FORMAT_R16G16B16A16_SFLOAT, {}, "indirectTexture", "kIndirectInput"},
+    {resources::kAO,
+     VK_FORMAT_R8G8B8A8_UNORM,
+     {1.0f, 1.0f, 1.0f, 1.0f},
+     "aoTexture",
+     "kAoInput",
+     "multiplies the environment term",
+     resources::kAmbient},
+    {resources::kAmbient,
+     VK_FORMAT_R16G16B16A16_SFLOAT,
+     {},
+     "ambientTexture",
+     "kAmbientInput",
+     "replaces the environment term",
+     ""},
+    {resources::kIndirect,
+     VK_FORMAT_R16G16B16A16_SFLOAT,
+     {},
+     "indirectTexture",
+     "kIndirectInput",
+     "adds indirect light",
+     ""},
     {resources::kContactShadow,
      VK_FORMAT_R8G8B8A8_UNORM,
      {1.0f, 1.0f, 1.0f, 1.0f},
      "contactTexture",
-     "kContactInput"},
-    {resources::kDirectLight, VK_FORMAT_R16G16B16A16_SFLOAT, {}, "directTexture", "kDirectInput"},
+     "kContactInput",
+     "multiplies the lights' shadow factors",
+     resources::kDirectLight},
+    {resources::kDirectLight,
+     VK_FORMAT_R16G16B16A16_SFLOAT,
+     {},
+     "directTexture",
+     "kDirectInput",
+     "replaces the lights' evaluation",
+     ""},
 }};
 
 // Workgroup of the engine's full-screen compute passes (lighting, tonemap): llvmpipe
