@@ -56,8 +56,8 @@ gi::vk::ComputeDesc shader(const char* name, const uint32_t (&words)[N],
   gi::vk::ComputeDesc d =
       gi::computeShader(std::string("ism: ") + name, words, std::move(constants));
   if (readsParams)
-    d.blocks.uniforms = {
-        {"ism", GI_CPP_BLOCK(Uniforms, rsm, atlas, bias, pull, gather, blur, envSphere, envVpls)}};
+    d.blocks.uniforms = {{"ism", GI_CPP_BLOCK(Uniforms, rsm, atlas, bias, pull, gather, blur,
+                                              envSphere, envVpls, nearField)}};
   return d;
 }
 
@@ -124,7 +124,7 @@ class IsmEffect : public gi::Effect {
             "environment as directional VPLs with orthographic ISMs",
         .stage = gi::EffectStage::BeforeLighting,
         .reads = {res::kDepth, res::kGBuffer, res::kSurfacePoints, res::kEnvironmentMap,
-                  res::kEnvironmentSampling},
+                  res::kEnvironmentSampling, res::kAO},
         .writes = {res::kIndirect, res::kAmbient, kAtlasView},
         .debugView = res::kIndirect,
         .estimates = gi::GroundTruth::IndirectLight};
@@ -342,13 +342,13 @@ class IsmEffect : public gi::Effect {
       gi::TextureHandle rsmDepth, rsmPos, rsmNormal, rsmFlux, atlas, depth, gbuffer, raw, half, low,
           indirect, atlasView;
       gi::BufferHandle cdf, vpls, points, envVpls, envSampling;
-      gi::TextureHandle envMap, ambient;
+      gi::TextureHandle envMap, ambient, ao;
     };
     auto io = std::make_shared<Io>();
     gi::Blackboard& bb = graph.blackboard();
     const Config c = cfg_;
     const VkBuffer frame = ctx.frameUniforms();
-    const VkSampler nearest = ctx.nearestSampler();
+    const VkSampler nearest = ctx.nearestSampler(), linear = ctx.linearSampler();
     const VkBuffer params = uniforms_.handle();
     // The gathering's resolution (gather_scale): the raw and blurred textures.
     const gi::TextureDesc rawDesc{kRawFormat, gi::SizeClass::OutputRelative, 1.0f / float(c.scale)};
@@ -491,10 +491,18 @@ class IsmEffect : public gi::Effect {
           io->gbuffer = b.read(bb.texture(res::kGBuffer));
           io->vpls = b.read(io->vpls, gi::BufferUsage::Uniform);
           io->atlas = b.read(io->atlas, gi::TextureUsage::Sampled, gi::Subresource::mipLevel(0));
-          if (c.env > 0) io->envVpls = b.read(io->envVpls, gi::BufferUsage::Uniform);
+          if (c.env > 0) {
+            io->envVpls = b.read(io->envVpls, gi::BufferUsage::Uniform);
+            // An AO effect's "ao" darkens the environment VPLs' light for the occluders within
+            // its range; their maps count only those beyond it (near/far split, nothing twice).
+            io->ao = b.readOptional(res::kAO);
+            nearField_ = b.isFallback(io->ao) ? 0.0f : float(ctx.publishedRange(res::kAO));
+          } else {
+            nearField_ = 0.0f;
+          }
           io->raw = b.write(b.create("ism_raw", rawDesc), gi::TextureUsage::StorageWrite);
         },
-        [this, io, c, frame, nearest, params](gi::PassContext& pc) {
+        [this, io, c, frame, nearest, linear, params](gi::PassContext& pc) {
           gi::vk::DescriptorWriter w(gather_);
           w.buffer("Frame", frame)
               .buffer("ism", params)
@@ -503,7 +511,10 @@ class IsmEffect : public gi::Effect {
               .texture("giGBuffer", pc.view(io->gbuffer), nearest)
               .texture("maps", pc.view(io->atlas, gi::Subresource::mipLevel(0)), nearest)
               .image("outRaw", pc.view(io->raw))
-              .buffer("EnvVpls", c.env > 0 ? pc.buffer(io->envVpls) : envBuffer_.handle());
+              .buffer("EnvVpls", c.env > 0 ? pc.buffer(io->envVpls) : envBuffer_.handle())
+              // Without environment VPLs the shader never samples it (ENV_PER_PIXEL = 0).
+              .texture("aoTexture", pc.view(c.env > 0 ? io->ao : io->depth),
+                       c.env > 0 ? linear : nearest);
           pc.descriptors().bind(pc.cmd(), gather_, w);
           const VkExtent2D e = pc.extent(io->raw);
           const uint32_t k = uint32_t(c.block);
@@ -837,6 +848,7 @@ class IsmEffect : public gi::Effect {
         std::isfinite(centre.x) && std::isfinite(centre.y) && std::isfinite(centre.z);
     u.envSphere = glm::vec4(finite ? centre : glm::vec3(0.0f), radius);
     u.envVpls = glm::vec4(c.env, c.envPadded, c.total(), float(s[h_.environment_normal_offset]));
+    u.nearField = glm::vec4(nearField_, 0.0f, 0.0f, 0.0f);
     uniforms_.write(&u, sizeof u);
     uploaded_ = u;
   }
@@ -907,7 +919,8 @@ class IsmEffect : public gi::Effect {
   VkSampler nearest_ = VK_NULL_HANDLE;
   gi::vk::Buffer uniforms_, vplBuffer_, envBuffer_;
   gi::ism::Uniforms uploaded_{};
-  struct Handles {  // typed settings read every frame, found by name in prepare()
+  float nearField_ = 0.0f;  // the range of the "ao" composed with the environment VPLs
+  struct Handles {          // typed settings read every frame, found by name in prepare()
     gi::Setting<double> distance_clamp, bias, bias_slope, pull_threshold, push_threshold, strength,
         blur_tolerance, splat_scale, environment_normal_offset;
   } h_;

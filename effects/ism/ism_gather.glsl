@@ -11,7 +11,8 @@
 // GLOSSY: x, y are RGB9E5 irradiance and its Phong-weighted sum (ism_glossy.glsl).
 // ENV_PER_PIXEL > 0: environment VPLs (ism_env_vpl.comp) too, interleaved the same way (pixel
 // phase gathers env VPLs phase + j K^2), E_i max(n.d_i, 0) x visibility from their
-// orthographic maps; `strength` scales the VPLs' indirect light, not the environment's.
+// orthographic maps beyond the near field, x "ao" within it; `strength` scales the VPLs'
+// indirect light, not the environment's.
 #include "common.glsl"
 #include "ism_common.glsl"
 #include "ism_glossy.glsl"
@@ -31,6 +32,10 @@ layout(set = 0, binding = 3) uniform sampler2D gDepth;
 #include "ism_lookup.glsl"
 layout(set = 0, binding = 6, rgba32ui) uniform writeonly uimage2D outRaw;
 layout(set = 0, binding = 8, std140) uniform EnvVpls { Vpl envVpls[ISM_VPL_SLOTS]; };
+// "ao" of an AO effect (its neutral 1x1 when none; any size, linear): the environment VPLs'
+// visibility within its range, multiplying their light (ism_lookup.glsl: the maps count only
+// occluders beyond it).
+layout(set = 0, binding = 9) uniform sampler2D aoTexture;
 
 // The receiver's BRDF (diffuse, + Phong when GLOSSY): adds VPL v's irradiance at x to e and,
 // when glossy, its Phong-weighted share to spec (view: unit direction to the camera).
@@ -73,6 +78,11 @@ void main() {
     vec3 ei = envVplIrradiance(v, uint(ism.envVpls.z) + i, x, n);
     envE += ei;
     if (GLOSSY) envSpec += ei * ismPhongLobe(-v.position.xyz, n, view, exponent);
+  }
+  if (ENV_PER_PIXEL > 0) {
+    float ao = clamp(textureLod(aoTexture, uv, 0.0).r, 0.0, 1.0);
+    envE *= ao;
+    envSpec *= ao;
   }
   // guard: half floats
   e = min(e * (ism.gather.z * ism.gather.w) + envE * ism.gather.z, vec3(65000.0));

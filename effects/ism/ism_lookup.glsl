@@ -42,7 +42,9 @@ vec3 vplIrradiance(Vpl v, uint tile, vec3 x, vec3 n) {
 // receiver is looked up from x + n x ism.envVpls.w texels (normal offset: an orthographic
 // texel holds one depth for a surface whose depth changes by texel x tan(theta) across it, so
 // a depth bias alone either shadows the floor itself at low elevations or leaks under
-// occluders), with the constant bias.
+// occluders), with the constant bias. Occluders within ism.nearField.x of the receiver along
+// d are left to the "ao" that multiplies the result (0: none): the map holds the surface
+// nearest the sky, so it is within that range only if every occluder on the way is.
 vec3 envVplIrradiance(Vpl v, uint tile, vec3 x, vec3 n) {
   vec3 d = v.position.xyz, s, u;
   ismBasis(-d, s, u);
@@ -53,7 +55,7 @@ vec3 envVplIrradiance(Vpl v, uint tile, vec3 x, vec3 n) {
 #else
   float stored = storedDistance(t);
 #endif
-  float visible = ismOrthoDepth(xo, d) - ism.bias.x <= stored ? 1.0 : 0.0;
+  float visible = ismOrthoDepth(xo, d) - max(ism.bias.x, ism.nearField.x) <= stored ? 1.0 : 0.0;
   return v.flux.rgb * (visible * max(dot(n, d), 0.0));
 }
 

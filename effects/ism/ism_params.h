@@ -49,8 +49,9 @@ struct Uniforms {
   glm::vec4 blur;       // plane tolerance (relative depth), min normal cosine, splat scale, seed
   glm::vec4 envSphere;  // environment VPLs' orthographic maps: scene centre, bounding radius R
   glm::vec4 envVpls;    // environment VPLs: count, padded count, first tile, normal offset (texels)
+  glm::vec4 nearField;  // x: range (world) of the "ao" that darkens the environment VPLs' light
 };
-static_assert(sizeof(Uniforms) == 8 * sizeof(glm::vec4));
+static_assert(sizeof(Uniforms) == 9 * sizeof(glm::vec4));
 
 // The paraboloid basis of a VPL with normal n, the same as SceneView::paraboloid's view matrix
 // (lookAlong: up +y, or +z when n is nearly vertical), so ISMs and classic maps share texels.

@@ -19,7 +19,8 @@
 //     SettingValues stores values per declaration index (typed Setting<T> handles).
 // 13: ImagePass gained `publish` (its layout grew).
 // 14: litFilterInfo and addLitFilterPass (gi/image_pass.h), used by the template.
-#define GI_EFFECT_ABI_VERSION 14u
+// 15: EffectContext::publishedRange (a new virtual).
+#define GI_EFFECT_ABI_VERSION 15u
 
 namespace gi {
 

@@ -87,6 +87,7 @@ struct Renderer::Impl : EffectContext {
   std::vector<EffectPublications> publications;  // this build's, effect by effect in order
   std::map<std::string, std::vector<std::string>> effectPasses;  // effect -> its passes
   std::vector<std::string> graphWarnings;
+  std::map<std::string, double> ranges;  // resource -> publishedRange, this build
 
   FrameGraph graph;
   bool graphDirty = true, recompiledByLastChange = false;
@@ -173,6 +174,10 @@ struct Renderer::Impl : EffectContext {
   }
   const CameraView& camera() override { return cameraView; }
   const std::vector<LightInfo>& lights() override { return lightSetup.world; }
+  double publishedRange(const std::string& resource) override {
+    auto it = ranges.find(resource);
+    return it == ranges.end() ? 0.0 : it->second;
+  }
 
   // ---- state --------------------------------------------------------------------------------
 
@@ -283,6 +288,7 @@ struct Renderer::Impl : EffectContext {
     graph.setPassOwner("");
     if (plugin) {
       publications.push_back({info.name, bb.lookedUp(), bb.published()});
+      recordRange(e, info.name, values, bb.published());
       const std::vector<std::string> all = graph.passNames();
       effectPasses[info.name].assign(all.begin() + std::ptrdiff_t(passesBefore), all.end());
     }
@@ -304,6 +310,17 @@ struct Renderer::Impl : EffectContext {
     return masks;
   }
 
+  // An AO-like output accounts for occluders within its quantity's radius (publishedRange).
+  void recordRange(const Effect& e, const std::string& name, const SettingValues& values,
+                   const std::set<std::string>& published) {
+    using Kind = EstimatedQuantity::Kind;
+    EstimatedQuantity q;
+    guarded(name, "estimatedQuantity()", [&] { q = e.estimatedQuantity(values); });
+    const bool ranged = q.kind == Kind::AmbientOcclusion || q.kind == Kind::Obscurance ||
+                        q.kind == Kind::Alchemy || q.kind == Kind::AlchemyDisk;
+    for (const std::string& r : published) ranges[r] = ranged ? q.radius : 0.0;
+  }
+
   void addBuiltin(Effect& e) {
     const std::vector<std::string> before = graph.passNames();
     addChecked(e, e.info(), SettingValues(), false);
@@ -321,6 +338,7 @@ struct Renderer::Impl : EffectContext {
     publications.clear();
     effectPasses.clear();
     graphWarnings.clear();
+    ranges.clear();
     Blackboard& bb = graph.blackboard();
     // The neutral value of each optional lighting input, declared in this one place.
     for (const LightingInput& in : kLightingInputs)
