@@ -128,14 +128,27 @@ TEST(IsmFormulas, GlossyVplLightIsBoundedByTheSingularityGuard) {
 TEST(IsmFormulas, PullPushFillsHolesWithoutDepthOutliers) {
   const float inf = std::numeric_limits<float>::infinity();
   const float children[4] = {2.0f, 2.1f, inf, 9.0f};
-  EXPECT_FLOAT_EQ(ism::pullDepth(children, 0.5f), 2.05f);  // 9 rejected, hole ignored
+  const ism::PullPushTexel pulled = ism::pullDepth(children, 0.5f);
+  EXPECT_FLOAT_EQ(pulled.depth, 2.05f);  // 9 rejected, hole ignored
+  EXPECT_TRUE(pulled.majority);          // 2 of the 3 valid children
   const float holes[4] = {inf, inf, inf, inf};
-  EXPECT_FALSE(std::isfinite(ism::pullDepth(holes, 0.5f)));
-  EXPECT_FLOAT_EQ(ism::pushDepth(inf, 2.05f, 0.5f), 2.05f);   // hole filled
-  EXPECT_FLOAT_EQ(ism::pushDepth(9.0f, 2.05f, 0.5f), 2.05f);  // outlier behind replaced
-  EXPECT_FLOAT_EQ(ism::pushDepth(2.3f, 2.05f, 0.5f), 2.3f);   // close: kept
-  EXPECT_FLOAT_EQ(ism::pushDepth(1.0f, 2.05f, 0.5f), 1.0f);   // in front: kept
-  EXPECT_FLOAT_EQ(ism::pushDepth(3.0f, inf, 0.5f), 3.0f);     // nothing coarse to push
+  EXPECT_FALSE(std::isfinite(ism::pullDepth(holes, 0.5f).depth));
+  auto push = [](float fine, ism::PullPushTexel coarse) {
+    return ism::pushDepth({fine, false}, coarse, 0.5f).depth;
+  };
+  EXPECT_FLOAT_EQ(push(inf, pulled), 2.05f);   // hole filled
+  EXPECT_FLOAT_EQ(push(9.0f, pulled), 2.05f);  // outlier behind replaced
+  EXPECT_FLOAT_EQ(push(2.3f, pulled), 2.3f);   // close: kept
+  EXPECT_FLOAT_EQ(push(1.0f, pulled), 1.0f);   // in front: kept
+  EXPECT_FLOAT_EQ(push(3.0f, {}), 3.0f);       // nothing coarse to push
+  // A silhouette: one near child among three far ones. The coarse value is the near surface's
+  // (holes next to it are filled with it) but it is a minority: the far texels stay.
+  const float edge[4] = {2.0f, 9.0f, 9.1f, 9.0f};
+  const ism::PullPushTexel silhouette = ism::pullDepth(edge, 0.5f);
+  EXPECT_FLOAT_EQ(silhouette.depth, 2.0f);
+  EXPECT_FALSE(silhouette.majority);
+  EXPECT_FLOAT_EQ(push(9.0f, silhouette), 9.0f);
+  EXPECT_FLOAT_EQ(push(inf, silhouette), 2.0f);
 }
 
 // Environment VPLs: the k^2 interleaving phases each gather every k^2-th VPL, so each phase's
@@ -298,14 +311,18 @@ std::vector<std::string> with(std::vector<std::string> a, const std::vector<std:
 }
 
 // One VPL: the shadow the box casts in the ISM agrees with the classic map's. IoU of the
-// zero-indirect masks (shadow + surfaces facing away, the latter identical in both) > 0.85
-// (measured 0.94 with one pull-push level; with the paraboloid RSM of an earlier version
-// 0.91, 0.86 without pull-push, 0.82 with two levels: pull-push's push
-// dilates silhouettes by up to 2^levels - 1 texels, so the ISM shadow is the larger one).
+// zero-indirect masks (shadow + surfaces facing away, the latter identical in both), on the
+// floor alone: measured 0.837 with the default push (holes only), 0.900 with the outlier rule
+// at push_threshold 0.05 (0.94 with the earlier rule that replaced any texel behind the coarse
+// value: it dilated silhouettes by up to 2^levels - 1 texels and darkened every benchmark
+// scene against classic maps, see the push_threshold setting).
 TEST_F(IsmTest, OneVplIsmShadowOverlapsTheClassicShadow) {
   const Scene s = panelScene();
   const Result classic = render(s, with(kOneVpl, {"ism.mode=classic"}), 2);
   const Result imperfect = render(s, kOneVpl, 2);
+  // The push's outlier rule (a texel behind a coarse value that holds most of its block takes
+  // it): off by default (holes only), it tightens this one-VPL shadow.
+  const Result outliers = render(s, with(kOneVpl, {"ism.push_threshold=0.05"}), 2);
   expectFinite(classic.indirect);
   expectFinite(imperfect.indirect);
   int litClassic = 0, litIsm = 0;
@@ -332,7 +349,17 @@ TEST_F(IsmTest, OneVplIsmShadowOverlapsTheClassicShadow) {
   EXPECT_GT(shadow, 200);                   // and the box shadows a visible region
   EXPECT_GT(overlap, 0.85);
   EXPECT_GT(floorShadow, 100);
-  EXPECT_GT(floorOverlap, 0.85);  // measured 0.93
+  EXPECT_GT(floorOverlap, 0.8);  // measured 0.837
+  const auto c = shadowMask(outliers);
+  std::vector<bool> floorC(c.size(), false);
+  for (int y = 0; y < int(kH); ++y)
+    for (int x = 0; x < int(kW); ++x) {
+      const size_t i = size_t(y) * kW + x;
+      floorC[i] = !classic.sky(x, y) && std::abs(classic.worldAt(x, y).y) <= 1e-3f && c[i];
+    }
+  const double outlierOverlap = iou(floorA, floorC);
+  std::printf("floor IoU with the outlier rule: %.3f\n", outlierOverlap);
+  EXPECT_GT(outlierOverlap, floorOverlap + 0.03);  // measured 0.900
 }
 
 // Dynamic: the box slides +1 in x (a looping translation clip, t = 0 -> 1). The surface points
@@ -372,25 +399,30 @@ TEST_F(IsmTest, IsmShadowFollowsAnAnimatedMesh) {
   EXPECT_LT(unchanged, overlap - 0.2);
 }
 
-// With few points (2048 for a 128^2 map, no splat enlargement) the ISM has holes through which
-// light leaks; pull-push fills them. Measured IoU against the classic shadow: 0.25 without,
-// 0.79 with two levels.
-TEST_F(IsmTest, PullPushClosesLightLeaks) {
+// With few points (2048 for a 128^2 map) the ISM has holes through which light leaks. Two
+// remedies, measured as IoU against the classic shadow: pull-push with the push's outlier rule
+// (no splat enlargement: 0.25 without, 0.62 with two levels at push_threshold 0.05: a texel
+// behind a coarse value is replaced only where the near surface holds most of the block, so
+// silhouettes do not grow), and splats sized by the area each point stands for in its map's
+// subset (radius up to 2 texels, no pull-push: 0.86), the default remedy.
+TEST_F(IsmTest, PullPushAndAreaSplatsCloseLightLeaks) {
   const Scene s = panelScene();
-  const std::vector<std::string> sparse = {"ism.vpls=1",
-                                           "ism.block_size=1",
-                                           "ism.ism_resolution=128",
-                                           "ism.points_per_ism=2048",
-                                           "ism.splat_radius=0",
+  const std::vector<std::string> sparse = {"ism.vpls=1", "ism.block_size=1",
+                                           "ism.ism_resolution=128", "ism.points_per_ism=2048",
                                            "ism.rsm_resolution=32"};
   const auto classic = shadowMask(render(s, with(sparse, {"ism.mode=classic"}), 2));
-  const double without =
-      iou(classic, shadowMask(render(s, with(sparse, {"ism.pull_push_levels=0"}))));
-  const double with2 =
-      iou(classic, shadowMask(render(s, with(sparse, {"ism.pull_push_levels=2"}))));
-  std::printf("IoU without pull-push %.3f, with 2 levels %.3f\n", without, with2);
-  EXPECT_GT(with2, without + 0.3);
-  EXPECT_GT(with2, 0.65);
+  auto ismIou = [&](const char* splat, const char* levels) {
+    return iou(classic, shadowMask(render(s, with(sparse, {splat, levels}))));
+  };
+  const double without = ismIou("ism.splat_radius=0", "ism.pull_push_levels=0");
+  const double pullPush = iou(
+      classic, shadowMask(render(s, with(sparse, {"ism.splat_radius=0", "ism.pull_push_levels=2",
+                                                  "ism.push_threshold=0.05"}))));
+  const double splats = ismIou("ism.splat_radius=2", "ism.pull_push_levels=0");
+  std::printf("IoU without either %.3f, pull-push (2 levels) %.3f, area splats %.3f\n", without,
+              pullPush, splats);
+  EXPECT_GT(pullPush, without + 0.3);
+  EXPECT_GT(splats, 0.8);
 }
 
 // A spot light pointing into the empty sky: the RSM is black, the CDF empty: zero VPLs, exactly
@@ -925,12 +957,12 @@ TEST_F(IsmTest, PullPushMatchesTheCpuRules) {
       size_t bad = 0, total = 0;
       for (int tile = 0; tile < 16; ++tile) {
         const int ox = (tile % 4) * kRes, oy = (tile / 4) * kRes;
-        std::vector<std::vector<float>> lv(size_t(levels) + 1);
+        std::vector<std::vector<ism::PullPushTexel>> lv(size_t(levels) + 1);
         lv[0].resize(kRes * kRes);
         for (int y = 0; y < kRes; ++y)
           for (int x = 0; x < kRes; ++x) {
             const float d = splatted.pixels[(size_t(oy + y) * splatted.width + ox + x) * 4];
-            lv[0][size_t(y) * kRes + x] = d > 0.0f ? d : inf;
+            lv[0][size_t(y) * kRes + x].depth = d > 0.0f ? d : inf;
           }
         for (int l = 0; l < levels; ++l) {
           const int n = kRes >> (l + 1);
@@ -939,7 +971,7 @@ TEST_F(IsmTest, PullPushMatchesTheCpuRules) {
             for (int x = 0; x < n; ++x) {
               const auto& f = lv[l];
               const size_t a = size_t(2 * y) * 2 * n + 2 * x, b = a + 2 * size_t(n);
-              const float c[4] = {f[a], f[a + 1], f[b], f[b + 1]};
+              const float c[4] = {f[a].depth, f[a + 1].depth, f[b].depth, f[b + 1].depth};
               lv[l + 1][size_t(y) * n + x] = ism::pullDepth(c, t * float(1 << l));
             }
         }
@@ -947,13 +979,13 @@ TEST_F(IsmTest, PullPushMatchesTheCpuRules) {
           const int n = kRes >> l;
           for (int y = 0; y < n; ++y)
             for (int x = 0; x < n; ++x) {
-              float& f = lv[l][size_t(y) * n + x];
+              ism::PullPushTexel& f = lv[l][size_t(y) * n + x];
               f = ism::pushDepth(f, lv[l + 1][size_t(y / 2) * (n / 2) + x / 2], t * float(1 << l));
             }
         }
         for (int y = 0; y < kRes; ++y)
           for (int x = 0; x < kRes; ++x) {
-            const float want = lv[0][size_t(y) * kRes + x];
+            const float want = lv[0][size_t(y) * kRes + x].depth;
             const float got = gpu.pixels[(size_t(oy + y) * gpu.width + ox + x) * 4];
             const bool same =
                 std::isfinite(want) ? std::abs(got - want) <= 1e-5f * want : got == 0.0f;

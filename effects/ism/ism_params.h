@@ -108,25 +108,38 @@ inline float phongLobe(const glm::vec3& w, const glm::vec3& n, const glm::vec3& 
 }
 
 // Pull-push over one 2x2 block (seed 002 §3.2, after Marroquim et al. 2007). Depths are
-// distances; kEmpty marks a hole. Pull: the mean of the valid children within `threshold` of
-// the nearest one (points from a hidden surface behind are not mixed in). Push: a texel takes
-// the coarse value when it is a hole or lies more than `threshold` behind it (an outlier).
-inline float pullDepth(const float child[4], float threshold) {
+// distances; infinity marks a hole. Pull: the mean of the valid children within `threshold` of
+// the nearest one (points from a hidden surface behind are not mixed in), and whether those
+// are at least half of the valid children (the coarse texel is mostly that surface). Push: a
+// texel takes the coarse value when it is a hole, or when it lies more than `threshold` behind
+// a majority coarse value (a hidden surface's sample seen through a gap in the near one).
+// Behind a minority it stays: that is a silhouette, and replacing it would widen the occluder
+// by up to 2^levels - 1 texels (on a courtyard's 64^2 orthographic sky maps, ~1.4 m).
+struct PullPushTexel {
+  float depth = std::numeric_limits<float>::infinity();
+  bool majority = false;
+};
+inline PullPushTexel pullDepth(const float child[4], float threshold) {
   float nearest = std::numeric_limits<float>::infinity();
   for (int i = 0; i < 4; ++i) nearest = std::min(nearest, child[i]);
-  if (!std::isfinite(nearest)) return std::numeric_limits<float>::infinity();
+  if (!std::isfinite(nearest)) return {};
   float sum = 0.0f;
-  int count = 0;
-  for (int i = 0; i < 4; ++i)
+  int count = 0, valid = 0;
+  for (int i = 0; i < 4; ++i) {
+    valid += std::isfinite(child[i]) ? 1 : 0;
     if (child[i] <= nearest + threshold) {
       sum += child[i];
       ++count;
     }
-  return sum / float(count);
+  }
+  return {sum / float(count), 2 * count >= valid};
 }
-inline float pushDepth(float fine, float coarse, float threshold) {
-  if (!std::isfinite(coarse)) return fine;
-  return (!std::isfinite(fine) || fine > coarse + threshold) ? coarse : fine;
+inline PullPushTexel pushDepth(const PullPushTexel& fine, const PullPushTexel& coarse,
+                               float threshold) {
+  if (!std::isfinite(coarse.depth)) return fine;
+  const bool replace =
+      !std::isfinite(fine.depth) || (coarse.majority && fine.depth > coarse.depth + threshold);
+  return replace ? coarse : fine;
 }
 
 }  // namespace gi::ism

@@ -6,7 +6,8 @@
 // memory, then the push comes back down the same way and each texel is stored once. Replaces
 // one dispatch per level over the whole atlas (and the coarse mips). Pull: level l+1 = the
 // mean of the valid children within the pull threshold of the nearest. Push: a level-l texel
-// that is a hole, or lies more than the push threshold behind the coarse value, takes it.
+// that is a hole, or lies more than the push threshold behind a coarse value that stands for
+// most of its children, takes it.
 // Thresholds scale by 2^l (l: the finer level); the rules are gi::ism::pullDepth/pushDepth.
 #extension GL_GOOGLE_include_directive : require
 #include "ism_common.glsl"
@@ -22,23 +23,35 @@ layout(set = 0, binding = 2, r32ui) uniform uimage2D atlas;
 const int OFFSET[7] = int[7](0, 0, 0, 256, 320, 336, 340);
 shared uint level[341];
 
+// The lowest bit of a pulled value (a 1-ulp change of its distance) says whether the near
+// children were at least half of the valid ones: only such a coarse value replaces a texel
+// behind it (gi::ism::pushDepth); behind a minority the texel is beside a silhouette and stays.
+uint depthBits(uint v) { return v == ISM_EMPTY ? v : v & ~1u; }  // without the flag
+
 uint pull(uint a, uint b, uint c, uint d, float threshold) {
+  a = depthBits(a);
+  b = depthBits(b);
+  c = depthBits(c);
+  d = depthBits(d);
   uint nearest = min(min(a, b), min(c, d));  // distances order like their float bits
   if (nearest == ISM_EMPTY) return ISM_EMPTY;
   float limit = uintBitsToFloat(nearest) + threshold;
-  float sum = 0.0, count = 0.0;
+  float sum = 0.0, count = 0.0, valid = 0.0;
   uint v[4] = uint[4](a, b, c, d);
   for (int i = 0; i < 4; ++i) {
     bool take = v[i] != ISM_EMPTY && uintBitsToFloat(v[i]) <= limit;
     sum += take ? uintBitsToFloat(v[i]) : 0.0;
     count += take ? 1.0 : 0.0;
+    valid += v[i] != ISM_EMPTY ? 1.0 : 0.0;
   }
-  return floatBitsToUint(sum / max(count, 1.0));
+  uint mean = floatBitsToUint(sum / max(count, 1.0)) & ~1u;
+  return mean | (2.0 * count >= valid ? 1u : 0u);
 }
 
 uint push(uint fine, uint coarse, float threshold) {
   if (coarse == ISM_EMPTY) return fine;
-  bool replace = fine == ISM_EMPTY || uintBitsToFloat(fine) > uintBitsToFloat(coarse) + threshold;
+  bool behind = uintBitsToFloat(depthBits(fine)) > uintBitsToFloat(depthBits(coarse)) + threshold;
+  bool replace = fine == ISM_EMPTY || ((coarse & 1u) != 0u && behind);
   return replace ? coarse : fine;
 }
 

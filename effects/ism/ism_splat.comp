@@ -33,6 +33,10 @@ void main() {
   uint idx = WRAP == 1 ? (tile * perIsm + j) % count : tile * perIsm + j;
   vec4 pa = points[2u * idx];
   float res = ism.atlas.x;
+  // The area the point stands for in this map: the engine's points share the surface, this
+  // map holds perIsm of them, so each covers count / perIsm times its own share (a fixed
+  // subset that is sparse on a large scene would otherwise leave holes pull-push must fill).
+  float area = max(pa.w, 0.0) * max(float(count) / float(perIsm), 1.0);
   ivec2 t;
   uint depth;
   int radius;
@@ -42,7 +46,7 @@ void main() {
     t = ismOrthoTexel(tile, pa.xyz, s, u);
     depth = floatBitsToUint(max(ismOrthoDepth(pa.xyz, d), 0.0));
     float side = max(ismOrthoTexelSide(), 1e-30);
-    radius = clamp(int(0.5 * sqrt(max(pa.w, 0.0)) / side * ism.blur.z), 0, MAX_SPLAT);
+    radius = clamp(int(0.5 * sqrt(area) / side * ism.blur.z), 0, MAX_SPLAT);
   } else {
     vec3 w = pa.xyz - vpl.position.xyz;
     float d = length(w);
@@ -60,7 +64,7 @@ void main() {
     vec2 pd = vec2(dot(dir, s), dot(dir, u)) / (1.0 + c);
     float r2 = dot(pd, pd);
     float texelOmega = 16.0 / (res * res) / ((1.0 + r2) * (1.0 + r2));
-    float omega = pa.w / (d * d);
+    float omega = area / (d * d);
     radius = clamp(int(0.5 * sqrt(omega / texelOmega) * ism.blur.z), 0, MAX_SPLAT);
   }
   if (MAX_SPLAT == 0) {
