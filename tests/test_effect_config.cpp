@@ -294,6 +294,17 @@ TEST_F(EffectGraphTest, RequestedEffectWhoseOutputReachesNothingIsCulled) {
   EXPECT_NE(r->warnings()[0].find("effect 'orphan' runs no pass"), std::string::npos)
       << r->warnings()[0];
   EXPECT_TRUE(make(scene, {"const_ao"})->warnings().empty());
+  // Which effect reaches the image, as --print-graph and the demo panel show it.
+  const auto effects = r->effectPasses();
+  ASSERT_EQ(effects.size(), 2u);
+  EXPECT_EQ(effects[0].effect, "const_ao");
+  EXPECT_EQ(effects[0].run, 1u);
+  EXPECT_EQ(effects[1].effect, "orphan");
+  EXPECT_EQ(effects[1].run, 0u);
+  EXPECT_EQ(effects[1].total, 1u);
+  EXPECT_NE(r->graphDescription().find("orphan: 0 of 1 passes run (reaches nothing: culled)"),
+            std::string::npos)
+      << r->graphDescription();
 }
 
 TEST_F(EffectGraphTest, EffectsThatWouldEraseEachOtherAreRefusedNamingBoth) {

@@ -73,6 +73,11 @@ void timingSection(const FrameStats& stats) {
 
 void passSection(gi::Renderer& renderer) {
   if (!ImGui::CollapsingHeader("Frame graph")) return;
+  // Which effect's work reaches the image: one that runs no pass is named, not left unseen.
+  for (const gi::Renderer::EffectPasses& e : renderer.effectPasses())
+    ImGui::Text("%s: %zu of %zu passes run", e.effect.c_str(), e.run, e.total);
+  for (const std::string& w : renderer.warnings())
+    ImGui::TextColored({1, 0.7f, 0.2f, 1}, "%s", w.c_str());
   ImGui::TextUnformatted("executed:");
   for (const std::string& p : renderer.passNames())
     ImGui::BulletText("%s%s", p.c_str(), renderer.isEnginePass(p) ? "" : "  (effect)");

@@ -66,6 +66,13 @@ class Renderer {
   // Said on the last graph build, one line each: an enabled effect every pass of which was
   // culled (nothing it writes reaches the view or a kept output). Apps print them.
   const std::vector<std::string>& warnings() const;
+  // Each enabled effect, in the order its passes were added, with how many of its passes the
+  // graph runs: 0 means nothing it writes reaches the view (a warning says so).
+  struct EffectPasses {
+    std::string effect;
+    size_t run = 0, total = 0;
+  };
+  std::vector<EffectPasses> effectPasses() const;
   // True for passes the engine's built-in stages added (G-buffer, skinning, surface points,
   // shadows, lighting, tonemap, floor), false for effects' passes.
   bool isEnginePass(const std::string& pass) const;

@@ -686,8 +686,24 @@ const std::vector<std::string>& Renderer::warnings() const {
 bool Renderer::isEnginePass(const std::string& pass) const {
   return impl_->enginePasses.count(pass) > 0;
 }
+std::vector<Renderer::EffectPasses> Renderer::effectPasses() const {
+  const std::vector<std::string> run = impl_->graph.executedPasses();
+  const std::set<std::string> executed(run.begin(), run.end());
+  std::vector<EffectPasses> out;
+  for (const EffectPublications& e : impl_->publications) {
+    const std::vector<std::string>& passes = impl_->effectPasses[e.effect];
+    const auto ran = std::count_if(passes.begin(), passes.end(),
+                                   [&](const std::string& p) { return executed.count(p) != 0; });
+    out.push_back({e.effect, size_t(ran), passes.size()});
+  }
+  return out;
+}
 std::string Renderer::graphDescription() const {
-  return impl_->graph.describe();
+  std::string effects;
+  for (const EffectPasses& e : effectPasses())
+    effects += "  " + e.effect + ": " + std::to_string(e.run) + " of " + std::to_string(e.total) +
+               " passes run" + (e.run == 0 ? " (reaches nothing: culled)" : "") + "\n";
+  return (effects.empty() ? "" : "effects:\n" + effects) + impl_->graph.describe();
 }
 std::string Renderer::graphDot() const {
   return impl_->graph.toDot();
