@@ -351,9 +351,14 @@ class IsmEffect : public gi::Effect {
       gi::BufferHandle cdf, vpls, points, envVpls, envSampling;
       gi::TextureHandle envMap, ambient, ao;
     };
+    const Config c = cfg_;
+    // No light to bounce and no sky to carry: no pass at all (the renderer names the effect
+    // in a warning) rather than a frame of passes that add exactly nothing.
+    const auto& lights = ctx.lights();
+    if (c.env == 0 && (lights.empty() || glm::dot(lights.front().radiance, glm::vec3(1)) <= 0.0f))
+      return;
     auto io = std::make_shared<Io>();
     gi::Blackboard& bb = graph.blackboard();
-    const Config c = cfg_;
     const VkBuffer frame = ctx.frameUniforms();
     const VkSampler nearest = ctx.nearestSampler(), linear = ctx.linearSampler();
     const VkBuffer params = uniforms_.handle();

@@ -404,8 +404,11 @@ struct Renderer::Impl : EffectContext {
     const std::vector<std::string> culled = graph.culledPasses();
     const std::set<std::string> culledSet(culled.begin(), culled.end());
     for (const auto& [effect, passes] : effectPasses)
-      if (!passes.empty() && std::all_of(passes.begin(), passes.end(),
-                                         [&](const auto& p) { return culledSet.count(p) != 0; }))
+      if (passes.empty())
+        graphWarnings.push_back("effect '" + effect +
+                                "' adds no pass: nothing to do for this scene and settings");
+      else if (std::all_of(passes.begin(), passes.end(),
+                           [&](const auto& p) { return culledSet.count(p) != 0; }))
         graphWarnings.push_back("effect '" + effect +
                                 "' runs no pass: nothing it writes reaches the view '" +
                                 settings.view + "'");
