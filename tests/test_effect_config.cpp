@@ -117,6 +117,37 @@ TEST(EffectConfig, PrecedenceDefaultsPresetSceneCommandLine) {
   EXPECT_TRUE(resolveEffects(scene, &preset, cli, reg).empty());
 }
 
+TEST(EffectConfig, RecommendedEffectsComeFromThePreset) {
+  EffectRegistry reg = testRegistry();
+  const std::string dir = test::makeTempDir("recommended");
+  const Preset preset = loadPreset(writeFile(
+      dir, "p.json",
+      R"({"recommended_effects": ["orphan", "const_ao"], "effects": {"const_ao": {"value": 0.2}}})"));
+  const Scene scene = sceneWith({{"const_ao", {}}});
+  EffectOverrides cli;
+  cli.effects = std::vector<std::string>{"recommended"};
+  const auto configs = resolveEffects(scene, &preset, cli, reg);
+  ASSERT_EQ(configs.size(), 2u);
+  EXPECT_EQ(configs[0].name, "orphan");
+  EXPECT_EQ(configs[1].name, "const_ao");
+  EXPECT_DOUBLE_EQ(configs[1].settings.number("value"), 0.2);  // with the preset's settings
+  // Without a preset, or with one that recommends nothing: a usage error naming why.
+  test::expectError([&] { resolveEffects(scene, nullptr, cli, reg); }, ErrorKind::Usage,
+                    {"--effects", "give --preset"});
+  const Preset none = loadPreset(writeFile(dir, "none.json", R"({"effects": {}})"));
+  test::expectError([&] { resolveEffects(scene, &none, cli, reg); }, ErrorKind::Usage,
+                    {"none.json", "recommends no effects"});
+  // A preset that recommends an unknown effect, or not a list of names, names its file.
+  const Preset unknown =
+      loadPreset(writeFile(dir, "unknown.json", R"({"recommended_effects": ["nope"]})"));
+  test::expectError([&] { resolveEffects(scene, &unknown, {}, reg); }, ErrorKind::Schema,
+                    {"unknown.json", "recommended_effects", "nope"});
+  for (const char* bad : {R"({"recommended_effects": "gtao"})", R"({"recommended_effects": []})",
+                          R"({"recommended_effects": [1]})"})
+    test::expectError([&] { loadPreset(writeFile(dir, "bad.json", bad)); }, ErrorKind::Schema,
+                      {"bad.json", "recommended_effects"});
+}
+
 TEST(EffectConfig, WorldLengthDefaultsFollowABareModelsSize) {
   // The real plugins' radii are world lengths: a model loaded without a scene file (the
   // 2CylinderEngine glTF, hundreds of units across) scales their defaults by its size; the

@@ -1155,6 +1155,67 @@ TEST_F(IsmTest, EnvironmentVplsLeaveTheNearFieldToAnAOEffect) {
     }
 }
 
+// SSDO's near-field bounce with ISM's far field, split by distance: the gathering skips the
+// first bounce's VPLs within SSDO's radius R of the receiver (EffectContext::publishedRange)
+// and adds the rest to SSDO's "indirect". One VPL on the panel at (-2, 2, 0), no interleaving,
+// no blur, so per pixel: indirect(both) = indirect(SSDO) + indirect(ISM) where the VPL is
+// farther than R, = indirect(SSDO) where it is nearer (the panel is 0.5 wide: pixels within
+// 0.4 of R either way are not judged).
+TEST_F(IsmTest, SsdoNearFieldAndIsmFarFieldSplitTheBounceByDistance) {
+  const Scene s = panelScene();
+  auto render = [&](const std::vector<std::string>& effects, std::vector<std::string> sets) {
+    const auto on = [&](const char* e) {
+      return std::find(effects.begin(), effects.end(), e) != effects.end();
+    };
+    if (on("ism")) sets.insert(sets.end(), kOneVpl.begin(), kOneVpl.end());
+    if (on("ssdo")) sets.push_back("ssdo.bounce=true");
+    Renderer r(ctx(), s, settingsFor(effects, s, sets, kW, kH), &registry);
+    r.renderFrame();
+    Result res;
+    res.indirect = r.readTarget("indirect");
+    res.depth = r.readTarget("depth");
+    res.camera = r.camera();
+    res.passes = r.passNames();
+    return res;
+  };
+  const float radius = 2.5f;
+  const std::string r = "ssdo.radius=" + std::to_string(radius);
+  const Result ssdo = render({"ssdo"}, {r});
+  const Result ism = render({"ism"}, {});
+  const Result both = render({"ssdo", "ism"}, {r});
+  ASSERT_NE(std::find(both.passes.begin(), both.passes.end(), "ism_gather"), both.passes.end());
+  const glm::vec3 panel(-2.0f, 2.0f, 0.0f);
+  int nearChecked = 0, farChecked = 0;
+  double farIsm = 0.0, nearIsm = 0.0;
+  for (int y = 0; y < int(kH); y += 2)
+    for (int x = 0; x < int(kW); x += 2) {
+      if (ssdo.sky(x, y)) continue;
+      const float d = glm::length(ssdo.worldAt(x, y) - panel);
+      const float a = luminance(ssdo.px(ssdo.indirect, x, y));
+      const float i = luminance(ism.px(ism.indirect, x, y));
+      const float sum = luminance(both.px(both.indirect, x, y));
+      if (d < radius - 0.4f) {
+        EXPECT_NEAR(sum, a, 1e-3f + 0.01f * a) << x << "," << y << " d " << d;
+        nearIsm += i;
+        ++nearChecked;
+      } else if (d > radius + 0.4f) {
+        EXPECT_NEAR(sum, a + i, 1e-3f + 0.01f * (a + i)) << x << "," << y << " d " << d;
+        farIsm += i;
+        ++farChecked;
+      }
+    }
+  std::printf(
+      "near pixels %d (SSDO's alone; ISM's there %.3f), far pixels %d (SSDO's + ISM's, "
+      "ISM's %.3f)\n",
+      nearChecked, nearIsm, farChecked, farIsm);
+  EXPECT_GT(nearChecked, 100);
+  EXPECT_GT(farChecked, 100);
+  // ISM alone lights both sides: both checks above can fail.
+  EXPECT_GT(farIsm, 1.0);
+  EXPECT_GT(nearIsm, 1.0);
+  expectFinite(both.indirect);
+}
+
 // A black environment gives environment VPLs nothing to carry (the sampler's black-map tables:
 // radiance 0): indirect light exactly 0 everywhere, no NaN, also with glossy receivers.
 TEST_F(IsmTest, EnvironmentVplsUnderABlackEnvironmentAddNothing) {

@@ -195,7 +195,7 @@ std::vector<std::string> effectItems(const Options& o, const gi::EffectRegistry&
   }
   for (const std::string& item : items)
     for (const std::string& e : splitPlus(item))
-      if (!registry.has(e))
+      if (item != "recommended" && !registry.has(e))
         usageError("--effects", "unknown effect '" + e + "' (known: " + knownEffects(registry) +
                                     "; plugins are loaded from <bin>/plugins and GI_PLUGIN_PATH)");
   return items;

@@ -93,7 +93,21 @@ std::vector<Config> buildConfigs(const Options& o, const Setup& s,
   for (size_t si = 0; si < s.scenes.size(); ++si)
     for (const std::string& item : items)
       for (size_t pi = 0; pi < s.presets.size(); ++pi) {
-        const std::vector<std::string> set = splitPlus(item);
+        std::vector<std::string> set = splitPlus(item);
+        std::string label = item;
+        if (item == "recommended") {  // the preset's own combination (recommended_effects)
+          if (!s.presets[pi] || s.presets[pi]->recommendedEffects.empty()) {
+            if (si == 0)
+              std::fprintf(stderr,
+                           "gi-bench: preset '%s' recommends no effects: no "
+                           "'recommended' row for it\n",
+                           s.presetNames[pi].c_str());
+            continue;
+          }
+          set = s.presets[pi]->recommendedEffects;
+          label.clear();
+          for (const std::string& e : set) label += (label.empty() ? "" : "+") + e;
+        }
         if (everyEffect && s.presets[pi] &&
             std::none_of(set.begin(), set.end(),
                          [&](const std::string& e) { return s.presets[pi]->effects.count(e); }))
@@ -106,7 +120,7 @@ std::vector<Config> buildConfigs(const Options& o, const Setup& s,
           Config c;
           c.scene = si;
           c.effectSet = set;
-          c.effectLabel = item;
+          c.effectLabel = label;
           c.preset = s.presetNames[pi];
           c.presetPtr = s.presets[pi].get();
           gi::EffectOverrides ov;

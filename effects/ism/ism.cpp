@@ -124,7 +124,7 @@ class IsmEffect : public gi::Effect {
             "environment as directional VPLs with orthographic ISMs",
         .stage = gi::EffectStage::BeforeLighting,
         .reads = {res::kDepth, res::kGBuffer, res::kSurfacePoints, res::kEnvironmentMap,
-                  res::kEnvironmentSampling, res::kAO},
+                  res::kEnvironmentSampling, res::kAO, res::kIndirect},
         .writes = {res::kIndirect, res::kAmbient, kAtlasView},
         .debugView = res::kIndirect,
         .estimates = gi::GroundTruth::IndirectLight};
@@ -349,16 +349,22 @@ class IsmEffect : public gi::Effect {
       gi::TextureHandle rsmDepth, rsmPos, rsmNormal, rsmFlux, atlas, depth, gbuffer, raw, half, low,
           indirect, atlasView;
       gi::BufferHandle cdf, vpls, points, envVpls, envSampling;
-      gi::TextureHandle envMap, ambient, ao;
+      gi::TextureHandle envMap, ambient, ao, prior;
     };
     const Config c = cfg_;
+    // Near/far split with effects that ran before (nothing counted twice): an AO's occluders
+    // within its range are left to its "ao"; an earlier "indirect" (e.g. SSDO's near-field
+    // bounce) has the first bounce's light from senders within its range, the gathering skips
+    // those VPLs and adds the rest to it.
+    gi::Blackboard& bb = graph.blackboard();
+    aoRange_ = c.env > 0 && bb.has(res::kAO) ? float(ctx.publishedRange(res::kAO)) : 0.0f;
+    indirectRange_ = bb.has(res::kIndirect) ? float(ctx.publishedRange(res::kIndirect)) : 0.0f;
     // No light to bounce and no sky to carry: no pass at all (the renderer names the effect
     // in a warning) rather than a frame of passes that add exactly nothing.
     const auto& lights = ctx.lights();
     if (c.env == 0 && (lights.empty() || glm::dot(lights.front().radiance, glm::vec3(1)) <= 0.0f))
       return;
     auto io = std::make_shared<Io>();
-    gi::Blackboard& bb = graph.blackboard();
     const VkBuffer frame = ctx.frameUniforms();
     const VkSampler nearest = ctx.nearestSampler(), linear = ctx.linearSampler();
     const VkBuffer params = uniforms_.handle();
@@ -508,9 +514,6 @@ class IsmEffect : public gi::Effect {
             // An AO effect's "ao" darkens the environment VPLs' light for the occluders within
             // its range; their maps count only those beyond it (near/far split, nothing twice).
             io->ao = b.readOptional(res::kAO);
-            nearField_ = b.isFallback(io->ao) ? 0.0f : float(ctx.publishedRange(res::kAO));
-          } else {
-            nearField_ = 0.0f;
           }
           io->raw = b.write(b.create("ism_raw", rawDesc), gi::TextureUsage::StorageWrite);
         },
@@ -546,10 +549,12 @@ class IsmEffect : public gi::Effect {
             io->depth = b.read(bb.texture(res::kDepth));
             io->low = b.write(b.create("ism_blur_y", rawDesc), gi::TextureUsage::StorageWrite);
           }
+          // An earlier effect's "indirect" (its neutral 0 when none), added to the far field.
+          io->prior = b.readOptional(res::kIndirect);
           io->indirect = b.write(b.create(res::kIndirect, gi::TextureDesc{kOutFormat}),
                                  gi::TextureUsage::StorageWrite);
         },
-        [this, io, c, frame, nearest, params](gi::PassContext& pc) {
+        [this, io, c, frame, nearest, linear, params](gi::PassContext& pc) {
           const VkExtent2D e = pc.extent(io->indirect), low = pc.extent(io->half);
           gi::vk::DescriptorWriter x(blurX_);
           x.buffer("Frame", frame)
@@ -572,6 +577,7 @@ class IsmEffect : public gi::Effect {
                 .texture("lowRaw", pc.view(io->low), nearest, VK_IMAGE_LAYOUT_GENERAL)
                 .texture("gDepth", pc.view(io->depth), nearest)
                 .texture("giGBuffer", pc.view(io->gbuffer), nearest)
+                .texture("priorIndirect", pc.view(io->prior), linear)
                 .image("outIndirect", pc.view(io->indirect));
             pc.dispatch(upsample_, u, e, kGroupX, kGroupY);
             return;
@@ -581,6 +587,7 @@ class IsmEffect : public gi::Effect {
               .buffer("ism", params)
               .texture("inRaw", pc.view(io->half), nearest, VK_IMAGE_LAYOUT_GENERAL)
               .texture("giGBuffer", pc.view(io->gbuffer), nearest)
+              .texture("priorIndirect", pc.view(io->prior), linear)
               .image("outIndirect", pc.view(io->indirect));
           pc.dispatch(blurY_, y, e, kGroupX, kGroupY);
         });
@@ -860,7 +867,7 @@ class IsmEffect : public gi::Effect {
         std::isfinite(centre.x) && std::isfinite(centre.y) && std::isfinite(centre.z);
     u.envSphere = glm::vec4(finite ? centre : glm::vec3(0.0f), radius);
     u.envVpls = glm::vec4(c.env, c.envPadded, c.total(), float(s[h_.environment_normal_offset]));
-    u.nearField = glm::vec4(nearField_, 0.0f, 0.0f, 0.0f);
+    u.nearField = glm::vec4(aoRange_, indirectRange_, 0.0f, 0.0f);
     uniforms_.write(&u, sizeof u);
     uploaded_ = u;
   }
@@ -931,8 +938,10 @@ class IsmEffect : public gi::Effect {
   VkSampler nearest_ = VK_NULL_HANDLE;
   gi::vk::Buffer uniforms_, vplBuffer_, envBuffer_;
   gi::ism::Uniforms uploaded_{};
-  float nearField_ = 0.0f;  // the range of the "ao" composed with the environment VPLs
-  struct Handles {          // typed settings read every frame, found by name in prepare()
+  // publishedRange of the "ao" composed with the environment VPLs and of an earlier
+  // "indirect" (addPasses; uploaded while recording).
+  float aoRange_ = 0.0f, indirectRange_ = 0.0f;
+  struct Handles {  // typed settings read every frame, found by name in prepare()
     gi::Setting<double> distance_clamp, bias, bias_slope, pull_threshold, push_threshold, strength,
         blur_tolerance, splat_scale, environment_normal_offset;
   } h_;

@@ -24,6 +24,8 @@ layout(set = 0, binding = 3, rgba32ui) uniform writeonly uimage2D outRaw;
 #define GI_GBUFFER_BINDING 3
 #include "gbuffer.glsl"  // the packed G-buffer (albedo, metallic)
 layout(set = 0, binding = 5, rgba16f) uniform writeonly image2D outIndirect;
+// An earlier effect's "indirect" (1x1 0 when none), added: ISM is its far field.
+layout(set = 0, binding = 8) uniform sampler2D priorIndirect;
 #endif
 
 vec3 unpackValue(uvec4 t) {
@@ -72,6 +74,7 @@ void main() {
   vec3 diffuse = albedo * (1.0 - metallic);
   vec3 l = diffuse * e / 3.14159265;
   if (GLOSSY) l += mix(vec3(0.04), albedo, metallic) * spec;
+  l += max(textureLod(priorIndirect, (vec2(p) + 0.5) * frame.viewport.zw, 0.0).rgb, vec3(0.0));
   imageStore(outIndirect, p, vec4(min(l, vec3(65000.0)), 1.0));
 #endif
 }

@@ -16,7 +16,8 @@ layout(set = 0, binding = 1, std140) uniform IsmParams {
   vec4 blur;    // plane tolerance, min normal cosine, splat scale, VPLs of all bounces
   vec4 envSphere;  // environment VPLs' orthographic maps: scene centre, bounding radius R
   vec4 envVpls;    // environment VPLs: count, padded count, first tile, normal offset (texels)
-  vec4 nearField;  // x: range (world) of the "ao" that darkens the environment VPLs' light
+  vec4 nearField;  // range (world) of x: the "ao" darkening the environment VPLs' light, y: the
+                   // earlier "indirect" the first bounce's far field is added to
 } ism;
 
 // One VPL: position (w 1: valid), normal, flux (rgb, W).

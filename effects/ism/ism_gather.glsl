@@ -69,7 +69,11 @@ void main() {
   float exponent = GLOSSY ? ismPhongExponent(PHONG_EXPONENT, giGBufferRoughness(surface)) : 1.0;
   for (int j = 0; j < PER_PIXEL; ++j) {
     uint i = phase + uint(j * K * K);
-    reflectVpl(vpls[i], min(i, uint(ism.blur.w) - 1u), x, n, view, exponent, e, spec);
+    Vpl v = vpls[i];
+    // Near field: the first bounce's light from senders within ism.nearField.y is an earlier
+    // effect's "indirect" (added after the blur); later bounces are all ISM's.
+    if (float(i) >= ism.rsm.z || distance(v.position.xyz, x) >= ism.nearField.y)
+      reflectVpl(v, min(i, uint(ism.blur.w) - 1u), x, n, view, exponent, e, spec);
   }
   vec3 envE = vec3(0.0), envSpec = vec3(0.0);
   for (int j = 0; j < ENV_PER_PIXEL; ++j) {

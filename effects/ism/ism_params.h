@@ -49,7 +49,8 @@ struct Uniforms {
   glm::vec4 blur;       // plane tolerance (relative depth), min normal cosine, splat scale, seed
   glm::vec4 envSphere;  // environment VPLs' orthographic maps: scene centre, bounding radius R
   glm::vec4 envVpls;    // environment VPLs: count, padded count, first tile, normal offset (texels)
-  glm::vec4 nearField;  // x: range (world) of the "ao" that darkens the environment VPLs' light
+  glm::vec4 nearField;  // range (world) of x: the "ao" darkening the environment VPLs' light, y:
+                        // the earlier "indirect" the first bounce's far field is added to
 };
 static_assert(sizeof(Uniforms) == 9 * sizeof(glm::vec4));
 

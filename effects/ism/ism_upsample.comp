@@ -20,6 +20,8 @@ layout(set = 0, binding = 3) uniform sampler2D gDepth;
 #define GI_GBUFFER_BINDING 4
 #include "gbuffer.glsl"  // the packed G-buffer (normal, albedo, metallic)
 layout(set = 0, binding = 7, rgba16f) uniform writeonly image2D outIndirect;
+// An earlier effect's "indirect" (1x1 0 when none), added: ISM is its far field.
+layout(set = 0, binding = 8) uniform sampler2D priorIndirect;
 
 
 void main() {
@@ -64,6 +66,7 @@ void main() {
   float metallic = giGBufferMetallic(surface);
   vec3 l = albedo * (1.0 - metallic) * e / 3.14159265;
   if (GLOSSY) l += mix(vec3(0.04), albedo, metallic) * spec;
+  l += max(textureLod(priorIndirect, (vec2(p) + 0.5) * frame.viewport.zw, 0.0).rgb, vec3(0.0));
   vec3 outv = isSky(depth) ? vec3(0.0) : min(l, vec3(65000.0));
   imageStore(outIndirect, p, vec4(outv, 1.0));
 }

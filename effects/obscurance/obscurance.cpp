@@ -53,7 +53,8 @@ class ObscuranceEffect : public gi::Effect {
         .reads = {res::kDepth, res::kGBuffer, res::kLights, res::kShadowViews, res::kShadowMaps},
         .writes = {res::kAO, res::kAmbient, res::kDirectLight},
         .debugView = res::kAO,
-        .estimates = gi::GroundTruth::AmbientOcclusion};
+        .estimates = gi::GroundTruth::AmbientOcclusion,
+        .range = "radius"};
   }
 
   // transfer off: obscurance with the membership setting (gi-reference --quantity obscurance

@@ -99,7 +99,8 @@ class SsdoEffect : public gi::Effect {
                       res::kEnvironmentMap, res::kEnvironmentSampling},
             .writes = {res::kAmbient, res::kIndirect, res::kContactShadow, res::kDirectLight},
             .debugView = res::kAmbient,
-            .estimates = gi::GroundTruth::IndirectLight};
+            .estimates = gi::GroundTruth::IndirectLight,
+            .range = "radius"};
   }
 
   std::vector<gi::SettingDesc> settings() const override {

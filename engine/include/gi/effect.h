@@ -52,9 +52,9 @@ class EffectContext {
   virtual std::shared_ptr<ViewUniforms> createView() = 0;
   virtual const CameraView& camera() = 0;              // the main camera of the current pose
   virtual const std::vector<LightInfo>& lights() = 0;  // world space, current pose
-  // The world-space distance within which the output `resource` accounts for occluders, as the
-  // effect that published it earlier in this graph build declares it (the radius of its
-  // EstimatedQuantity, for AO-like kinds); 0 when no effect published it or it has no range.
+  // The world-space distance within which the output `resource` accounts for occluders and
+  // light, as the effect that published it earlier in this graph build declares it (the value
+  // of its EffectInfo::range setting); 0 when no effect published it or it declares no range.
   // An effect that composes with it (e.g. a far-field term beside a near-field AO) leaves that
   // range to it, so nothing is counted twice.
   virtual double publishedRange(const std::string& resource) = 0;

@@ -29,6 +29,9 @@ struct Preset {
   double targetMs = 0.0;                             // frame budget the preset aims at ...
   uint32_t referenceWidth = 0, referenceHeight = 0;  // ... at this resolution
   std::map<std::string, nlohmann::json> effects;     // effect (or "engine") -> {setting: value}
+  // The effects this profile recommends running together ("recommended_effects"), chosen by
+  // their measured error on the benchmark scenes; `--effects recommended` runs them.
+  std::vector<std::string> recommendedEffects;
 };
 
 // Folders searched for presets by name: $GI_PRESET_PATH (':'-separated), then
@@ -47,7 +50,9 @@ Preset parsePreset(std::string_view text, const std::string& path);
 void validatePreset(const Preset& preset, const EffectRegistry& registry);
 
 struct EffectOverrides {
-  std::optional<std::vector<std::string>> effects;  // --effects (replaces the scene's list)
+  // --effects (replaces the scene's list); the single name "recommended" stands for the
+  // preset's recommendedEffects.
+  std::optional<std::vector<std::string>> effects;
   std::vector<std::string> sets;  // --set effect.key=value (or engine.key=value), in order
 };
 

@@ -19,7 +19,7 @@
 //     SettingValues stores values per declaration index (typed Setting<T> handles).
 // 13: ImagePass gained `publish` (its layout grew).
 // 14: litFilterInfo and addLitFilterPass (gi/image_pass.h), used by the template.
-// 15: EffectContext::publishedRange (a new virtual).
+// 15: EffectContext::publishedRange (a new virtual), EffectInfo::range.
 #define GI_EFFECT_ABI_VERSION 15u
 
 namespace gi {
@@ -129,6 +129,10 @@ struct EffectInfo {
   std::vector<std::string> writes;
   std::string debugView;  // resource shown by `gi-render --view <name>`
   GroundTruth estimates = GroundTruth::DirectLight;
+  // The world-length setting within which its outputs account for occluders and light (its
+  // near field, e.g. an AO's or SSDO's "radius"); empty: unbounded. An effect that composes
+  // with them reads it through EffectContext::publishedRange and leaves that range to them.
+  std::string range;
 };
 
 class Effect {

@@ -60,6 +60,15 @@ void layerEngineSettings(SettingValues& v, const Scene& scene, const Preset* pre
 }  // namespace
 
 void validatePreset(const Preset& preset, const EffectRegistry& registry) {
+  for (const std::string& name : preset.recommendedEffects) {
+    if (isEngine(name))
+      throw Error(ErrorKind::Schema, preset.path, "recommended_effects: 'engine' is no effect");
+    try {
+      registry.info(name);
+    } catch (const Error& e) {
+      throw Error(ErrorKind::Schema, preset.path, std::string("recommended_effects: ") + e.what());
+    }
+  }
   for (const auto& [effect, values] : preset.effects) {
     if (isEngine(effect)) {
       SettingValues s(kEngineSettingsOwner, engineSettingDescs());
@@ -100,7 +109,15 @@ std::vector<EffectConfig> resolveEffects(const Scene& scene, const Preset* prese
                                          const EffectOverrides& cli,
                                          const EffectRegistry& registry) {
   std::vector<std::string> names;
-  if (cli.effects) {
+  if (cli.effects && *cli.effects == std::vector<std::string>{"recommended"}) {
+    if (!preset)
+      throw Error(ErrorKind::Usage, "--effects",
+                  "'recommended' runs a preset's recommended effects: give --preset");
+    if (preset->recommendedEffects.empty())
+      throw Error(ErrorKind::Usage, preset->path,
+                  "preset '" + preset->name + "' recommends no effects (recommended_effects)");
+    names = preset->recommendedEffects;
+  } else if (cli.effects) {
     names = *cli.effects;
     for (const std::string& name : names)
       if (isEngine(name))

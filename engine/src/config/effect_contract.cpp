@@ -77,7 +77,7 @@ void checkComposition(const std::vector<EffectPublications>& inOrder,
         throw Error(ErrorKind::Usage, "",
                     "effects '" + it->second + "' and '" + e.effect + "' both write '" + name +
                         "' and '" + e.effect + "' does not read it: '" + it->second +
-                        "''s would be lost (its passes culled); enable one of them");
+                        "''s would be replaced and reach nothing; enable one of them");
     }
     for (const std::string& name : e.published) lastWriter[name] = e.effect;
   }

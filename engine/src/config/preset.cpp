@@ -86,7 +86,7 @@ Preset parsePreset(std::string_view text, const std::string& path) {
   // "calibration": gi-bench --calibrate's record of its search (read by people, not here).
   onlyKeys(j,
            {"name", "description", "platform", "target_ms", "reference_resolution", "effects",
-            "calibration"},
+            "recommended_effects", "calibration"},
            "", p.path);
   if (j.contains("calibration") && !j["calibration"].is_object())
     throw Error(ErrorKind::Schema, p.path, "calibration: expected an object");
@@ -123,6 +123,17 @@ Preset parsePreset(std::string_view text, const std::string& path) {
         throw Error(ErrorKind::Schema, p.path,
                     "effects." + it.key() + ": expected an object of settings");
       p.effects[it.key()] = it.value();
+    }
+  }
+  if (j.contains("recommended_effects")) {
+    const json& r = j["recommended_effects"];
+    if (!r.is_array() || r.empty())
+      throw Error(ErrorKind::Schema, p.path,
+                  "recommended_effects: expected a non-empty array of effect names");
+    for (const json& name : r) {
+      if (!name.is_string())
+        throw Error(ErrorKind::Schema, p.path, "recommended_effects: expected effect names");
+      p.recommendedEffects.push_back(name);
     }
   }
   return p;

@@ -288,7 +288,7 @@ struct Renderer::Impl : EffectContext {
     graph.setPassOwner("");
     if (plugin) {
       publications.push_back({info.name, bb.lookedUp(), bb.published()});
-      recordRange(e, info.name, values, bb.published());
+      recordRange(info, values, bb.published());
       const std::vector<std::string> all = graph.passNames();
       effectPasses[info.name].assign(all.begin() + std::ptrdiff_t(passesBefore), all.end());
     }
@@ -310,15 +310,20 @@ struct Renderer::Impl : EffectContext {
     return masks;
   }
 
-  // An AO-like output accounts for occluders within its quantity's radius (publishedRange).
-  void recordRange(const Effect& e, const std::string& name, const SettingValues& values,
+  // Its outputs account for occluders and light within its declared range (publishedRange).
+  void recordRange(const EffectInfo& info, const SettingValues& values,
                    const std::set<std::string>& published) {
-    using Kind = EstimatedQuantity::Kind;
-    EstimatedQuantity q;
-    guarded(name, "estimatedQuantity()", [&] { q = e.estimatedQuantity(values); });
-    const bool ranged = q.kind == Kind::AmbientOcclusion || q.kind == Kind::Obscurance ||
-                        q.kind == Kind::Alchemy || q.kind == Kind::AlchemyDisk;
-    for (const std::string& r : published) ranges[r] = ranged ? q.radius : 0.0;
+    double range = 0.0;
+    if (!info.range.empty()) {
+      const auto& descs = values.descs();
+      if (std::none_of(descs.begin(), descs.end(),
+                       [&](const SettingDesc& d) { return d.name == info.range; }))
+        throw Error(ErrorKind::Usage, "",
+                    "effect '" + info.name + "' declares its range by the setting '" + info.range +
+                        "', which it does not have");
+      range = values.number(info.range);
+    }
+    for (const std::string& r : published) ranges[r] = range;
   }
 
   void addBuiltin(Effect& e) {

@@ -12,7 +12,8 @@ EffectInfo aoEffectInfo(std::string name, std::string description) {
           .reads = {resources::kDepth, resources::kGBuffer},
           .writes = {resources::kAO},
           .debugView = resources::kAO,
-          .estimates = GroundTruth::AmbientOcclusion};
+          .estimates = GroundTruth::AmbientOcclusion,
+          .range = "radius"};
 }
 
 SettingDesc aoRadiusSetting(std::string help) {
