@@ -202,18 +202,23 @@ class IsmTest : public test::EffectTest {
   };
   Result render(const Scene& scene, const std::vector<std::string>& sets, int frames = 1,
                 bool withIsm = true, double time = 0.0) {
-    const RenderSettings rs =
-        withIsm ? settingsFor(scene, sets, kW, kH) : settingsFor({}, scene, sets, kW, kH);
-    Renderer r(ctx(), scene, rs, &registry);
+    return renderEffects(scene,
+                         withIsm ? std::vector<std::string>{"ism"} : std::vector<std::string>{},
+                         sets, frames, time);
+  }
+  // `effects` together; "indirect" is read when an effect published it.
+  Result renderEffects(const Scene& scene, const std::vector<std::string>& effects,
+                       const std::vector<std::string>& sets, int frames = 1, double time = 0.0) {
+    Renderer r(ctx(), scene, settingsFor(effects, scene, sets, kW, kH), &registry);
     r.setTime(time);
     for (int i = 0; i < frames; ++i) r.renderFrame();
     Result res;
     res.passes = r.passNames();
     res.warnings = r.warnings();
-    // Without a light to bounce or environment VPLs the effect adds no pass (and no "indirect").
-    if (withIsm &&
-        std::find(res.passes.begin(), res.passes.end(), "ism_gather") != res.passes.end())
-      res.indirect = r.readTarget("indirect");
+    // Without a light to bounce or environment VPLs ISM adds no pass (and no "indirect").
+    for (const auto& e : r.effectPasses())
+      if (e.run > 0 && (e.effect == "ism" || e.effect == "ssdo"))
+        res.indirect = r.readTarget("indirect");
     res.depth = r.readTarget("depth");
     res.lit = r.readTarget("lit");
     res.camera = r.camera();
@@ -1113,14 +1118,7 @@ TEST_F(IsmTest, EnvironmentVplShadowFollowsAnAnimatedBox) {
 TEST_F(IsmTest, EnvironmentVplsLeaveTheNearFieldToAnAOEffect) {
   const Scene s = environmentScene("env_box_ao", true);
   auto render = [&](const std::vector<std::string>& effects, const std::vector<std::string>& sets) {
-    Renderer r(ctx(), s, settingsFor(effects, s, sets, kW, kH), &registry);
-    r.renderFrame();
-    Result res;
-    res.lit = r.readTarget("lit");
-    res.depth = r.readTarget("depth");
-    res.camera = r.camera();
-    res.passes = r.passNames();
-    return res;
+    return renderEffects(s, effects, sets);
   };
   const std::string env = "ism.environment_vpls=256";
   const Result aoWide = render({"gtao"}, {"gtao.radius=20"});
@@ -1169,14 +1167,7 @@ TEST_F(IsmTest, SsdoNearFieldAndIsmFarFieldSplitTheBounceByDistance) {
     };
     if (on("ism")) sets.insert(sets.end(), kOneVpl.begin(), kOneVpl.end());
     if (on("ssdo")) sets.push_back("ssdo.bounce=true");
-    Renderer r(ctx(), s, settingsFor(effects, s, sets, kW, kH), &registry);
-    r.renderFrame();
-    Result res;
-    res.indirect = r.readTarget("indirect");
-    res.depth = r.readTarget("depth");
-    res.camera = r.camera();
-    res.passes = r.passNames();
-    return res;
+    return renderEffects(s, effects, sets);
   };
   const float radius = 2.5f;
   const std::string r = "ssdo.radius=" + std::to_string(radius);

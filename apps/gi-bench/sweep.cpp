@@ -105,8 +105,9 @@ std::vector<Config> buildConfigs(const Options& o, const Setup& s,
             continue;
           }
           set = s.presets[pi]->recommendedEffects;
-          label.clear();
-          for (const std::string& e : set) label += (label.empty() ? "" : "+") + e;
+          label = "recommended (";
+          for (size_t k = 0; k < set.size(); ++k) label += (k ? "+" : "") + set[k];
+          label += ")";
         }
         if (everyEffect && s.presets[pi] &&
             std::none_of(set.begin(), set.end(),
