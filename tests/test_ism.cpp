@@ -151,6 +151,35 @@ TEST(IsmFormulas, PullPushFillsHolesWithoutDepthOutliers) {
   EXPECT_FLOAT_EQ(push(inf, silhouette), 2.0f);
 }
 
+// The environment VPLs' orthographic maps fitted to the view: a camera that sees part of a
+// large scene gets a smaller map (a smaller texel) that still holds every point it sees, with a
+// depth origin past the scene's far side; a camera looking away from the scene, or a broken
+// matrix, gets the whole scene.
+TEST(IsmFormulas, EnvironmentMapsFitWhatTheCameraSees) {
+  const glm::vec3 lo(-10, 0, -10), hi(10, 5, 10);
+  const float sceneRadius = 0.5f * glm::length(hi - lo);
+  const glm::vec3 eye(0, 2, 8);
+  const glm::mat4 proj = perspectiveReverseZ(glm::radians(30.0f), 1.0f, 0.1f, 100.0f);
+  const glm::mat4 view = glm::lookAt(eye, glm::vec3(0, 2, -10), glm::vec3(0, 1, 0));
+  const ism::OrthoFit fit = ism::fitEnvironmentMaps(lo, hi, glm::inverse(proj * view), eye);
+  EXPECT_LT(fit.radius, 0.8f * sceneRadius);
+  for (const glm::vec3 seen : {glm::vec3(0, 0, 0), glm::vec3(0, 0, -10), glm::vec3(2, 2, 6)})
+    EXPECT_LE(glm::length(seen - fit.centre), fit.radius) << seen.x << "," << seen.z;
+  for (int i = 0; i < 8; ++i) {  // every occluder of the scene lies in front of the depth origin
+    const glm::vec3 corner((i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z);
+    EXPECT_GE(fit.depth, glm::length(corner - fit.centre));
+  }
+  const glm::vec3 away(0, 2, 20);
+  const glm::mat4 awayView = glm::lookAt(away, glm::vec3(0, 2, 40), glm::vec3(0, 1, 0));
+  const ism::OrthoFit whole = ism::fitEnvironmentMaps(lo, hi, glm::inverse(proj * awayView), away);
+  EXPECT_FLOAT_EQ(whole.radius, sceneRadius);
+  EXPECT_FLOAT_EQ(whole.depth, sceneRadius);
+  const glm::mat4 broken(std::numeric_limits<float>::quiet_NaN());
+  const ism::OrthoFit guarded = ism::fitEnvironmentMaps(lo, hi, broken, eye);
+  EXPECT_FLOAT_EQ(guarded.radius, sceneRadius);
+  EXPECT_TRUE(std::isfinite(guarded.centre.x));
+}
+
 // Environment VPLs: the k^2 interleaving phases each gather every k^2-th VPL, so each phase's
 // sample points must cover both coordinates of the sampler's unit square, not just all of them
 // together: 256 points, 16 phases, each phase's 16 points one in every 1/16 slab of either

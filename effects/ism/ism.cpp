@@ -57,7 +57,7 @@ gi::vk::ComputeDesc shader(const char* name, const uint32_t (&words)[N],
       gi::computeShader(std::string("ism: ") + name, words, std::move(constants));
   if (readsParams)
     d.blocks.uniforms = {{"ism", GI_CPP_BLOCK(Uniforms, rsm, atlas, bias, pull, gather, blur,
-                                              envSphere, envVpls, nearField)}};
+                                              envSphere, envVpls, nearField, envDepth)}};
   return d;
 }
 
@@ -219,6 +219,11 @@ class IsmEffect : public gi::Effect {
          "environment VPLs: receivers look up their orthographic maps from this many texels "
          "along their normal (with the constant `bias`; see ism_lookup.glsl)",
          false},
+        {"environment_fit_view", SettingType::Bool, 1, 0, 1,
+         "environment VPLs: their orthographic maps cover the scene within the camera's frustum "
+         "(smaller texels where the view holds part of the scene; occluders outside still "
+         "count) instead of the scene's whole bounding sphere",
+         false},
     };
   }
 
@@ -232,6 +237,7 @@ class IsmEffect : public gi::Effect {
     h_.blur_tolerance = s.handle<double>("blur_tolerance");
     h_.splat_scale = s.handle<double>("splat_scale");
     h_.environment_normal_offset = s.handle<double>("environment_normal_offset");
+    h_.environment_fit_view = s.handle<bool>("environment_fit_view");
     gi::vk::Context& vk = ctx.vulkan();
     vk.requireWorkgroup(kGroupX, kGroupY, "ism");
     Config c;
@@ -865,7 +871,13 @@ class IsmEffect : public gi::Effect {
     const float radius = 0.5f * extent;
     const bool finite =
         std::isfinite(centre.x) && std::isfinite(centre.y) && std::isfinite(centre.z);
-    u.envSphere = glm::vec4(finite ? centre : glm::vec3(0.0f), radius);
+    gi::ism::OrthoFit fit{finite ? centre : glm::vec3(0.0f), radius, radius};
+    if (finite && s[h_.environment_fit_view]) {
+      const gi::CameraView& cam = ctx.camera();
+      fit = gi::ism::fitEnvironmentMaps(lo, hi, glm::inverse(cam.proj * cam.view), cam.position);
+    }
+    u.envSphere = glm::vec4(fit.centre, fit.radius);
+    u.envDepth = glm::vec4(fit.depth, 0.0f, 0.0f, 0.0f);
     u.envVpls = glm::vec4(c.env, c.envPadded, c.total(), float(s[h_.environment_normal_offset]));
     u.nearField = glm::vec4(aoRange_, indirectRange_, 0.0f, 0.0f);
     uniforms_.write(&u, sizeof u);
@@ -944,6 +956,7 @@ class IsmEffect : public gi::Effect {
   struct Handles {  // typed settings read every frame, found by name in prepare()
     gi::Setting<double> distance_clamp, bias, bias_slope, pull_threshold, push_threshold, strength,
         blur_tolerance, splat_scale, environment_normal_offset;
+    gi::Setting<bool> environment_fit_view;
   } h_;
 };
 

@@ -30,7 +30,7 @@ void main() {
   int i = range.first + k, tile = range.firstTile + k;
   Vpl v = vpls[i];
   float near = ism.bias.z, far = ism.bias.w, radius = max(ism.envSphere.w, 1e-30);
-  vec3 eye = ORTHO ? ism.envSphere.xyz + (radius + near) * v.position.xyz : v.position.xyz;
+  vec3 eye = ORTHO ? ism.envSphere.xyz + (ism.envDepth.x + near) * v.position.xyz : v.position.xyz;
   vec3 f = ORTHO ? safeNormalize(-v.position.xyz, vec3(0.0, -1.0, 0.0))
                  : safeNormalize(v.normal.xyz, vec3(0.0, -1.0, 0.0));
   vec3 up = abs(f.y) > 0.99 ? vec3(0.0, 0.0, 1.0) : vec3(0.0, 1.0, 0.0);

@@ -14,10 +14,11 @@ layout(set = 0, binding = 1, std140) uniform IsmParams {
   vec4 pull;    // pull threshold, push threshold, levels, scene extent
   vec4 gather;  // d_min^2, block k, k^2, strength
   vec4 blur;    // plane tolerance, min normal cosine, splat scale, VPLs of all bounces
-  vec4 envSphere;  // environment VPLs' orthographic maps: scene centre, bounding radius R
+  vec4 envSphere;  // environment VPLs' orthographic maps: centre, half side R (fitted to the view)
   vec4 envVpls;    // environment VPLs: count, padded count, first tile, normal offset (texels)
   vec4 nearField;  // range (world) of x: the "ao" darkening the environment VPLs' light, y: the
                    // earlier "indirect" the first bounce's far field is added to
+  vec4 envDepth;   // x: the orthographic maps' depth origin beyond envSphere's centre
 } ism;
 
 // One VPL: position (w 1: valid), normal, flux (rgb, W).
@@ -59,7 +60,12 @@ ivec2 ismOrthoTexel(uint tile, vec3 p, vec3 s, vec3 u) {
   ivec2 t = clamp(ivec2((disk * 0.5 + 0.5) * float(res)), ivec2(0), ivec2(res - 1));
   return ismTileOrigin(tile) + t;
 }
-float ismOrthoDepth(vec3 p, vec3 d) { return ism.envSphere.w - dot(p - ism.envSphere.xyz, d); }
+// Inside the map's square (the fitted region: gi::ism::fitEnvironmentMaps)?
+bool ismOrthoInside(vec3 p, vec3 s, vec3 u) {
+  vec3 q = p - ism.envSphere.xyz;
+  return max(abs(dot(q, s)), abs(dot(q, u))) <= ism.envSphere.w;
+}
+float ismOrthoDepth(vec3 p, vec3 d) { return ism.envDepth.x - dot(p - ism.envSphere.xyz, d); }
 float ismOrthoTexelSide() { return 2.0 * ism.envSphere.w / ism.atlas.x; }  // world units
 
 uint ismHash(uint x) {

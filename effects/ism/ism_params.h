@@ -51,8 +51,50 @@ struct Uniforms {
   glm::vec4 envVpls;    // environment VPLs: count, padded count, first tile, normal offset (texels)
   glm::vec4 nearField;  // range (world) of x: the "ao" darkening the environment VPLs' light, y:
                         // the earlier "indirect" the first bounce's far field is added to
+  glm::vec4 envDepth;   // x: the orthographic maps' depth origin beyond envSphere's centre
 };
-static_assert(sizeof(Uniforms) == 9 * sizeof(glm::vec4));
+static_assert(sizeof(Uniforms) == 10 * sizeof(glm::vec4));
+
+// The environment VPLs' orthographic maps (seed 002 §5) over what the camera can see of the
+// scene: the bounds of its frustum out to the scene's farthest corner, within the scene's
+// bounds [lo, hi], not the scene's whole bounding sphere, so a texel shrinks where the view
+// holds part of a large scene. `centre` and `radius` span the maps; `depth` (from the centre
+// toward the sky) reaches past the scene's far side, so occluders outside the fitted region
+// still shadow it. A frustum that misses the bounds falls back to the whole scene.
+struct OrthoFit {
+  glm::vec3 centre{0.0f};
+  float radius = 1.0f, depth = 1.0f;
+};
+inline OrthoFit fitEnvironmentMaps(const glm::vec3& lo, const glm::vec3& hi,
+                                   const glm::mat4& invViewProj, const glm::vec3& eye) {
+  const glm::vec3 sceneCentre = 0.5f * (lo + hi);
+  const float sceneRadius = std::max(0.5f * glm::length(hi - lo), 1e-6f);
+  float far = 0.0f;
+  for (int i = 0; i < 8; ++i) {
+    const glm::vec3 corner((i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z);
+    far = std::max(far, glm::length(corner - eye));
+  }
+  glm::vec3 fmin = eye, fmax = eye;
+  for (int i = 0; i < 4; ++i) {  // the frustum's edges, out to the farthest corner
+    const glm::vec4 h = invViewProj * glm::vec4((i & 1) ? 1.0f : -1.0f, (i & 2) ? 1.0f : -1.0f,
+                                                1.0f, 1.0f);  // reverse-Z: 1 is the near plane
+    const glm::vec3 p = glm::vec3(h) / h.w;
+    const glm::vec3 d = p - eye;
+    const float len = glm::length(d);
+    if (!(len > 0.0f) || !std::isfinite(len)) return {sceneCentre, sceneRadius, sceneRadius};
+    const glm::vec3 end = eye + d / len * far;
+    fmin = glm::min(fmin, glm::min(p, end));
+    fmax = glm::max(fmax, glm::max(p, end));
+  }
+  const glm::vec3 bmin = glm::max(fmin, lo), bmax = glm::min(fmax, hi);
+  if (!(bmin.x <= bmax.x && bmin.y <= bmax.y && bmin.z <= bmax.z))
+    return {sceneCentre, sceneRadius, sceneRadius};
+  OrthoFit f;
+  f.centre = 0.5f * (bmin + bmax);
+  f.radius = std::max(0.5f * glm::length(bmax - bmin), 1e-6f);
+  f.depth = glm::length(f.centre - sceneCentre) + sceneRadius;
+  return f;
+}
 
 // The paraboloid basis of a VPL with normal n, the same as SceneView::paraboloid's view matrix
 // (lookAlong: up +y, or +z when n is nearly vertical), so ISMs and classic maps share texels.

@@ -43,6 +43,7 @@ void main() {
   if (ORTHO) {
     vec3 d = vpl.position.xyz, s, u;
     ismBasis(-d, s, u);  // the view's axis, as the classic maps' (ism_classic_views.comp)
+    if (!ismOrthoInside(pa.xyz, s, u)) return;  // outside the fitted map: no receiver under it
     t = ismOrthoTexel(tile, pa.xyz, s, u);
     depth = floatBitsToUint(max(ismOrthoDepth(pa.xyz, d), 0.0));
     float side = max(ismOrthoTexelSide(), 1e-30);
