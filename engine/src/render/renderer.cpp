@@ -403,18 +403,29 @@ struct Renderer::Impl : EffectContext {
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   }
 
-  // An enabled effect whose every pass the graph culled costs nothing but does nothing either:
-  // said, naming it, instead of left for the user to find in --print-graph.
+  // Each enabled effect, in order, with how many of its passes the graph runs.
+  std::vector<Renderer::EffectPasses> passesPerEffect() const {
+    const std::vector<std::string> run = graph.executedPasses();
+    const std::set<std::string> executed(run.begin(), run.end());
+    std::vector<Renderer::EffectPasses> out;
+    for (const EffectPublications& e : publications) {
+      const std::vector<std::string>& passes = effectPasses.at(e.effect);
+      const auto ran = std::count_if(passes.begin(), passes.end(),
+                                     [&](const std::string& p) { return executed.count(p) != 0; });
+      out.push_back({e.effect, size_t(ran), passes.size()});
+    }
+    return out;
+  }
+
+  // An enabled effect that runs no pass costs nothing but does nothing either: said, naming
+  // it, instead of left for the user to find in --print-graph.
   void warnAboutCulledEffects() {
-    const std::vector<std::string> culled = graph.culledPasses();
-    const std::set<std::string> culledSet(culled.begin(), culled.end());
-    for (const auto& [effect, passes] : effectPasses)
-      if (passes.empty())
-        graphWarnings.push_back("effect '" + effect +
+    for (const Renderer::EffectPasses& e : passesPerEffect())
+      if (e.total == 0)
+        graphWarnings.push_back("effect '" + e.effect +
                                 "' adds no pass: nothing to do for this scene and settings");
-      else if (std::all_of(passes.begin(), passes.end(),
-                           [&](const auto& p) { return culledSet.count(p) != 0; }))
-        graphWarnings.push_back("effect '" + effect +
+      else if (e.run == 0)
+        graphWarnings.push_back("effect '" + e.effect +
                                 "' runs no pass: nothing it writes reaches the view '" +
                                 settings.view + "'");
   }
@@ -695,16 +706,7 @@ bool Renderer::isEnginePass(const std::string& pass) const {
   return impl_->enginePasses.count(pass) > 0;
 }
 std::vector<Renderer::EffectPasses> Renderer::effectPasses() const {
-  const std::vector<std::string> run = impl_->graph.executedPasses();
-  const std::set<std::string> executed(run.begin(), run.end());
-  std::vector<EffectPasses> out;
-  for (const EffectPublications& e : impl_->publications) {
-    const std::vector<std::string>& passes = impl_->effectPasses[e.effect];
-    const auto ran = std::count_if(passes.begin(), passes.end(),
-                                   [&](const std::string& p) { return executed.count(p) != 0; });
-    out.push_back({e.effect, size_t(ran), passes.size()});
-  }
-  return out;
+  return impl_->passesPerEffect();
 }
 std::string Renderer::graphDescription() const {
   std::string effects;
