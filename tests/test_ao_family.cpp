@@ -13,6 +13,7 @@
 
 #include "effect_fixture.h"
 #include "gi/scene_io.h"
+#include "process.h"
 #include "quad_scene.h"
 #include "test_support.h"
 
@@ -90,7 +91,8 @@ TEST_P(AoFamilyTest, NoDarkPixelsOnTheOutlineOfACurvedObject) {
   // plugin's unfiltered spread; and with the effect's filter on every pixel of the object must
   // stay open (> 0.97).
   for (const char* scale : {"1", "[0.1, 2, 0.1]"}) {
-    const Scene s = test::outlineScene(scale, ::testing::TempDir() + "/ao_family_outline.json");
+    const Scene s =
+        test::outlineScene(scale, test::makeTempDir("scenes") + "/ao_family_outline.json");
     for (const auto& sets : {GetParam().blurOff, GetParam().blurOn}) {
       const bool filtered = sets == GetParam().blurOn;
       const std::string blur = sets[0];

@@ -23,6 +23,7 @@
 #include "effect_fixture.h"
 #include "gi/renderer.h"
 #include "gi/scene_io.h"
+#include "process.h"
 #include "test_support.h"
 
 namespace gi {
@@ -254,7 +255,7 @@ class IsmTest : public test::EffectTest {
     return res;
   }
   Scene jsonScene(const std::string& name, const std::string& json) {
-    const std::string path = ::testing::TempDir() + "/ism_" + name + ".json";
+    const std::string path = test::makeTempDir("scenes") + "/ism_" + name + ".json";
     {
       std::ofstream f(path);
       f << json;

@@ -11,6 +11,7 @@
 #include "gi/reference/reference.h"
 #include "gi/renderer.h"
 #include "gi/scene_io.h"
+#include "process.h"
 
 namespace gi {
 namespace {
@@ -109,7 +110,7 @@ TEST_F(IsmReference, CornellBoxOneBounceMatchesTheReference) {
 // Measured (160x120, reference 1024 spp): NRMSE 0.035 (classic maps 0.028) against the engine
 // term's 0.103. Thresholds: each below 0.05 and below 0.6 x the engine's.
 TEST_F(IsmReference, EnvironmentVplsShadowTheEnvironmentLikeTheReference) {
-  const std::string path = ::testing::TempDir() + "/ism_env_reference.json";
+  const std::string path = test::makeTempDir("scenes") + "/ism_env_reference.json";
   {
     std::ofstream f(path);
     f << R"({ "models": [

@@ -14,6 +14,7 @@
 #include "gi/errors.h"
 #include "gi/renderer.h"
 #include "gi/scene_io.h"
+#include "process.h"
 #include "test_support.h"
 #include "vulkan_fixture.h"
 
@@ -94,7 +95,7 @@ Frame renderWith(vk::Context& ctx, const Scene& scene, EffectRegistry& reg,
   RenderSettings rs;
   rs.width = 96;
   rs.height = 72;
-  rs.keepForReadback = {"albedo", "material"};  // read after the frame
+  rs.keepForReadback = {"lit", "depth", "albedo", "material"};  // read after the frame
   for (const std::string& e : effects) rs.effects.push_back({e, reg.defaultSettings(e)});
   Renderer r(ctx, scene, rs, &reg);
   r.renderFrame();
@@ -200,7 +201,7 @@ TEST_F(LightingCompositionTest, AmbientWithAlphaTwoIsMultipliedByTheDiffuseAlbed
 TEST_F(LightingCompositionTest, ContactShadowScalesOnlyTheShadowedLightsDirectTerm) {
   auto scene = [](bool withShadowed) {
     const std::string path =
-        ::testing::TempDir() + "/contact_" + (withShadowed ? "two" : "one") + ".json";
+        test::makeTempDir("scenes") + "/contact_" + (withShadowed ? "two" : "one") + ".json";
     std::ofstream(path) << R"({
       "models": [ { "primitive": "plane", "size": 20, "material": { "base_color": [0.6, 0.6, 0.6] } },
                   { "primitive": "box", "size": [1, 1, 1], "translation": [0, 0.5, 0] } ],

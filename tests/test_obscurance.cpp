@@ -18,6 +18,7 @@
 #include "../effects/obscurance/obscurance_kernel.h"
 #include "effect_fixture.h"
 #include "gi/renderer.h"
+#include "process.h"
 #include "quad_scene.h"
 
 namespace gi {
@@ -393,7 +394,7 @@ TEST_F(ObscuranceTest, RadianceTransferWithoutLightsIsTheAlbedoTransferTimesTheA
 // sends its direct light: W above 1), fading with the distance; the albedo transfer's stays
 // grey and below the open floor's.
 TEST_F(ObscuranceTest, RadianceTransferBleedsTheColourOfALitWall) {
-  const std::string path = ::testing::TempDir() + "/obscurance_red_wall.json";
+  const std::string path = test::makeTempDir("scenes") + "/obscurance_red_wall.json";
   {
     std::ofstream f(path);
     f << R"({

@@ -14,6 +14,7 @@
 #include "../effects/ssao/ssao_kernel.h"
 #include "effect_fixture.h"
 #include "gi/renderer.h"
+#include "process.h"
 #include "quad_scene.h"
 
 namespace gi {
@@ -293,7 +294,7 @@ TEST_F(SsaoTest, NoDarkPixelsOnTheOutlineOfACurvedObject) {
   // pointed into the object, whose pixels then read AO ~0.1 (isolated dots the blur keeps, as it
   // does not average across the outline). Every pixel of the object must stay open.
   for (const char* scale : {"1", "[0.1, 2, 0.1]"}) {
-    const Scene s = test::outlineScene(scale, ::testing::TempDir() + "/ssao_outline.json");
+    const Scene s = test::outlineScene(scale, test::makeTempDir("scenes") + "/ssao_outline.json");
     for (const char* blur : {"ssao.blur_radius=0", "ssao.blur_radius=2"}) {
       Result r = render(s, {"ssao.radius=0.5", "ssao.samples=16", blur}, 320, 240);
       auto onSphere = [&](int x, int y) { return r.worldAt(x, y).z > -1.0f; };

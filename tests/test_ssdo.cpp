@@ -19,6 +19,7 @@
 #include "gi/errors.h"
 #include "gi/renderer.h"
 #include "gi/scene_io.h"
+#include "process.h"
 #include "quad_scene.h"
 #include "ssdo_frames.h"
 #include "test_support.h"
@@ -94,7 +95,7 @@ class SsdoTest : public test::EffectTest {
   // JSON scenes: a scene without lights gets a default sun, so each names one of intensity 0
   // (the environment and emission are then the only light).
   Scene jsonScene(const std::string& name, const std::string& json) {
-    const std::string path = ::testing::TempDir() + "/ssdo_" + name + ".json";
+    const std::string path = test::makeTempDir("scenes") + "/ssdo_" + name + ".json";
     {
       std::ofstream f(path);
       f << json;

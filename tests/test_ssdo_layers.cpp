@@ -13,6 +13,7 @@
 #include "gi/effect_config.h"
 #include "gi/renderer.h"
 #include "gi/scene_io.h"
+#include "process.h"
 #include "quad_scene.h"
 #include "ssdo_frames.h"
 #include "test_support.h"
@@ -40,7 +41,7 @@ class SsdoLayersTest : public test::EffectTest {
                            r.readTarget("depth"), r.camera());
   }
   Scene jsonScene(const std::string& name, const std::string& json) {
-    const std::string path = ::testing::TempDir() + "/ssdo_layers_" + name + ".json";
+    const std::string path = test::makeTempDir("scenes") + "/ssdo_layers_" + name + ".json";
     {
       std::ofstream f(path);
       f << json;
