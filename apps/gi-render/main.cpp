@@ -179,13 +179,16 @@ int run(const Options& o) {
   std::optional<gi::vk::Swapchain> swapchain;
   if (window) swapchain.emplace(ctx, window->handle());
 
-  std::map<std::string, std::vector<double>> samples;
+  std::map<std::string, std::vector<double>> samples, cpuSamples;
   const int frames = o.frames > 0 ? o.frames : window ? INT_MAX : 1;
   int rendered = 0;
   for (; rendered < frames && !(window && window->closed()); ++rendered) {
     renderer.setTime(o.time + rendered * o.timeStep);
     renderer.renderFrame();
-    for (const auto& t : renderer.lastTimings()) samples[t.name].push_back(t.ms);
+    for (const auto& t : renderer.lastTimings()) {
+      samples[t.name].push_back(t.ms);
+      if (t.cpuMs >= 0.0) cpuSamples[t.name].push_back(t.cpuMs);
+    }
     if (swapchain) swapchain->present(renderer.outputImage(), renderer.outputExtent());
   }
   if (rendered == 0) std::printf("window closed before the first frame\n");
@@ -195,14 +198,24 @@ int run(const Options& o) {
     std::printf("scene %s, %ux%u, %zu triangles, %d frame(s), device %s\n", o.common.scene.c_str(),
                 o.common.width, o.common.height, scene.triangleCount(), rendered,
                 ctx.deviceName().c_str());
-    std::printf("%-12s %12s\n", "pass", "median ms");
-    double total = 0;
+    // With --isolate-passes also each pass's process CPU time (tight on a loaded machine).
+    const bool cpu = !cpuSamples.empty();
+    std::printf("%-12s %12s%s\n", "pass", "median ms", cpu ? "       cpu ms" : "");
+    double total = 0, cpuTotal = 0;
     for (const std::string& name : renderer.passNames()) {
       const double median = gi::cli::median(samples[name]);
       total += median;
-      std::printf("%-12s %12.3f\n", name.c_str(), median);
+      std::printf("%-12s %12.3f", name.c_str(), median);
+      if (cpu) {
+        const double c = gi::cli::median(cpuSamples[name]);
+        cpuTotal += c;
+        std::printf(" %12.3f", c);
+      }
+      std::printf("\n");
     }
-    std::printf("%-12s %12.3f\n", "total", total);
+    std::printf("%-12s %12.3f", "total", total);
+    if (cpu) std::printf(" %12.3f", cpuTotal);
+    std::printf("\n");
     std::string culled;
     for (const std::string& c : renderer.culledPassNames()) culled += " " + c;
     std::printf("culled passes:%s\n", culled.empty() ? " none" : culled.c_str());
@@ -218,9 +231,9 @@ int run(const Options& o) {
     const gi::Renderer::DrawCounts draws = renderer.lastFrameDraws();
     std::printf(
         "instance draws (last frame, all views): %llu drawn, %llu culled by the views' "
-        "frusta\n",
-        static_cast<unsigned long long>(draws.drawn),
-        static_cast<unsigned long long>(draws.culled));
+        "frusta; shadow maps: %u drawn whole, %u from their static cache\n",
+        static_cast<unsigned long long>(draws.drawn), static_cast<unsigned long long>(draws.culled),
+        draws.shadowMapsDrawn, draws.shadowMapsCached);
     std::printf("frame graph compile %.3f ms (CPU), plugin loading %.3f ms (%zu effect(s))\n",
                 renderer.lastCompileMs(), pluginLoadMs, registry.names().size());
     rusage usage{};

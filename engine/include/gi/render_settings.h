@@ -41,6 +41,10 @@ struct RenderSettings {
   // Skip drawing instances whose posed bounds lie outside a view's frustum (main camera, shadow
   // maps, cube faces, depth layers): the same image, fewer draws. Off for A/B measurements.
   bool cullDraws = true;
+  // Shadow maps cost only what changed: a light that did not move keeps its static casters'
+  // depth in a cache; each frame redraws only the dynamic casters (skinned, morphed, or moved
+  // once) over the texels they cover. The same maps bit for bit; off for A/B measurements.
+  bool cacheShadows = true;
   std::string view =
       "output";  // the resource the frame delivers (a G-buffer channel, an effect's view)
   // Resources readTarget() will read besides `view`: kept intact to the end of the frame (the

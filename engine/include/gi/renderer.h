@@ -79,9 +79,12 @@ class Renderer {
   std::string graphDescription() const;  // gi-render --print-graph
   std::string graphDot() const;          // Graphviz
   double lastCompileMs() const;          // CPU time of the last graph build + compile
-  // Instance draws the last frame recorded and skipped by frustum culling (all views).
+  // Instance draws the last frame recorded and skipped by frustum culling (all views), and
+  // its shadow maps drawn whole (including a cache being built) and restored from their cache
+  // (only the dynamic casters drawn; RenderSettings::cacheShadows).
   struct DrawCounts {
     uint64_t drawn = 0, culled = 0;
+    uint32_t shadowMapsDrawn = 0, shadowMapsCached = 0;
   };
   DrawCounts lastFrameDraws() const;
 

@@ -18,6 +18,10 @@ std::vector<SettingDesc> engineSettingDescs() {
              "largest image (3 x size <= maxImageDimension2D, e.g. 5461 at 16384)",
              true},
             0, true),
+      {"shadow_cache", SettingType::Bool, d.cacheShadows ? 1.0 : 0.0, 0, 1,
+       "a light that did not move keeps its static casters' depth: each frame redraws only the "
+       "dynamic casters (skinned, morphed, or moved once) over what they cover (the same maps; "
+       "off: every map drawn whole every frame)"},
       {"pcf_radius", SettingType::Int, double(d.pcfRadius), 0, 3,
        "shadow filter: (2r+1)^2 texels per lookup (0: one hard-edged tap)"},
       hints({"exposure", SettingType::Float, double(d.exposure), 1e-3, 1e3,
@@ -38,6 +42,7 @@ SettingValues engineSettingsOf(const RenderSettings& s) {
   SettingValues v(kEngineSettingsOwner, engineSettingDescs());
   const std::string origin = "RenderSettings";
   v.set("shadow_map_size", s.shadowMapSize, origin);
+  v.set("shadow_cache", s.cacheShadows, origin);
   v.set("pcf_radius", s.pcfRadius, origin);
   v.set("exposure", double(s.exposure), origin);
   v.set("environment_intensity", double(s.environmentIntensity), origin);
@@ -51,6 +56,7 @@ void applyEngineSettings(const SettingValues& v, RenderSettings& s) {
     throw Error(ErrorKind::InvalidData, "",
                 "applyEngineSettings: got the settings of '" + v.owner() + "', not the engine's");
   s.shadowMapSize = uint32_t(v.integer("shadow_map_size"));
+  s.cacheShadows = v.flag("shadow_cache");
   s.pcfRadius = uint32_t(v.integer("pcf_radius"));
   s.exposure = float(v.number("exposure"));
   s.environmentIntensity = float(v.number("environment_intensity"));

@@ -148,6 +148,21 @@ LightSetup planLights(const Scene& scene, const std::vector<Node>& nodes, const 
   return out;
 }
 
+void ShadowFitBounds::update(const glm::vec3& lo, const glm::vec3& hi) {
+  const bool inside =
+      glm::all(glm::greaterThanEqual(lo, lo_)) && glm::all(glm::lessThanEqual(hi, hi_));
+  const bool shrunk = glm::any(glm::lessThan(2.0f * (hi - lo), hi_ - lo_));
+  if (!fitted_) {
+    lo_ = lo;
+    hi_ = hi;
+  } else if (!inside || shrunk) {
+    const glm::vec3 margin = 0.125f * (hi - lo);
+    lo_ = lo - margin;
+    hi_ = hi + margin;
+  }
+  fitted_ = true;
+}
+
 void checkLightLimits(const LightSetup& next, const VkPhysicalDeviceLimits& limits) {
   auto refuse = [](const std::string& message) {
     throw Error(ErrorKind::Unsupported, "", message);

@@ -43,6 +43,22 @@ LightSetup planLights(const Scene& scene, const std::vector<Node>& nodes, const 
                       const glm::vec3& boundsMin, const glm::vec3& boundsMax,
                       uint32_t shadowMapSize);
 
+// The box the shadow maps are fitted to: the posed geometry's bounds, kept while the geometry
+// stays inside them, so that objects moving within the scene leave the still lights' views (and
+// their cached maps) alone. When the geometry leaves the box, or has shrunk below half of it
+// along an axis, the box is refitted with a margin of 1/8 of its size on each side. A scene
+// that never moves keeps its exact bounds.
+class ShadowFitBounds {
+ public:
+  void update(const glm::vec3& lo, const glm::vec3& hi);
+  const glm::vec3& min() const { return lo_; }
+  const glm::vec3& max() const { return hi_; }
+
+ private:
+  bool fitted_ = false;
+  glm::vec3 lo_{0.0f}, hi_{0.0f};
+};
+
 // Throws gi::Error (Unsupported) naming the limit `setup` exceeds: the engine's (kMaxLights
 // records, kMaxShadowViews views) or the device's (a shadow-map layer's size, the layer count).
 void checkLightLimits(const LightSetup& setup, const VkPhysicalDeviceLimits& limits);

@@ -91,6 +91,7 @@ struct Renderer::Impl : EffectContext {
 
   FrameGraph graph;
   bool graphDirty = true, recompiledByLastChange = false;
+  ShadowFitBounds shadowFit;
   double compileMs = 0.0;
   DescriptorArena descriptors;
   std::unique_ptr<GpuTimer> timer;  // sized to the compiled graph
@@ -237,8 +238,9 @@ struct Renderer::Impl : EffectContext {
   void updateLights() {
     glm::vec3 lo, hi;
     sceneGpu->bounds(lo, hi);
-    LightSetup next =
-        planLights(source, sceneGpu->pose().nodes, cameraView, lo, hi, settings.shadowMapSize);
+    shadowFit.update(lo, hi);
+    LightSetup next = planLights(source, sceneGpu->pose().nodes, cameraView, shadowFit.min(),
+                                 shadowFit.max(), settings.shadowMapSize);
     checkLightLimits(next, ctx.properties().limits);
     if (!next.sameLayout(lightSetup)) graphDirty = true;
     lightBuffers->upload(next);
@@ -465,6 +467,7 @@ struct Renderer::Impl : EffectContext {
     if (graphDirty) buildGraph();
     sceneGpu->setCulling(settings.cullDraws);
     sceneGpu->beginFrame();
+    state->shadowMapsDrawn = state->shadowMapsCached = 0;
     updateFrameUniforms();
     for (ActiveEffect& a : effects)
       guarded(a.info.name, "update()", [&] { a.effect->update(*this, a.settings); });
@@ -720,7 +723,7 @@ std::string Renderer::graphDot() const {
 }
 Renderer::DrawCounts Renderer::lastFrameDraws() const {
   const SceneGpu::DrawCounts c = impl_->sceneGpu->drawCounts();
-  return {c.drawn, c.culled};
+  return {c.drawn, c.culled, impl_->state->shadowMapsDrawn, impl_->state->shadowMapsCached};
 }
 double Renderer::lastCompileMs() const {
   return impl_->compileMs;

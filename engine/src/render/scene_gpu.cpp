@@ -227,6 +227,7 @@ void SceneGpu::upload() {
                         uint32_t(instances_.size()), materialIndex});
       instances_.push_back(inst);
       instanceNodes_.push_back(int(n));
+      dynamic_.push_back(skinned || morphed ? 1 : 0);
     }
   }
   // Keep buffers non-empty so descriptors stay valid for an empty scene.
@@ -359,7 +360,13 @@ void SceneGpu::setTime(double seconds) {
   for (size_t i = 0; i < instanceNodes_.size(); ++i) {
     GpuInstance& inst = instances_[i];
     const glm::mat4& world = pose_.nodes[instanceNodes_[i]].world;
-    if (inst.model != world) ++poseVersion_;
+    if (inst.model != world) {
+      ++poseVersion_;
+      if (!dynamic_[i]) {
+        dynamic_[i] = 1;
+        ++staticVersion_;
+      }
+    }
     inst.model = world;
     inst.normalMatrix = glm::mat4(cofactor3(world));
   }
@@ -663,6 +670,19 @@ void SceneGpu::setViewport(VkCommandBuffer cmd, const SceneView& view, VkExtent2
 }
 
 void SceneGpu::drawDepth(PassContext& pc, const SceneTargets& t, std::span<const SceneView> views) {
+  drawDepth(pc, t, views, Subset::All);
+}
+
+std::vector<SceneGpu::Box> SceneGpu::dynamicBoxes() {
+  std::vector<Box> boxes;
+  const std::vector<Box>& all = instanceBoxes();
+  for (size_t i = 0; i < all.size() && i < dynamic_.size(); ++i)
+    if (dynamic_[i]) boxes.push_back(all[i]);
+  return boxes;
+}
+
+void SceneGpu::drawDepth(PassContext& pc, const SceneTargets& t, std::span<const SceneView> views,
+                         Subset subset) {
   VkCommandBuffer c = pc.cmd();
   beginRendering(pc, t, 0);
   if (!draws_.empty()) bindGeometry(c);
@@ -675,6 +695,7 @@ void SceneGpu::drawDepth(PassContext& pc, const SceneTargets& t, std::span<const
     const glm::mat4 clip = v.proj * v.view;
     const glm::mat4* cull = v.projection == Projection::Paraboloid ? nullptr : &clip;
     for (const SceneDrawItem& d : draws_) {
+      if (subset != Subset::All && isDynamic(d.instance) != (subset == Subset::Dynamic)) continue;
       if (!inView(d, cull)) continue;
       pushDraw(c, depthPipeline_, d, true);
       vkCmdDrawIndexed(c, d.indexCount, 1, d.firstIndex, d.vertexOffset, 0);

@@ -64,6 +64,21 @@ class SceneGpu final : public GpuScene {
   };
   DrawCounts drawCounts() const { return counts_; }
 
+  // Which instances may change from frame to frame (for caches of what the others look like,
+  // e.g. shadow maps of static casters). Skinned and morphed instances are dynamic from the
+  // start; any other instance becomes dynamic the first time its matrix changes and stays so.
+  // That change bumps staticVersion(): whatever was drawn of the static instances before is
+  // out of date in the same frame.
+  bool isDynamic(uint32_t instance) const { return dynamic_[instance] != 0; }
+  uint64_t staticVersion() const { return staticVersion_; }
+  using Box = std::pair<glm::vec3, glm::vec3>;
+  // World boxes of the dynamic instances in the current pose.
+  std::vector<Box> dynamicBoxes();
+  // drawDepth restricted to the static or the dynamic instances (targets.clear as given).
+  enum class Subset { All, Static, Dynamic };
+  void drawDepth(PassContext& pc, const SceneTargets& targets, std::span<const SceneView> views,
+                 Subset subset);
+
   // Skinned/morphed mesh instances: each owns a copy of its mesh's vertices in the vertex
   // buffer, rewritten by the skinning pass from its rest vertices.
   struct Deformed {
@@ -87,7 +102,6 @@ class SceneGpu final : public GpuScene {
   void updateDeformations();
   void createPipelines();
   const std::pair<glm::vec3, glm::vec3>& morphDeltaBounds(int mesh, size_t target) const;
-  using Box = std::pair<glm::vec3, glm::vec3>;
   // World box of `mesh` at `node` in the current pose (morph targets and joints included).
   Box instanceBox(size_t node, int mesh) const;
   // Each instance's box, recomputed when the pose changed.
@@ -114,6 +128,8 @@ class SceneGpu final : public GpuScene {
   std::vector<int> instanceNodes_;  // node of each GpuInstance
   std::vector<GpuInstance> instances_;
   std::vector<glm::mat4> rendered_;  // model matrices of the last rendered frame
+  std::vector<uint8_t> dynamic_;     // per instance: see isDynamic()
+  uint64_t staticVersion_ = 1;
   bool instancesDirty_ = true;
   uint64_t poseVersion_ = 1;
   std::vector<Deformed> deformed_;

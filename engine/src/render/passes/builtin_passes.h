@@ -30,6 +30,8 @@ struct EngineState {
   vk::Image& output;  // the tonemapped RGBA8 image (imported as "output")
   VkSampler nearest, linear;
   uint32_t skinnedThisFrame = 0;  // written by the skinning pass
+  // Shadow maps this frame drawn whole (or their cache built) and restored from their cache.
+  uint32_t shadowMapsDrawn = 0, shadowMapsCached = 0;
 };
 
 std::unique_ptr<Effect> makeSkinningPass(EngineState& state);

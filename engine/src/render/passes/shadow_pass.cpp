@@ -2,19 +2,33 @@
 // through GpuScene into its own layer of "shadow_maps" (D32 reverse-Z 2-D array; a point light's
 // six faces share its layer as a 3x2 atlas). Without shadowed lights "shadow_maps" is the
 // engine's 1x1 array cleared to "no occluder". Only readers keep these passes alive.
+//
+// The maps persist across frames and cost only what changed (RenderSettings::cacheShadows):
+// while a light's views and the static casters stay the same, its map's static depth lives in
+// a cache image; a frame copies back the texels the dynamic casters covered last time or cover
+// now and draws only the dynamic casters over them. A light whose views changed since the last
+// frame (it moves) is drawn whole, as without the cache; its cache is built the first frame it
+// stands still. Each frame's maps are the same, bit for bit, as drawing everything.
+#include <optional>
+
 #include "gi/vk/common.h"
 #include "render/passes/builtin_passes.h"
+#include "render/shadow_cache.h"
 
 namespace gi {
 namespace {
 
 namespace res = resources;
 
-// "shadow_maps" when no light casts shadows: one 1x1 layer cleared to 0 (reverse-Z: nothing).
-vk::Image makeNoShadowsImage(vk::Context& ctx) {
+// A D32 2-D array cleared to 0 (reverse-Z: no occluder), left SHADER_READ_ONLY_OPTIMAL.
+vk::Image makeDepthArray(vk::Context& ctx, uint32_t width, uint32_t height, uint32_t layers,
+                         VkImageUsageFlags usage) {
   vk::ImageDesc d;
-  d.format = VK_FORMAT_D32_SFLOAT;
-  d.usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT |
+  d.format = kSceneDepthFormat;
+  d.width = width;
+  d.height = height;
+  d.layers = layers;
+  d.usage = usage | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT |
             VK_IMAGE_USAGE_TRANSFER_SRC_BIT;  // readTarget("shadow_maps") copies from it
   d.viewType = VK_IMAGE_VIEW_TYPE_2D_ARRAY;
   vk::Image img(ctx, d);
@@ -23,7 +37,7 @@ vk::Image makeNoShadowsImage(vk::Context& ctx) {
                      VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_PIPELINE_STAGE_2_NONE, 0,
                      VK_PIPELINE_STAGE_2_CLEAR_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
     VkClearDepthStencilValue zero{0.0f, 0};
-    VkImageSubresourceRange range{VK_IMAGE_ASPECT_DEPTH_BIT, 0, 1, 0, 1};
+    VkImageSubresourceRange range{VK_IMAGE_ASPECT_DEPTH_BIT, 0, 1, 0, layers};
     vkCmdClearDepthStencilImage(c, img.handle(), VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &zero, 1,
                                 &range);
     vk::imageBarrier(c, img.handle(), VK_IMAGE_ASPECT_DEPTH_BIT,
@@ -32,6 +46,42 @@ vk::Image makeNoShadowsImage(vk::Context& ctx) {
                      VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, VK_ACCESS_2_SHADER_SAMPLED_READ_BIT);
   });
   return img;
+}
+
+constexpr VkPipelineStageFlags2 kDepthStages =
+    VK_PIPELINE_STAGE_2_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_2_LATE_FRAGMENT_TESTS_BIT;
+constexpr VkAccessFlags2 kDepthAccess =
+    VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT;
+
+// One layer's layout change inside a pass (the graph syncs the pass as a whole).
+void layerBarrier(VkCommandBuffer c, VkImage image, uint32_t layer, VkImageLayout from,
+                  VkImageLayout to, VkPipelineStageFlags2 srcStage, VkAccessFlags2 srcAccess,
+                  VkPipelineStageFlags2 dstStage, VkAccessFlags2 dstAccess) {
+  VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
+  b.srcStageMask = srcStage;
+  b.srcAccessMask = srcAccess;
+  b.dstStageMask = dstStage;
+  b.dstAccessMask = dstAccess;
+  b.oldLayout = from;
+  b.newLayout = to;
+  b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+  b.image = image;
+  b.subresourceRange = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 1, layer, 1};
+  VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
+  dep.imageMemoryBarrierCount = 1;
+  dep.pImageMemoryBarriers = &b;
+  vkCmdPipelineBarrier2(c, &dep);
+}
+
+std::vector<SceneView> sceneViews(const ShadowMap& map) {
+  std::vector<SceneView> views;
+  for (const ShadowMap::View& v : map.views) {
+    SceneView sv;
+    sv.proj = v.viewProj;  // world -> clip as one matrix
+    sv.viewport = v.rect;
+    views.push_back(sv);
+  }
+  return views;
 }
 
 class ShadowPass final : public Effect {
@@ -44,55 +94,156 @@ class ShadowPass final : public Effect {
   }
   std::vector<SettingDesc> settings() const override { return {}; }
   void prepare(EffectContext& ctx, const SettingValues&) override {
-    if (!noShadows_) noShadows_ = makeNoShadowsImage(ctx.vulkan());
+    if (!noShadows_) noShadows_ = makeDepthArray(ctx.vulkan(), 1, 1, 1, 0);
   }
   void addPasses(FrameGraph& graph, EffectContext& ctx, const SettingValues&) override {
     const LightSetup& setup = s_.lights;
-    if (setup.maps.empty()) {
-      TextureDesc desc{kSceneDepthFormat, SizeClass::Absolute, 1.0f, 1, 1};
-      desc.type = TextureType::Tex2DArray;
-      graph.blackboard().put(
-          res::kShadowMaps,
-          graph.importTexture(res::kShadowMaps, noShadows_.handle(), noShadows_.view(), desc,
-                              VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL));
-      return;
-    }
-    TextureDesc desc{kSceneDepthFormat, SizeClass::Absolute, 1.0f, setup.layerWidth(),
-                     setup.layerHeight()};
+    const bool none = setup.maps.empty();
+    const vk::Image& image = none ? noShadows_ : mapsFor(ctx.vulkan(), setup);
+    TextureDesc desc{kSceneDepthFormat, SizeClass::Absolute, 1.0f, image.desc().width,
+                     image.desc().height};
     desc.type = TextureType::Tex2DArray;
-    desc.layers = uint32_t(setup.maps.size());
-    TextureHandle maps;
+    desc.layers = image.desc().layers;
+    TextureHandle maps = graph.importTexture(res::kShadowMaps, image.handle(), image.view(), desc,
+                                             VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                                             VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
     GpuScene& scene = ctx.scene();
-    for (uint32_t slot = 0; slot < setup.maps.size(); ++slot) {
+    for (uint32_t slot = 0; !none && slot < setup.maps.size(); ++slot) {
       auto io = std::make_shared<TextureHandle>();
       graph.addPass(
           "shadow_" + std::to_string(setup.maps[slot].light),
           [&](PassBuilder& b) {
             scene.declareRead(b);
-            if (!maps.valid()) maps = b.create(res::kShadowMaps, desc);
             *io = maps = b.write(maps, TextureUsage::DepthAttachment, Subresource::layerOf(slot));
           },
-          [this, io, slot, &scene](PassContext& pc) {
-            const ShadowMap& map = s_.lights.maps[slot];
-            std::vector<SceneView> views;
-            for (const ShadowMap::View& v : map.views) {
-              SceneView sv;
-              sv.proj = v.viewProj;  // world -> clip as one matrix
-              sv.viewport = v.rect;
-              views.push_back(sv);
-            }
-            SceneTargets t;
-            t.depth = pc.view(*io, Subresource::layerOf(slot));
-            t.extent = pc.extent(*io);
-            scene.drawDepth(pc, t, views);
-          });
+          [this, io, slot](PassContext& pc) { record(pc, slot, *io); });
     }
     graph.blackboard().put(res::kShadowMaps, maps);
   }
 
  private:
+  // What a layer of the maps and its cache hold.
+  struct Slot {
+    std::optional<ShadowMap> drawn;  // the views the layer was last drawn with
+    uint64_t staticVersion = 0;      // SceneGpu::staticVersion() then
+    vk::Image cache;                 // static casters' depth (map.width x map.height), or none
+    bool cached = false;             // `cache` holds `drawn`'s static depth
+    std::vector<std::optional<VkRect2D>> dynamicTexels;  // per view, last drawn
+  };
+
+  // The persistent maps for this layout: recreated (and every cache dropped) when it changes.
+  const vk::Image& mapsFor(vk::Context& ctx, const LightSetup& setup) {
+    const uint32_t w = setup.layerWidth(), h = setup.layerHeight(),
+                   layers = uint32_t(setup.maps.size());
+    if (!maps_ || maps_.desc().width != w || maps_.desc().height != h ||
+        maps_.desc().layers != layers) {
+      maps_ = makeDepthArray(ctx, w, h, layers, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT);
+      slots_.clear();
+    }
+    slots_.resize(layers);
+    return maps_;
+  }
+
+  void record(PassContext& pc, uint32_t index, TextureHandle maps) {
+    SceneGpu& scene = s_.scene;
+    const ShadowMap& map = s_.lights.maps[index];
+    Slot& slot = slots_[index];
+    const std::vector<SceneView> views = sceneViews(map);
+    SceneTargets layer;
+    layer.depth = pc.view(maps, Subresource::layerOf(index));
+    layer.extent = pc.extent(maps);
+    const bool unchanged = slot.drawn && shadow_cache::sameViews(*slot.drawn, map) &&
+                           slot.staticVersion == scene.staticVersion();
+    const bool useCache = s_.settings.cacheShadows && unchanged;
+    slot.drawn = map;
+    slot.staticVersion = scene.staticVersion();
+    if (!useCache) {  // the light moved, the static casters changed, or no caching: all of it
+      slot.cached = false;
+      slot.dynamicTexels.assign(views.size(), std::nullopt);
+      scene.drawDepth(pc, layer, views);
+      ++s_.shadowMapsDrawn;
+      return;
+    }
+    VkCommandBuffer c = pc.cmd();
+    // Texels to restore from the cache: the whole map when the cache is built now, else the
+    // dynamic casters' last and current texels.
+    std::vector<VkImageCopy> copies;
+    const std::vector<shadow_cache::Box> dynamic = scene.dynamicBoxes();
+    std::vector<SceneView> dynamicViews;
+    for (size_t v = 0; v < views.size(); ++v) {
+      const std::optional<VkRect2D> now =
+          shadow_cache::coveredTexels(map.views[v].viewProj, map.views[v].rect, dynamic);
+      const std::optional<VkRect2D> restore = shadow_cache::unite(now, slot.dynamicTexels[v]);
+      slot.dynamicTexels[v] = now;
+      if (now) dynamicViews.push_back(views[v]);
+      if (!restore || !slot.cached) continue;
+      VkImageCopy copy{};
+      copy.srcSubresource = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 0, 1};
+      copy.dstSubresource = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, index, 1};
+      copy.srcOffset = copy.dstOffset = {restore->offset.x, restore->offset.y, 0};
+      copy.extent = {restore->extent.width, restore->extent.height, 1};
+      copies.push_back(copy);
+    }
+    if (!slot.cached) {
+      buildCache(pc, slot, map, views);
+      VkImageCopy copy{};
+      copy.srcSubresource = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 0, 1};
+      copy.dstSubresource = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, index, 1};
+      copy.extent = {map.width, map.height, 1};
+      copies = {copy};
+      ++s_.shadowMapsDrawn;
+    } else {
+      ++s_.shadowMapsCached;
+    }
+    if (!copies.empty()) {
+      layerBarrier(c, maps_.handle(), index, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL,
+                   VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, kDepthStages, kDepthAccess,
+                   VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_WRITE_BIT);
+      vkCmdCopyImage(c, slot.cache.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, maps_.handle(),
+                     VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, uint32_t(copies.size()), copies.data());
+      layerBarrier(c, maps_.handle(), index, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                   VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_COPY_BIT,
+                   VK_ACCESS_2_TRANSFER_WRITE_BIT, kDepthStages, kDepthAccess);
+    }
+    if (!dynamicViews.empty()) {
+      layer.clear = false;
+      scene.drawDepth(pc, layer, dynamicViews, SceneGpu::Subset::Dynamic);
+    }
+  }
+
+  // Draws the static casters into the slot's cache (made on first use), left TRANSFER_SRC.
+  void buildCache(PassContext& pc, Slot& slot, const ShadowMap& map,
+                  const std::vector<SceneView>& views) {
+    VkCommandBuffer c = pc.cmd();
+    VkImageLayout from = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+    if (!slot.cache || slot.cache.desc().width != map.width ||
+        slot.cache.desc().height != map.height) {
+      vk::ImageDesc d;
+      d.format = kSceneDepthFormat;
+      d.width = map.width;
+      d.height = map.height;
+      d.usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+      slot.cache = vk::Image(pc.context(), d);
+      from = VK_IMAGE_LAYOUT_UNDEFINED;
+    }
+    vk::imageBarrier(c, slot.cache.handle(), VK_IMAGE_ASPECT_DEPTH_BIT, from,
+                     VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_2_COPY_BIT, 0,
+                     kDepthStages, kDepthAccess);
+    SceneTargets t;
+    t.depth = slot.cache.view();
+    t.extent = {map.width, map.height};
+    s_.scene.drawDepth(pc, t, views, SceneGpu::Subset::Static);
+    vk::imageBarrier(c, slot.cache.handle(), VK_IMAGE_ASPECT_DEPTH_BIT,
+                     VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                     kDepthStages, VK_ACCESS_2_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+                     VK_PIPELINE_STAGE_2_COPY_BIT, VK_ACCESS_2_TRANSFER_READ_BIT);
+    slot.cached = true;
+  }
+
   EngineState& s_;
   vk::Image noShadows_;  // 1x1 one-layer D32 array cleared to 0: "shadow_maps" without shadows
+  vk::Image maps_;       // "shadow_maps" when lights cast shadows: one layer per map
+  std::vector<Slot> slots_;
 };
 
 }  // namespace
