@@ -9,8 +9,10 @@
 #include <cstdlib>
 
 #include <array>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <set>
 #include <sstream>
 
@@ -165,6 +167,58 @@ TEST(Demo, WalkingSpeedsAndTheFloor) {
   EXPECT_NEAR(positions[1][2], positions[0][2] - 3 * 8.0 / 30.0, 1e-3) << r.output;
   EXPECT_NEAR(positions[2][0], 6 * 0.5 / 30.0, 1e-3) << r.output;
   EXPECT_NEAR(positions[3][1], -0.5 + 0.3, 1e-4) << "the eye stops 0.3 above --floor";
+}
+
+// At one frame per second (--min-frame-ms 1000), 30 ms taps and a click, each starting and
+// ending between two frames, still act (the input queue): a click on the panel's Pause button
+// pauses the clock, F2 writes a screenshot, Esc quits long before the 30 frames asked for. The
+// clock follows wall time: paused after a few one-second frames, it reads seconds, not the
+// tenths that a per-frame step cap of 0.1 s gave.
+TEST(Demo, QuickTapsAndAClickActAtOneFramePerSecond) {
+  REQUIRE_DEMO();
+  if (test::runCommand("command -v xdotool").exitCode != 0)
+    GTEST_SKIP() << "xdotool not installed (Debian package xdotool): skipping";
+  const std::string dir = test::makeTempDir("demo_input");
+  const std::string log = dir + "/log", script = dir + "/input.sh";
+  // Inside the virtual X session: start the demo, wait for its first panel, then act.
+  std::ofstream(script) << "\"$@\" > '" << log << R"(' 2>&1 &
+pid=$!
+for i in $(seq 1 900); do grep -q 'widget pause:' ')"
+                        << log << R"(' && break; sleep 0.1; done
+set -- $(grep 'widget pause:' ')"
+                        << log << R"(' | head -n 1 | sed 's/widget pause: //')
+xdotool mousemove --sync $(($1 + $3 / 2)) $(($2 + $4 / 2))
+sleep 1.5
+xdotool mousedown 1; sleep 0.03; xdotool mouseup 1
+sleep 2.5
+xdotool keydown F2; sleep 0.03; xdotool keyup F2
+sleep 2.5
+xdotool keydown Escape; sleep 0.03; xdotool keyup Escape
+wait $pid
+echo "exit $?" >> ')" << log
+                        << "'\n";
+  const auto start = std::chrono::steady_clock::now();
+  const test::ProcessResult r = test::runCommand(
+      "xvfb-run -a -s '-screen 0 640x480x24' sh '" + script + "' " + test::binPath("gi-demo") +
+      " --validation --scene default --effects none" + kSize +
+      " --min-frame-ms 1000 --frames 30 --print-widgets --out-dir '" + dir + "'");
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::ifstream in(log);
+  const std::string out((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_EQ(r.exitCode, 0) << r.output << out;
+  EXPECT_NE(out.find("exit 0"), std::string::npos) << out;
+  EXPECT_EQ(out.find("validation"), std::string::npos) << out;
+  const size_t paused = out.find("clock paused at t = ");
+  ASSERT_NE(paused, std::string::npos) << "the click on Pause was lost:\n" << out;
+  const double t = std::atof(out.c_str() + paused + 20);
+  EXPECT_GE(t, 1.0) << "the clock does not follow wall time:\n" << out;
+  EXPECT_LE(t, 10.0) << out;
+  EXPECT_NE(out.find("wrote " + dir + "/gi-demo-1.png"), std::string::npos)
+      << "the F2 tap was lost:\n"
+      << out;
+  EXPECT_TRUE(std::filesystem::exists(dir + "/gi-demo-1.png"));
+  EXPECT_LT(seconds, 25.0) << "the Esc tap was lost (the demo ran its 30 frames):\n" << out;
 }
 
 TEST(Demo, EveryViewOfTheSelectorShows) {

@@ -13,6 +13,7 @@ GI_PACKAGES=(
   libstb-dev libembree-dev libgtest-dev libbenchmark-dev clang-format clang-tidy
   assimp-testmodels python3  # python3: the external-effect test checks images with it
   xvfb xauth  # test_window runs gi-render --window on a virtual X server
+  xdotool     # test_demo taps keys and clicks in gi-demo's window under it
   clang-14 libclang-rt-14-dev  # tools/fuzz: libFuzzer (the fuzz_smoke test)
 )
 

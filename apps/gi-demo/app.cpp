@@ -37,7 +37,7 @@ struct App::ImguiContext {
     ImGui::CreateContext();
     ImGui::GetIO().IniFilename = nullptr;  // no imgui.ini left in the working directory
     ImGui::StyleColorsDark();
-    ImGui_ImplGlfw_InitForVulkan(window, true);
+    ImGui_ImplGlfw_InitForVulkan(window, false);  // InputQueue takes the window's input
   }
   ~ImguiContext() {
     ImGui_ImplGlfw_Shutdown();
@@ -69,6 +69,7 @@ App::App(const AppOptions& o) : options_(o) {
   if (w > 0 && h > 0) co.width = uint32_t(w), co.height = uint32_t(h);
   controller_ = std::make_unique<Controller>(*ctx_, scene_, registry_, co);
   imgui_ = std::make_unique<ImguiContext>(window_->handle());
+  input_ = std::make_unique<InputQueue>(window_->handle());
   presenter_ = std::make_unique<Presenter>(*ctx_, window_->handle());
 
   glm::vec3 lo, hi;
@@ -76,12 +77,13 @@ App::App(const AppOptions& o) : options_(o) {
   camera_ = std::make_unique<FreeCamera>(controller_->renderer().camera(), o.floor.value_or(lo.y));
   state_.time = o.time;
   state_.paused = o.paused;
-  glfwGetCursorPos(window_->handle(), &lastX_, &lastY_);
+  lastX_ = input_->cursorX(), lastY_ = input_->cursorY();
   last_ = lastWatch_ = std::chrono::steady_clock::now();
 }
 
 App::~App() {
   gi::vk::clearShaderOverrides();
+  input_.reset();
   presenter_.reset();  // the Vulkan backend before ImGui's context
   imgui_.reset();
   preview_.reset();
@@ -110,17 +112,15 @@ int App::run() {
 
 CameraInput App::readInput() {
   CameraInput in;
-  GLFWwindow* w = window_->handle();
   const ImGuiIO& io = ImGui::GetIO();
-  double x = 0, y = 0;
-  glfwGetCursorPos(w, &x, &y);
-  if (!io.WantCaptureMouse && glfwGetMouseButton(w, GLFW_MOUSE_BUTTON_RIGHT) == GLFW_PRESS) {
+  const double x = input_->cursorX(), y = input_->cursorY();
+  if (!io.WantCaptureMouse && input_->buttonDown(GLFW_MOUSE_BUTTON_RIGHT)) {
     in.lookX = float(x - lastX_);
     in.lookY = float(y - lastY_);
   }
   lastX_ = x, lastY_ = y;
   if (io.WantCaptureKeyboard) return in;
-  auto down = [&](int key) { return glfwGetKey(w, key) == GLFW_PRESS ? 1.0f : 0.0f; };
+  auto down = [&](int key) { return input_->keyDown(key) ? 1.0f : 0.0f; };
   in.forward = down(GLFW_KEY_W) - down(GLFW_KEY_S);
   in.right = down(GLFW_KEY_D) - down(GLFW_KEY_A);
   in.up = down(GLFW_KEY_E) - down(GLFW_KEY_Q);
@@ -132,7 +132,7 @@ CameraInput App::readInput() {
 // One-shot keys (ImGui 1.86 indexes keys by the GLFW key code).
 void App::handleKeys() {
   if (ImGui::GetIO().WantCaptureKeyboard) return;
-  if (ImGui::IsKeyPressed(GLFW_KEY_P, false)) state_.paused = !state_.paused;
+  if (ImGui::IsKeyPressed(GLFW_KEY_P, false)) togglePause();
   if (ImGui::IsKeyPressed(GLFW_KEY_N)) state_.stepOnce = true;
   if (ImGui::IsKeyPressed(GLFW_KEY_F2, false)) state_.screenshot = true;
   if (ImGui::IsKeyPressed(GLFW_KEY_R, false))
@@ -147,11 +147,23 @@ void App::handleKeys() {
     glfwSetWindowShouldClose(window_->handle(), GLFW_TRUE);
 }
 
+void App::togglePause() {
+  state_.paused = !state_.paused;
+  if (options_.printWidgets) {
+    std::printf("clock %s at t = %.3f s\n", state_.paused ? "paused" : "playing", state_.time);
+    std::fflush(stdout);
+  }
+}
+
 void App::frame() {
   const auto start = std::chrono::steady_clock::now();
-  const double wallDt = std::min(std::chrono::duration<double>(start - last_).count(), 0.1);
+  // Real time: the clock and the camera advance by the wall time since the last frame, however
+  // slow the frames are (a stall of over a second, e.g. a shader rebuilt, counts as one second).
+  const double wallDt = std::min(std::chrono::duration<double>(start - last_).count(), 1.0);
   last_ = start;
   const double dt = script_.empty() ? wallDt : kScriptStep;
+  // This frame's input: the queued events up to the second change of any key or button.
+  if (script_.empty()) input_->apply(ImGui::GetIO());
   // Hot reload: the window checks the shaders and the plugin modules twice a second (a script
   // only on `reload`).
   if (script_.empty() && start - lastWatch_ > std::chrono::milliseconds(500)) {
@@ -195,10 +207,18 @@ void App::frame() {
   const auto uiStart = std::chrono::steady_clock::now();
   ImGui_ImplVulkan_NewFrame();
   ImGui_ImplGlfw_NewFrame();
+  if (script_.empty()) input_->writeTo(ImGui::GetIO());  // over the backend's device state
   ImGui::NewFrame();
   if (script_.empty()) handleKeys();
   drawPanel(*controller_, stats_, state_, *camera_, accuracy_);
   drawHelp(state_);
+  if (state_.togglePause) togglePause();
+  state_.togglePause = false;
+  if (options_.printWidgets && state_.panel && state_.pauseButton != pauseButtonPrinted_) {
+    const auto& b = pauseButtonPrinted_ = state_.pauseButton;
+    std::printf("widget pause: %.0f %.0f %.0f %.0f\n", b[0], b[1], b[2], b[3]);
+    std::fflush(stdout);
+  }
   ImGui::Render();
   stats_.uiCpuMs = ms(std::chrono::steady_clock::now() - uiStart);
 
@@ -263,6 +283,8 @@ void App::frame() {
   timingGpu_.push_back(gpu);
   timingUiCpu_.push_back(stats_.uiCpuMs);
   timingUiGpu_.push_back(std::max(stats_.uiGpuMs, 0.0));
+  if (options_.minFrameMs > 0)
+    std::this_thread::sleep_until(start + std::chrono::milliseconds(options_.minFrameMs));
 }
 
 void App::screenshot(const std::string& path) {

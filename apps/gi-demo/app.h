@@ -3,6 +3,7 @@
 // through the Controller and the same few methods here.
 #pragma once
 
+#include <array>
 #include <chrono>
 #include <memory>
 #include <optional>
@@ -13,6 +14,7 @@
 #include "controller.h"
 #include "free_camera.h"
 #include "gi/vk/resources.h"
+#include "input_queue.h"
 #include "module_watcher.h"
 #include "panel.h"
 #include "presenter.h"
@@ -31,6 +33,12 @@ struct AppOptions {
   bool paused = false;
   std::optional<float> floor;  // default: the lowest point of the scene
   std::string shaderDir;       // hot reload reads a shader file of this name from here if present
+  // Each frame lasts at least this long (the rest is slept): a slow device's frame rate, to try
+  // the controls at it (the input queue keeps quick taps and clicks).
+  int minFrameMs = 0;
+  // Prints where the panel's Pause button is each frame it moved ("widget pause: x y w h"),
+  // and the clock's pause and play: what a test that clicks in the window needs.
+  bool printWidgets = false;
 };
 
 class App {
@@ -46,6 +54,7 @@ class App {
   bool advanceScript();  // false once the script has ended
   void execute(const ScriptStep& step);
   CameraInput readInput();
+  void togglePause();  // the clock (P, the panel's button), said with --print-widgets
   void handleKeys();
   void screenshot(const std::string& path);
   void resizeWindow(int width, int height);
@@ -80,6 +89,8 @@ class App {
   float lookX_ = 0, lookY_ = 0;
   bool cameraMoved_ = false;
   double lastX_ = 0, lastY_ = 0;
+  std::unique_ptr<InputQueue> input_;
+  std::array<float, 4> pauseButtonPrinted_{};
   std::chrono::steady_clock::time_point last_;
 };
 

@@ -24,6 +24,9 @@ const char* kUsage =
     "  --frames N             exit after N frames (without --script)\n"
     "  --out-dir DIR          where the screenshot key writes (default out)\n"
     "  --shader-dir DIR       hot reload reads an effect's shader file from DIR when it has one\n"
+    "  --min-frame-ms N       each frame lasts at least N ms (a slow device's rate, to try the\n"
+    "                         controls at it)\n"
+    "  --print-widgets        print where the Pause button is and when the clock pauses/plays\n"
     "                         of that name (default: the source tree's file)\n"
     "  --validation           enable Vulkan validation layers (also GI_VALIDATION=1)\n"
     "  --device NAME          pick the Vulkan device by name or index (also GI_DEVICE)\n"
@@ -54,6 +57,10 @@ demo::AppOptions parseArgs(int argc, char** argv) {
       o.outDir = a.value();
     else if (a.is("--shader-dir"))
       o.shaderDir = a.value();
+    else if (a.is("--min-frame-ms"))
+      o.minFrameMs = int(a.integer(0, 60000));
+    else if (a.is("--print-widgets"))
+      o.printWidgets = true;
     else
       a.unknown();
   }

@@ -179,7 +179,9 @@ void drawPanel(Controller& controller, const FrameStats& stats, DemoState& state
 
   ImGui::Text("t = %.2f s %s", state.time, state.paused ? "(paused)" : "");
   ImGui::SameLine();
-  if (ImGui::Button(state.paused ? "Play" : "Pause")) state.paused = !state.paused;
+  if (ImGui::Button(state.paused ? "Play" : "Pause")) state.togglePause = true;
+  const ImVec2 at = ImGui::GetItemRectMin(), size = ImGui::GetItemRectSize();
+  state.pauseButton = {at.x, at.y, size.x, size.y};
   ImGui::SameLine();
   if (ImGui::Button("Step")) state.stepOnce = true;
   ImGui::SameLine();

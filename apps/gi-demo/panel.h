@@ -4,6 +4,7 @@
 // culled passes. No effect is named here. Every change goes through the Controller.
 #pragma once
 
+#include <array>
 #include <deque>
 #include <string>
 #include <vector>
@@ -29,7 +30,9 @@ struct DemoState {
   std::string message;          // last screenshot path or similar
   std::string accuracyRequest;  // an effect whose accuracy check the user asked for
   int accuracySpp = 64;
-  bool showError = false;  // show the last accuracy check's error image
+  bool showError = false;              // show the last accuracy check's error image
+  bool togglePause = false;            // the panel's Pause/Play button was pressed
+  std::array<float, 4> pauseButton{};  // where it is: x, y, width, height (window pixels)
 };
 
 void drawPanel(Controller& controller, const FrameStats& stats, DemoState& state,
