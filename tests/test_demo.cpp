@@ -174,6 +174,21 @@ TEST(Demo, WalkingSpeedsAndTheFloor) {
 // pauses the clock, F2 writes a screenshot, Esc quits long before the 30 frames asked for. The
 // clock follows wall time: paused after a few one-second frames, it reads seconds, not the
 // tenths that a per-frame step cap of 0.1 s gave.
+// Dynamic resolution: with a budget no frame can meet, the render drops to a quarter of the
+// window's size (the smallest scale) within a few frames; without one it stays at the window's.
+TEST(Demo, AFrameBudgetScalesTheRender) {
+  REQUIRE_DEMO();
+  const std::string dir = test::makeTempDir("demo_budget");
+  const std::string script = writeScript(dir, "frames 20\nprint timings\n");
+  auto tight = runDemo(" --scene default --effects none" + kSize +
+                       " --frame-budget-ms 0.5 --script " + script);
+  ASSERT_EQ(tight.exitCode, 0) << tight.output;
+  EXPECT_NE(tight.output.find("frames at 40x30"), std::string::npos) << tight.output;
+  auto off = runDemo(" --scene default --effects none" + kSize + " --script " + script);
+  ASSERT_EQ(off.exitCode, 0) << off.output;
+  EXPECT_NE(off.output.find("frames at 160x120"), std::string::npos) << off.output;
+}
+
 TEST(Demo, QuickTapsAndAClickActAtOneFramePerSecond) {
   REQUIRE_DEMO();
   if (test::runCommand("command -v xdotool").exitCode != 0)

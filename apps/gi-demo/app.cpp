@@ -6,6 +6,7 @@
 #include <imgui_impl_vulkan.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
@@ -77,6 +78,7 @@ App::App(const AppOptions& o) : options_(o) {
   camera_ = std::make_unique<FreeCamera>(controller_->renderer().camera(), o.floor.value_or(lo.y));
   state_.time = o.time;
   state_.paused = o.paused;
+  state_.frameBudgetMs = float(o.frameBudgetMs);
   lastX_ = input_->cursorX(), lastY_ = input_->cursorY();
   last_ = lastWatch_ = std::chrono::steady_clock::now();
 }
@@ -173,12 +175,20 @@ void App::frame() {
   }
   gi::Renderer& renderer = controller_->renderer();
 
-  // The renderer follows the window's size.
+  // The renderer follows the window's size, times the dynamic resolution's scale (the
+  // swapchain's blit stretches the image to the window).
+  if (resolution_.options().budgetMs != double(state_.frameBudgetMs)) {
+    gi::DynamicResolution::Options o = resolution_.options();
+    o.budgetMs = state_.frameBudgetMs;
+    resolution_.setOptions(o);
+  }
+  state_.renderScale = resolution_.scale();
   int w = 0, h = 0;
   glfwGetFramebufferSize(window_->handle(), &w, &h);
   const VkExtent2D size = renderer.outputExtent();
-  if (w > 0 && h > 0 && (uint32_t(w) != size.width || uint32_t(h) != size.height))
-    controller_->resize(uint32_t(w), uint32_t(h));
+  const uint32_t rw = std::max(16u, uint32_t(std::lround(w * state_.renderScale)));
+  const uint32_t rh = std::max(16u, uint32_t(std::lround(h * state_.renderScale)));
+  if (w > 0 && h > 0 && (rw != size.width || rh != size.height)) controller_->resize(rw, rh);
 
   CameraInput input = script_.empty() ? readInput() : held_;
   input.lookX += lookX_;
@@ -285,6 +295,8 @@ void App::frame() {
   timingUiGpu_.push_back(std::max(stats_.uiGpuMs, 0.0));
   if (options_.minFrameMs > 0)
     std::this_thread::sleep_until(start + std::chrono::milliseconds(options_.minFrameMs));
+  // The displayed frame's time picks the next frames' render scale.
+  resolution_.update(ms(std::chrono::steady_clock::now() - start));
 }
 
 void App::screenshot(const std::string& path) {

@@ -13,6 +13,7 @@
 #include "accuracy.h"
 #include "controller.h"
 #include "free_camera.h"
+#include "gi/dynamic_resolution.h"
 #include "gi/vk/resources.h"
 #include "input_queue.h"
 #include "module_watcher.h"
@@ -36,6 +37,9 @@ struct AppOptions {
   // Each frame lasts at least this long (the rest is slept): a slow device's frame rate, to try
   // the controls at it (the input queue keeps quick taps and clicks).
   int minFrameMs = 0;
+  // Dynamic resolution: the render scale keeps the displayed frame within this many ms (0: off;
+  // the panel changes it).
+  double frameBudgetMs = 0.0;
   // Prints where the panel's Pause button is each frame it moved ("widget pause: x y w h"),
   // and the clock's pause and play: what a test that clicks in the window needs.
   bool printWidgets = false;
@@ -90,6 +94,7 @@ class App {
   bool cameraMoved_ = false;
   double lastX_ = 0, lastY_ = 0;
   std::unique_ptr<InputQueue> input_;
+  gi::DynamicResolution resolution_{{}};
   std::array<float, 4> pauseButtonPrinted_{};
   std::chrono::steady_clock::time_point last_;
 };

@@ -26,6 +26,8 @@ const char* kUsage =
     "  --shader-dir DIR       hot reload reads an effect's shader file from DIR when it has one\n"
     "  --min-frame-ms N       each frame lasts at least N ms (a slow device's rate, to try the\n"
     "                         controls at it)\n"
+    "  --frame-budget-ms MS   dynamic resolution: scale the render so a frame takes at most MS\n"
+    "                         (0: off, the default; the panel's \"frame budget\" changes it)\n"
     "  --print-widgets        print where the Pause button is and when the clock pauses/plays\n"
     "                         of that name (default: the source tree's file)\n"
     "  --validation           enable Vulkan validation layers (also GI_VALIDATION=1)\n"
@@ -59,6 +61,8 @@ demo::AppOptions parseArgs(int argc, char** argv) {
       o.shaderDir = a.value();
     else if (a.is("--min-frame-ms"))
       o.minFrameMs = int(a.integer(0, 60000));
+    else if (a.is("--frame-budget-ms"))
+      o.frameBudgetMs = a.number(0, 10000);
     else if (a.is("--print-widgets"))
       o.printWidgets = true;
     else

@@ -188,6 +188,13 @@ void drawPanel(Controller& controller, const FrameStats& stats, DemoState& state
   if (ImGui::Button("Screenshot")) state.screenshot = true;
   ImGui::SliderFloat("camera speed", &camera.speed, 0.1f, 20.0f, "%.2f m/s",
                      ImGuiSliderFlags_Logarithmic);
+  ImGui::SliderFloat("frame budget", &state.frameBudgetMs, 0.0f, 200.0f,
+                     state.frameBudgetMs > 0.0f ? "%.0f ms" : "off");
+  if (ImGui::IsItemHovered())
+    ImGui::SetTooltip("dynamic resolution: the render scale keeps the frame within this time");
+  ImGui::SameLine();
+  ImGui::Text("render %ux%u (%.0f%%)", renderer.outputExtent().width,
+              renderer.outputExtent().height, 100.0 * state.renderScale);
   if (!state.message.empty()) ImGui::TextWrapped("%s", state.message.c_str());
   if (!controller.lastError().empty())
     ImGui::TextColored({1, 0.4f, 0.3f, 1}, "%s", controller.lastError().c_str());

@@ -30,8 +30,10 @@ struct DemoState {
   std::string message;          // last screenshot path or similar
   std::string accuracyRequest;  // an effect whose accuracy check the user asked for
   int accuracySpp = 64;
-  bool showError = false;              // show the last accuracy check's error image
-  bool togglePause = false;            // the panel's Pause/Play button was pressed
+  bool showError = false;      // show the last accuracy check's error image
+  bool togglePause = false;    // the panel's Pause/Play button was pressed
+  float frameBudgetMs = 0.0f;  // dynamic resolution\'s budget (0: off), and its current scale
+  double renderScale = 1.0;
   std::array<float, 4> pauseButton{};  // where it is: x, y, width, height (window pixels)
 };
 
