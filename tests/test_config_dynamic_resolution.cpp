@@ -18,8 +18,8 @@ struct Outcome {
 };
 
 // `frames` frames of fixed + perPixel x scale^2 ms, times (1 + noise x u), u uniform in [-1, 1].
-Outcome simulate(DynamicResolution& dr, double fixed, double perPixel, int frames, double noise = 0.0,
-             unsigned seed = 1) {
+Outcome simulate(DynamicResolution& dr, double fixed, double perPixel, int frames,
+                 double noise = 0.0, unsigned seed = 1) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   Outcome r;
@@ -67,7 +67,8 @@ TEST(DynamicResolution, ImpossibleBudgetGivesTheSmallestScaleAndOffKeepsTheLarge
   DynamicResolution off({0.0});
   EXPECT_EQ(simulate(off, 20.0, 160.0, 100).scale, 1.0);
   DynamicResolution guarded({66.0});
-  for (double bad : {0.0, -1.0, std::nan(""), double(INFINITY)}) EXPECT_EQ(guarded.update(bad), 1.0);
+  for (double bad : {0.0, -1.0, std::nan(""), double(INFINITY)})
+    EXPECT_EQ(guarded.update(bad), 1.0);
 }
 
 }  // namespace
