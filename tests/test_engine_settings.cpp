@@ -153,11 +153,11 @@ TEST(EngineSettings, ErrorsNameFileKeyAndRangeLikeAnEffects) {
   for (const auto& call :
        std::vector<std::function<void()>>{[&] { resolveEngineSettings(scene, nullptr, cli, {}); },
                                           [&] { resolveEffects(scene, nullptr, cli, none); }})
-    expectError(
-        call, ErrorKind::Schema,
-        {"--set", "engine.nope", "unknown setting",
-         "engine has: shadow_map_size, shadow_cache, pcf_radius, exposure, environment_intensity, "
-         "surface_points, surface_point_seed"});
+    expectError(call, ErrorKind::Schema,
+                {"--set", "engine.nope", "unknown setting",
+                 "engine has: shadow_map_size, shadow_cache, shadow_update_period, pcf_radius, "
+                 "exposure, environment_intensity, "
+                 "surface_points, surface_point_seed"});
   cli.sets = {"engine.surface_points=-5"};
   expectError([&] { resolveEngineSettings(scene, nullptr, cli, {}); }, ErrorKind::InvalidData,
               {"--set", "engine.surface_points", "-5"});
@@ -215,9 +215,9 @@ TEST(GiRenderEngineSettings, UnknownKeyAndListing) {
   test::TempDir dir("engine-cli-errors");
   auto r = test::runCommand(render(dir.path("x.png"), "--set engine.nope=1"));
   EXPECT_EQ(r.exitCode, 1) << r.output;
-  EXPECT_NE(
-      r.output.find("engine.nope: unknown setting (engine has: shadow_map_size, shadow_cache, "),
-      std::string::npos)
+  EXPECT_NE(r.output.find("engine.nope: unknown setting (engine has: shadow_map_size, "
+                          "shadow_cache, shadow_update_period, "),
+            std::string::npos)
       << r.output;
   EXPECT_FALSE(std::filesystem::exists(dir.path("x.png")));
   r = test::runCommand(render(dir.path("x.png"), "--exposure 0"));

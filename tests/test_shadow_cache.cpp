@@ -151,5 +151,57 @@ TEST_F(ShadowCacheTest, FramesEqualDrawingEveryMapWholeAndReuseTheStillLightsMap
   EXPECT_GT(frames[4].pixels[i], 2.0f * frames[3].pixels[i]) << "pixel " << x << ", " << y;
 }
 
+// engine.shadow_update_period 3: the orbiting spot light's map (slot 2) is drawn whole on every
+// third frame and kept with the views it was drawn with in between. On the frames it is drawn
+// the image is the exact one bit for bit; in between it differs a little (its shadows lag the
+// light by one or two frames of its orbit) and stays finite; the still lights' maps come from
+// their caches throughout.
+TEST_F(ShadowCacheTest, AMovingLightsMapIsDrawnEveryNthFrameAndKeptInBetween) {
+  const Scene scene = animatedScene();
+  RenderSettings rs;
+  rs.width = 160;
+  rs.height = 120;
+  rs.view = "lit";
+  rs.shadowMapSize = 256;
+  RenderSettings amortised = rs;
+  amortised.shadowUpdatePeriod = 3;
+  Renderer exact(ctx(), scene, rs), lagging(ctx(), scene, amortised);
+  int drawnFrames = 0, keptFrames = 0;
+  for (int f = 0; f < 11; ++f) {
+    const double t = 0.5 + 0.05 * f;  // after the box's jump; the orbiting box moves each frame
+    for (Renderer* r : {&exact, &lagging}) {
+      r->setTime(t);
+      r->renderFrame();
+    }
+    if (f < 2) continue;  // the first frame and the orbiting box's first move draw every map
+    SCOPED_TRACE("frame " + std::to_string(f));
+    const Renderer::DrawCounts c = lagging.lastFrameDraws();
+    ASSERT_EQ(c.shadowMapsDrawn + c.shadowMapsCached, 3u);
+    ASSERT_LE(c.shadowMapsDrawn, 1u) << "only the moving spot light is ever drawn whole";
+    const ImageRGBA32F a = lagging.readTarget("lit"), b = exact.readTarget("lit");
+    double diff = 0.0, sum = 0.0;
+    size_t differing = 0;
+    for (size_t i = 0; i < a.pixels.size(); i += 4)
+      for (int ch = 0; ch < 3; ++ch) {
+        ASSERT_TRUE(std::isfinite(a.pixels[i + ch]));
+        diff += std::abs(a.pixels[i + ch] - b.pixels[i + ch]);
+        sum += std::abs(b.pixels[i + ch]);
+        differing += a.pixels[i + ch] != b.pixels[i + ch];
+      }
+    if (c.shadowMapsDrawn == 1) {
+      ++drawnFrames;
+      EXPECT_EQ(differing, 0u) << "drawn whole, the map is the exact one";
+    } else {
+      ++keptFrames;
+      EXPECT_GT(differing, 0u) << "a kept map lags the moving light";
+      // Measured 0.0018 one frame behind, 0.0034 two; a kept map read with today's views
+      // instead of the ones it was drawn with gives 0.0029 and 0.0058-0.0068.
+      EXPECT_LT(diff / sum, 0.0045) << "relative L1 difference from the exact frame";
+    }
+  }
+  EXPECT_EQ(drawnFrames, 3);  // frames 2..10: one in three
+  EXPECT_EQ(keptFrames, 6);
+}
+
 }  // namespace
 }  // namespace gi

@@ -45,6 +45,11 @@ struct RenderSettings {
   // depth in a cache; each frame redraws only the dynamic casters (skinned, morphed, or moved
   // once) over the texels they cover. The same maps bit for bit; off for A/B measurements.
   bool cacheShadows = true;
+  // Amortised shadows of moving lights (with cacheShadows): a moving light's map is drawn whole
+  // every N-th frame (the lights staggered); in between it keeps the views it was drawn with
+  // (its shadows lag the light by up to N-1 frames) and only the dynamic casters are redrawn
+  // into it. 1: every frame, exact.
+  uint32_t shadowUpdatePeriod = 1;
   std::string view =
       "output";  // the resource the frame delivers (a G-buffer channel, an effect's view)
   // Resources readTarget() will read besides `view`: kept intact to the end of the frame (the

@@ -22,6 +22,11 @@ std::vector<SettingDesc> engineSettingDescs() {
        "a light that did not move keeps its static casters' depth: each frame redraws only the "
        "dynamic casters (skinned, morphed, or moved once) over what they cover (the same maps; "
        "off: every map drawn whole every frame)"},
+      {"shadow_update_period", SettingType::Int, double(d.shadowUpdatePeriod), 1, 8,
+       "a moving light's shadow map is drawn whole every N-th frame (lights staggered); in "
+       "between it keeps the views it was drawn with (shadows lag the light by up to N-1 "
+       "frames) and only dynamic casters are redrawn (needs shadow_cache; 1: every frame, "
+       "exact)"},
       {"pcf_radius", SettingType::Int, double(d.pcfRadius), 0, 3,
        "shadow filter: (2r+1)^2 texels per lookup (0: one hard-edged tap)"},
       hints({"exposure", SettingType::Float, double(d.exposure), 1e-3, 1e3,
@@ -43,6 +48,7 @@ SettingValues engineSettingsOf(const RenderSettings& s) {
   const std::string origin = "RenderSettings";
   v.set("shadow_map_size", s.shadowMapSize, origin);
   v.set("shadow_cache", s.cacheShadows, origin);
+  v.set("shadow_update_period", s.shadowUpdatePeriod, origin);
   v.set("pcf_radius", s.pcfRadius, origin);
   v.set("exposure", double(s.exposure), origin);
   v.set("environment_intensity", double(s.environmentIntensity), origin);
@@ -57,6 +63,7 @@ void applyEngineSettings(const SettingValues& v, RenderSettings& s) {
                 "applyEngineSettings: got the settings of '" + v.owner() + "', not the engine's");
   s.shadowMapSize = uint32_t(v.integer("shadow_map_size"));
   s.cacheShadows = v.flag("shadow_cache");
+  s.shadowUpdatePeriod = uint32_t(v.integer("shadow_update_period"));
   s.pcfRadius = uint32_t(v.integer("pcf_radius"));
   s.exposure = float(v.number("exposure"));
   s.environmentIntensity = float(v.number("environment_intensity"));

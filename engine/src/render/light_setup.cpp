@@ -28,6 +28,7 @@ bool addShadowMap(const Light& l, const glm::mat4& world, uint32_t lightIndex,
         glm::vec3(i & 1 ? bmax.x : bmin.x, i & 2 ? bmax.y : bmin.y, i & 4 ? bmax.z : bmin.z);
   ShadowMap map;
   map.light = lightIndex;
+  map.firstView = uint32_t(out.size());
   auto addView = [&](const glm::mat4& viewProj, const glm::vec4& params, glm::uvec2 offset) {
     map.views.push_back({viewProj, VkRect2D{{int32_t(offset.x), int32_t(offset.y)}, {res, res}}});
     out.push_back({viewProj * invView, params, glm::vec4(offset.x, offset.y, res, 0.0f)});
@@ -109,6 +110,7 @@ bool LightSetup::sameLayout(const LightSetup& o) const {
 LightSetup planLights(const Scene& scene, const std::vector<Node>& nodes, const CameraView& camera,
                       const glm::vec3& bmin, const glm::vec3& bmax, uint32_t shadowMapSize) {
   LightSetup out;
+  out.cameraInvView = glm::inverse(camera.view);
   const bool hasBounds = bmin.x <= bmax.x;
   for (const Node& node : nodes) {
     if (node.light < 0 || size_t(node.light) >= scene.lights.size()) continue;
@@ -189,6 +191,11 @@ LightBuffers::LightBuffers(vk::Context& ctx)
     : lights_(ctx, kMaxLights * sizeof(GpuLight), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true),
       shadowViews_(ctx, kMaxShadowViews * sizeof(GpuShadowView), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
                    true) {}
+
+void LightBuffers::writeShadowView(uint32_t index, const GpuShadowView& view) {
+  if (index < kMaxShadowViews)
+    shadowViews_.write(&view, sizeof view, size_t(index) * sizeof(GpuShadowView));
+}
 
 void LightBuffers::upload(const LightSetup& setup) {
   if (!setup.lights.empty())

@@ -17,7 +17,8 @@ namespace gi {
 // One shadow map: one layer of the "shadow_maps" array (its slot), rendered as one view, or six
 // cube faces in a 3x2 atlas.
 struct ShadowMap {
-  uint32_t light = 0;  // index into the light records (names the pass "shadow_<light>")
+  uint32_t light = 0;      // index into the light records (names the pass "shadow_<light>")
+  uint32_t firstView = 0;  // its first record in LightSetup::views
   uint32_t width = 0, height = 0;
   struct View {
     glm::mat4 viewProj;  // world -> light clip
@@ -31,6 +32,7 @@ struct LightSetup {
   std::vector<LightInfo> world;      // the same lights in world space
   std::vector<GpuShadowView> views;  // every shadow map's views, in slot order
   std::vector<ShadowMap> maps;       // one per shadow-casting light that sees the scene
+  glm::mat4 cameraInvView{1.0f};     // camera view -> world: views[i].viewToClip's right factor
   uint32_t layerWidth() const;       // the array's layer size: the largest map
   uint32_t layerHeight() const;
   // Same slots, lights and view counts: only the buffers' contents change, not the graph.
@@ -69,6 +71,8 @@ class LightBuffers {
  public:
   explicit LightBuffers(vk::Context& ctx);
   void upload(const LightSetup& setup);
+  // One shadow view record rewritten (a map kept with the views it was drawn with).
+  void writeShadowView(uint32_t index, const GpuShadowView& view);
   const vk::Buffer& lights() const { return lights_; }
   const vk::Buffer& shadowViews() const { return shadowViews_; }
 

@@ -121,6 +121,7 @@ struct Renderer::Impl : EffectContext {
     updateFrameUniforms();  // frame() is valid from the first prepare() on
     state.reset(new EngineState{ctx, settings, *sceneGpu, lightSetup, *environment, surfacePoints,
                                 output, nearestClamp.handle(), linearClamp.handle()});
+    state->lightBuffers = &*lightBuffers;
     ctx.requireWorkgroup(256, 1, "skinning / surface points");  // local_size_x 256
     skinningPass = makeSkinningPass(*state);
     gbufferPass = makeGBufferPass(*state);

@@ -29,7 +29,8 @@ struct EngineState {
   std::unique_ptr<SurfacePointsPass>& surfacePoints;
   vk::Image& output;  // the tonemapped RGBA8 image (imported as "output")
   VkSampler nearest, linear;
-  uint32_t skinnedThisFrame = 0;  // written by the skinning pass
+  uint32_t skinnedThisFrame = 0;         // written by the skinning pass
+  LightBuffers* lightBuffers = nullptr;  // the shadow pass rewrites the views of maps it keeps
   // Shadow maps this frame drawn whole (or their cache built) and restored from their cache.
   uint32_t shadowMapsDrawn = 0, shadowMapsCached = 0;
 };

@@ -9,6 +9,11 @@
 // now and draws only the dynamic casters over them. A light whose views changed since the last
 // frame (it moves) is drawn whole, as without the cache; its cache is built the first frame it
 // stands still. Each frame's maps are the same, bit for bit, as drawing everything.
+// With RenderSettings::shadowUpdatePeriod N > 1 a moving light is drawn whole (and cached) only
+// every N-th frame, the lights staggered; in between its map keeps the views it was drawn with,
+// the shadow view records say so (its shadows lag the light), and only the dynamic casters are
+// redrawn into it, as for a still light.
+#include <algorithm>
 #include <optional>
 
 #include "gi/vk/common.h"
@@ -125,6 +130,8 @@ class ShadowPass final : public Effect {
   // What a layer of the maps and its cache hold.
   struct Slot {
     std::optional<ShadowMap> drawn;  // the views the layer was last drawn with
+    std::vector<glm::vec4> params;   // their shadow view records' params (near, far, texel)
+    uint32_t frame = 0;              // frames recorded: with the slot's index, its update phase
     uint64_t staticVersion = 0;      // SceneGpu::staticVersion() then
     vk::Image cache;                 // static casters' depth (map.width x map.height), or none
     bool cached = false;             // `cache` holds `drawn`'s static depth
@@ -146,24 +153,59 @@ class ShadowPass final : public Effect {
 
   void record(PassContext& pc, uint32_t index, TextureHandle maps) {
     SceneGpu& scene = s_.scene;
-    const ShadowMap& map = s_.lights.maps[index];
+    const ShadowMap& current = s_.lights.maps[index];
     Slot& slot = slots_[index];
-    const std::vector<SceneView> views = sceneViews(map);
+    const RenderSettings& rs = s_.settings;
+    const uint32_t period = rs.cacheShadows ? std::max(rs.shadowUpdatePeriod, 1u) : 1u;
+    const bool staticSame = slot.drawn && slot.staticVersion == scene.staticVersion();
+    const bool viewsSame = slot.drawn && shadow_cache::sameViews(*slot.drawn, current);
+    // A moving light keeps the views its map was drawn with except on its frame of the period
+    // (the lights' frames are staggered by their index).
+    const bool keep = staticSame && !viewsSame && slot.cached && (slot.frame + index) % period != 0;
+    ++slot.frame;
     SceneTargets layer;
     layer.depth = pc.view(maps, Subresource::layerOf(index));
     layer.extent = pc.extent(maps);
-    const bool unchanged = slot.drawn && shadow_cache::sameViews(*slot.drawn, map) &&
-                           slot.staticVersion == scene.staticVersion();
-    const bool useCache = s_.settings.cacheShadows && unchanged;
-    slot.drawn = map;
-    slot.staticVersion = scene.staticVersion();
-    if (!useCache) {  // the light moved, the static casters changed, or no caching: all of it
+    if (!rs.cacheShadows || !staticSame || !(viewsSame || keep)) {
+      // Drawn whole: the light moved (on its frame), the static casters changed, or no cache.
+      slot.drawn = current;
+      slot.params.clear();
+      for (size_t v = 0; v < current.views.size(); ++v)
+        slot.params.push_back(s_.lights.views[current.firstView + v].params);
+      slot.staticVersion = scene.staticVersion();
       slot.cached = false;
-      slot.dynamicTexels.assign(views.size(), std::nullopt);
-      scene.drawDepth(pc, layer, views);
-      ++s_.shadowMapsDrawn;
-      return;
+      slot.dynamicTexels.assign(current.views.size(), std::nullopt);
+      if (period == 1) {
+        scene.drawDepth(pc, layer, sceneViews(current));
+        ++s_.shadowMapsDrawn;
+        return;
+      }
+      // Amortised: the cache is built now, so that the frames keeping these views restore only
+      // what the dynamic casters cover.
+    } else if (keep) {
+      keepDrawnViews(index, slot);
     }
+    drawFromCache(pc, index, slot, layer);
+  }
+
+  // The lighting pass and the effects read a kept map with the views it was drawn with: its
+  // shadow view records (GPU and CPU copies) become those views seen from today's camera.
+  void keepDrawnViews(uint32_t index, const Slot& slot) {
+    const ShadowMap& current = s_.lights.maps[index];
+    for (size_t v = 0; v < current.views.size(); ++v) {
+      GpuShadowView& record = s_.lights.views[current.firstView + v];
+      record.viewToClip = slot.drawn->views[v].viewProj * s_.lights.cameraInvView;
+      record.params = slot.params[v];
+      s_.lightBuffers->writeShadowView(uint32_t(current.firstView + v), record);
+    }
+  }
+
+  // The slot's drawn views from its cache: restores what the dynamic casters covered and cover
+  // (or the whole map when the cache is built now), then draws the dynamic casters.
+  void drawFromCache(PassContext& pc, uint32_t index, Slot& slot, SceneTargets layer) {
+    SceneGpu& scene = s_.scene;
+    const ShadowMap& map = *slot.drawn;
+    const std::vector<SceneView> views = sceneViews(map);
     VkCommandBuffer c = pc.cmd();
     // Texels to restore from the cache: the whole map when the cache is built now, else the
     // dynamic casters' last and current texels.
