@@ -99,13 +99,19 @@ Scene animatedScene() {
 
 class ShadowCacheTest : public VulkanTest {};
 
-TEST_F(ShadowCacheTest, FramesEqualDrawingEveryMapWholeAndReuseTheStillLightsMaps) {
-  const Scene scene = animatedScene();
+// The lit image of a small frame with 256-texel shadow maps.
+RenderSettings smallLitFrame() {
   RenderSettings rs;
   rs.width = 160;
   rs.height = 120;
   rs.view = "lit";
   rs.shadowMapSize = 256;
+  return rs;
+}
+
+TEST_F(ShadowCacheTest, FramesEqualDrawingEveryMapWholeAndReuseTheStillLightsMaps) {
+  const Scene scene = animatedScene();
+  RenderSettings rs = smallLitFrame();
   rs.keepForReadback = {"shadow_maps"};
   RenderSettings whole = rs;
   whole.cacheShadows = false;
@@ -158,11 +164,7 @@ TEST_F(ShadowCacheTest, FramesEqualDrawingEveryMapWholeAndReuseTheStillLightsMap
 // their caches throughout.
 TEST_F(ShadowCacheTest, AMovingLightsMapIsDrawnEveryNthFrameAndKeptInBetween) {
   const Scene scene = animatedScene();
-  RenderSettings rs;
-  rs.width = 160;
-  rs.height = 120;
-  rs.view = "lit";
-  rs.shadowMapSize = 256;
+  const RenderSettings rs = smallLitFrame();
   RenderSettings amortised = rs;
   amortised.shadowUpdatePeriod = 3;
   Renderer exact(ctx(), scene, rs), lagging(ctx(), scene, amortised);

@@ -62,20 +62,8 @@ constexpr VkAccessFlags2 kDepthAccess =
 void layerBarrier(VkCommandBuffer c, VkImage image, uint32_t layer, VkImageLayout from,
                   VkImageLayout to, VkPipelineStageFlags2 srcStage, VkAccessFlags2 srcAccess,
                   VkPipelineStageFlags2 dstStage, VkAccessFlags2 dstAccess) {
-  VkImageMemoryBarrier2 b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER_2};
-  b.srcStageMask = srcStage;
-  b.srcAccessMask = srcAccess;
-  b.dstStageMask = dstStage;
-  b.dstAccessMask = dstAccess;
-  b.oldLayout = from;
-  b.newLayout = to;
-  b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-  b.image = image;
-  b.subresourceRange = {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 1, layer, 1};
-  VkDependencyInfo dep{VK_STRUCTURE_TYPE_DEPENDENCY_INFO};
-  dep.imageMemoryBarrierCount = 1;
-  dep.pImageMemoryBarriers = &b;
-  vkCmdPipelineBarrier2(c, &dep);
+  vk::imageBarrier(c, image, {VK_IMAGE_ASPECT_DEPTH_BIT, 0, 1, layer, 1}, from, to, srcStage,
+                   srcAccess, dstStage, dstAccess);
 }
 
 std::vector<SceneView> sceneViews(const ShadowMap& map) {
