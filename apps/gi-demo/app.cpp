@@ -409,10 +409,12 @@ void App::reloadPlugins(bool settled) {
 void App::printTimings() {
   std::printf(
       "timings: %zu frames at %ux%u, frame %.2f ms (wall, median), GPU passes %.3f ms, UI GPU "
-      "%.3f ms, UI CPU %.3f ms\n",
+      "%.3f ms, UI CPU %.3f ms; last frame's shadow maps: %u drawn whole, %u from their cache\n",
       timingFrames_.size(), controller_->renderer().outputExtent().width,
       controller_->renderer().outputExtent().height, median(timingFrames_), median(timingGpu_),
-      median(timingUiGpu_), median(timingUiCpu_));
+      median(timingUiGpu_), median(timingUiCpu_),
+      controller_->renderer().lastFrameDraws().shadowMapsDrawn,
+      controller_->renderer().lastFrameDraws().shadowMapsCached);
   timingFrames_.clear();
   timingGpu_.clear();
   timingUiCpu_.clear();
