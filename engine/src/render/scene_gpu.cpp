@@ -673,12 +673,16 @@ void SceneGpu::drawDepth(PassContext& pc, const SceneTargets& t, std::span<const
   drawDepth(pc, t, views, Subset::All);
 }
 
-std::vector<SceneGpu::Box> SceneGpu::dynamicBoxes() {
-  std::vector<Box> boxes;
-  const std::vector<Box>& all = instanceBoxes();
-  for (size_t i = 0; i < all.size() && i < dynamic_.size(); ++i)
-    if (dynamic_[i]) boxes.push_back(all[i]);
-  return boxes;
+// An instance turns dynamic only when its matrix changes, which also bumps poseVersion_.
+const std::vector<SceneGpu::Box>& SceneGpu::dynamicBoxes() {
+  if (dynamicBoxesVersion_ != poseVersion_) {
+    const std::vector<Box>& all = instanceBoxes();
+    dynamicBoxes_.clear();
+    for (size_t i = 0; i < all.size() && i < dynamic_.size(); ++i)
+      if (dynamic_[i]) dynamicBoxes_.push_back(all[i]);
+    dynamicBoxesVersion_ = poseVersion_;
+  }
+  return dynamicBoxes_;
 }
 
 void SceneGpu::drawDepth(PassContext& pc, const SceneTargets& t, std::span<const SceneView> views,

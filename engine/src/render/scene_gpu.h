@@ -72,8 +72,8 @@ class SceneGpu final : public GpuScene {
   bool isDynamic(uint32_t instance) const { return dynamic_[instance] != 0; }
   uint64_t staticVersion() const { return staticVersion_; }
   using Box = std::pair<glm::vec3, glm::vec3>;
-  // World boxes of the dynamic instances in the current pose.
-  std::vector<Box> dynamicBoxes();
+  // World boxes of the dynamic instances in the current pose (recomputed when it changes).
+  const std::vector<Box>& dynamicBoxes();
   // drawDepth restricted to the static or the dynamic instances (targets.clear as given).
   enum class Subset { All, Static, Dynamic };
   void drawDepth(PassContext& pc, const SceneTargets& targets, std::span<const SceneView> views,
@@ -145,8 +145,8 @@ class SceneGpu final : public GpuScene {
   std::vector<vk::Buffer> viewChunks_;
   size_t viewSlotsUsed_ = 0;
   bool culling_ = true;
-  std::vector<Box> instanceBoxes_;
-  uint64_t boxesVersion_ = 0;
+  std::vector<Box> instanceBoxes_, dynamicBoxes_;
+  uint64_t boxesVersion_ = 0, dynamicBoxesVersion_ = 0;
   DrawCounts counts_;
 };
 

@@ -198,7 +198,7 @@ class ShadowPass final : public Effect {
     // Texels to restore from the cache: the whole map when the cache is built now, else the
     // dynamic casters' last and current texels.
     std::vector<VkImageCopy> copies;
-    const std::vector<shadow_cache::Box> dynamic = scene.dynamicBoxes();
+    const std::vector<shadow_cache::Box>& dynamic = scene.dynamicBoxes();
     std::vector<SceneView> dynamicViews;
     for (size_t v = 0; v < views.size(); ++v) {
       const std::optional<VkRect2D> now =
