@@ -429,9 +429,20 @@ TEST(ReferenceAO, SphereOnPlaneMatchesProjectedSolidAngleAndIsDarkestAtContact) 
   for (int i = 0; i < 3; ++i) EXPECT_LT(sum[i] / count[i], sum[i + 1] / count[i + 1]);
 }
 
+// The lighting pass's BRDF for a punctual light on a dielectric (lights.glsl): rho / pi plus
+// f0 = 0.04 times the normalised Blinn-Phong lobe (s + 8) / (8 pi) (n.h)^s, s = 2 / r^4 - 2.
+glm::vec3 lightingBrdf(glm::vec3 rho, float roughness, glm::vec3 n, glm::vec3 l, glm::vec3 v) {
+  const float s =
+      std::clamp(2.0f / std::pow(std::max(roughness, 0.03f), 4.0f) - 2.0f, 1.0f, 4096.0f);
+  const glm::vec3 h = glm::normalize(l + v);
+  const float lobe = (s + 8.0f) / (8.0f * float(kPi)) * std::pow(std::max(glm::dot(n, h), 0.0f), s);
+  return rho / float(kPi) + glm::vec3(0.04f * lobe);
+}
+
 TEST(ReferenceDirect, AnalyticLightsAndEnvironmentsOnAPlane) {
   const glm::vec3 albedo(0.5f, 0.6f, 0.7f);
-  // Directional light (lux) tilted 30 degrees + constant environment: exact, no variance.
+  // Directional light (lux) tilted 30 degrees + constant environment (Lambert only): exact, no
+  // variance.
   {
     SceneBuilder b;
     b.add(parallelogram({-50, 0, 50}, {100, 0, 0}, {0, 0, -100}), b.material(albedo));
@@ -441,17 +452,20 @@ TEST(ReferenceDirect, AnalyticLightsAndEnvironmentsOnAPlane) {
     b.constantEnvironment(glm::vec3(0.2f, 0.3f, 0.4f), 2.0f);
     const Scene scene = b.done();
     const glm::vec3 l = -glm::normalize(glm::vec3(sun * glm::vec4(0, 0, -1, 0)));
-    const glm::vec3 expected = albedo / float(kPi) * glm::vec3(1.0f, 0.9f, 0.8f) * 3.0f * l.y +
-                               albedo * glm::vec3(0.2f, 0.3f, 0.4f) * 2.0f;
+    const float roughness = scene.materials[0].roughness;
     const ref::Result r = ref::render(scene, smallSettings(ref::Quantity::Direct, 16));
     for (size_t i = 0; i < size_t(r.value.width) * r.value.height; ++i) {
       const PixelView p = pixel(r, i);
       if (!p.geometry) continue;
+      const glm::vec3 v = glm::normalize(glm::vec3(0, 2, 3) - p.position);
+      const glm::vec3 expected = lightingBrdf(albedo, roughness, {0, 1, 0}, l, v) *
+                                     glm::vec3(1.0f, 0.9f, 0.8f) * 3.0f * l.y +
+                                 albedo * glm::vec3(0.2f, 0.3f, 0.4f) * 2.0f;
       for (int c = 0; c < 3; ++c) ASSERT_NEAR(p.value[c], expected[c], 1e-5f);
       ASSERT_EQ(p.stdError.x, 0.0f);
     }
   }
-  // Point light (candela) at height h: (rho/pi) I cos / d^2; an occluding square between it
+  // Point light (candela) at height h: f_r I cos / d^2; an occluding square between it
   // and the plane casts an exact shadow.
   {
     const glm::vec3 lightPos(0.3f, 1.5f, -0.2f);
@@ -461,7 +475,9 @@ TEST(ReferenceDirect, AnalyticLightsAndEnvironmentsOnAPlane) {
     b.camera({0, 2.5f, 3}, {0, 0, 0});
     b.light(LightType::Point, glm::translate(glm::mat4(1.0f), lightPos), glm::vec3(1.0f), 5.0f);
     b.constantEnvironment(glm::vec3(0.0f), 0.0f);
-    const ref::Result r = ref::render(b.done(), smallSettings(ref::Quantity::Direct, 4, 64, 48));
+    const Scene scene = b.done();
+    const float roughness = scene.materials[0].roughness;
+    const ref::Result r = ref::render(scene, smallSettings(ref::Quantity::Direct, 4, 64, 48));
     int lit = 0, shadowed = 0;
     for (size_t i = 0; i < size_t(r.value.width) * r.value.height; ++i) {
       const PixelView p = pixel(r, i);
@@ -472,9 +488,11 @@ TEST(ReferenceDirect, AnalyticLightsAndEnvironmentsOnAPlane) {
       const float margin = std::max(std::abs(cross.x), std::abs(cross.z)) - 0.2f;
       if (std::abs(margin) < 0.01f) continue;  // penumbra-free, but skip the pixel-exact edge
       const float d2 = glm::dot(toLight, toLight);
+      const glm::vec3 l = toLight / std::sqrt(d2);
+      const glm::vec3 v = glm::normalize(glm::vec3(0, 2.5f, 3) - p.position);
       const glm::vec3 expected =
           margin < 0 ? glm::vec3(0.0f)
-                     : albedo / float(kPi) * 5.0f * (toLight.y / std::sqrt(d2)) / d2;
+                     : lightingBrdf(albedo, roughness, {0, 1, 0}, l, v) * 5.0f * l.y / d2;
       for (int c = 0; c < 3; ++c) ASSERT_NEAR(p.value[c], expected[c], 1e-5f + 1e-5f * expected[c]);
       (margin < 0 ? shadowed : lit)++;
     }
@@ -574,7 +592,11 @@ TEST(ReferenceDirect, SpotConeAndRangeFollowTheRasteriser) {
     const float d2 = rho * rho + 1.0f;
     if (angle < glm::radians(19.5f)) {
       const float window = std::clamp(1.0f - std::pow(d2 / (1.3f * 1.3f), 2.0f), 0.0f, 1.0f);
-      const float expected = 1.0f / float(kPi) * 2.0f / d2 * std::cos(angle) * window;
+      const glm::vec3 l = glm::normalize(-p.position + glm::vec3(0, 1, 0));
+      const glm::vec3 v = glm::normalize(glm::vec3(0, 1.5f, 0.01f) - p.position);
+      const float expected =
+          lightingBrdf(glm::vec3(1.0f), scene.materials[0].roughness, {0, 1, 0}, l, v).x * 2.0f /
+          d2 * std::cos(angle) * window;
       EXPECT_NEAR(p.value.x, expected, 1e-5f);
       ++inner;
     } else if (angle > glm::radians(30.5f)) {

@@ -34,8 +34,11 @@ void main() {
   vec3 n = safeNormalize(inViewNormal, faceN);
   if (dot(n, faceN) < 0.0) n = -n;
 
+  // Emission leaves the side the authored normal points to, or both for a double-sided
+  // material (the reference's rule). A product, not a branch on the uniform (see above).
+  float emitting = max(float(dot(inViewNormal, -inViewPos) >= 0.0), material.params.w);
   outGBuffer = giGBufferEncode(n, albedo.rgb, material.params.x, material.params.y,
-                               material.emission.rgb);
+                               material.emission.rgb * emitting);
   // This pixel's centre in NDC (what the interpolated clip position divided by w gives).
   vec2 cur = gl_FragCoord.xy * frame.viewport.zw * 2.0 - 1.0;
   vec2 prev = inPrevClip.w > 0.0 ? inPrevClip.xy / inPrevClip.w : cur;

@@ -7,7 +7,8 @@
 layout(set = 0, binding = 2) uniform MaterialBlock {
   vec4 baseColor;  // linear rgba
   vec4 emission;   // rgb radiance, 1
-  vec4 params;     // roughness, metallic (both clamped to [0, 1]), textured (1/0), 0
+  vec4 params;     // roughness, metallic (both clamped to [0, 1]), textured (1/0),
+                   // double-sided emission (1/0)
 } material;
 
 #endif

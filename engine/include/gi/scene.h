@@ -64,6 +64,10 @@ struct Material {
   glm::vec3 emission{0.0f};                     // linear radiance added on top of lighting
   float roughness = 0.8f;
   float metallic = 0.0f;
+  // Emission leaves the side the surface's normal points to; double-sided (glTF doubleSided):
+  // both sides. Only emission is one-sided: every surface reflects light on both sides (the
+  // rasteriser culls no faces).
+  bool doubleSided = false;
 };
 
 struct Camera {

@@ -101,7 +101,8 @@ struct RayScene::Impl {
     if (glm::dot(ng, toOrigin) < 0.0f) ng = -ng;
     glm::vec3 ns = safeNormalize(
         w * inst.normals[tri[0]] + u * inst.normals[tri[1]] + v * inst.normals[tri[2]], ng);
-    if (glm::dot(ns, toOrigin) < 0.0f) ns = -ns;
+    hit.frontFacing = glm::dot(ns, toOrigin) >= 0.0f;
+    if (!hit.frontFacing) ns = -ns;
     hit.geometricNormal = ng;
     hit.shadingNormal = ns;
     hit.uv = w * inst.uvs[tri[0]] + u * inst.uvs[tri[1]] + v * inst.uvs[tri[2]];
@@ -255,9 +256,11 @@ std::vector<WorldTriangle> RayScene::triangles(
   std::vector<WorldTriangle> out;
   for (const auto& inst : impl_->instances) {
     if (!keep(inst->material)) continue;
-    for (size_t t = 0; t + 2 < inst->indices.size(); t += 3)
-      out.push_back({inst->positions[inst->indices[t]], inst->positions[inst->indices[t + 1]],
-                     inst->positions[inst->indices[t + 2]], inst->material});
+    for (size_t t = 0; t + 2 < inst->indices.size(); t += 3) {
+      const uint32_t a = inst->indices[t], b = inst->indices[t + 1], c = inst->indices[t + 2];
+      out.push_back({inst->positions[a], inst->positions[b], inst->positions[c], inst->normals[a],
+                     inst->normals[b], inst->normals[c], inst->material});
+    }
   }
   return out;
 }

@@ -90,19 +90,33 @@ struct WorldLight {
   bool shadows = true;
 };
 
-// An emissive triangle, sampled for next-event estimation in the bounce.
+// An emissive triangle, sampled for next-event estimation in the bounce. It lights the side
+// its interpolated vertex normals point to (both for a double-sided material).
 struct Emitter {
   glm::vec3 p0{0.0f}, e1{0.0f}, e2{0.0f}, normal{0.0f, 1.0f, 0.0f}, emission{0.0f};
+  glm::vec3 n0{0.0f}, n1{0.0f}, n2{0.0f};
+  bool doubleSided = false;
 };
 
 float luminance(const glm::vec3& c) {
   return (c.x + c.y + c.z) / 3.0f;
 }
 
+// The lighting pass's BRDF (lighting.comp, lights.glsl): Lambert with the diffuse colour for
+// every light, plus a normalised Blinn-Phong lobe for the point, spot and directional lights
+// only (the renderer has no specular term for the environment or indirect light).
 struct SurfaceMaterial {
-  glm::vec3 diffuse{0.0f};  // albedo * (1 - metallic): the Lambert colour (BRDF = diffuse / pi)
-  glm::vec3 emission{0.0f};
+  glm::vec3 diffuse{0.0f};   // albedo * (1 - metallic): the Lambert colour (BRDF = diffuse / pi)
+  glm::vec3 emission{0.0f};  // 0 where a one-sided emitter is seen from behind
+  glm::vec3 f0{0.04f};       // specular colour: mix(0.04, albedo, metallic)
+  float shininess = 1.0f;    // Blinn-Phong exponent of the roughness (shininessOf)
 };
+
+// lights.glsl's shininessOf: the Blinn-Phong exponent of a roughness.
+float shininessOf(float roughness) {
+  const float r = std::max(roughness, 0.03f);
+  return std::clamp(2.0f / (r * r * r * r) - 2.0f, 1.0f, 4096.0f);
+}
 
 // Everything a sample needs, shared read-only by the worker threads.
 class Shading {
@@ -144,6 +158,10 @@ class Shading {
       if (!(area > 0.0f) || !std::isfinite(area)) continue;
       e.normal = c / (2.0f * area);
       e.emission = emission(t.material);
+      e.n0 = t.n0;
+      e.n1 = t.n1;
+      e.n2 = t.n2;
+      e.doubleSided = materials_[std::min<size_t>(t.material, materials_.size() - 1)].doubleSided;
       emitterPower_ += double(area) * luminance(e.emission);
       emitterCdf_.push_back(emitterPower_);
       emitters_.push_back(e);
@@ -159,7 +177,11 @@ class Shading {
       albedo *= textures_[m.baseColorTexture].sample(hit.uv);
     albedo = glm::clamp(finiteOrZero(albedo), 0.0f, 1.0f);
     const float metallic = std::isfinite(m.metallic) ? std::clamp(m.metallic, 0.0f, 1.0f) : 0.0f;
-    return {albedo * (1.0f - metallic), glm::max(finiteOrZero(m.emission), glm::vec3(0.0f))};
+    const float roughness = std::isfinite(m.roughness) ? std::clamp(m.roughness, 0.0f, 1.0f) : 0.0f;
+    const bool emits = hit.frontFacing || m.doubleSided;
+    return {albedo * (1.0f - metallic),
+            emits ? glm::max(finiteOrZero(m.emission), glm::vec3(0.0f)) : glm::vec3(0.0f),
+            glm::mix(glm::vec3(0.04f), albedo, metallic), shininessOf(roughness)};
   }
 
   glm::vec3 environment(const glm::vec3& dir) const { return environmentRadiance(env_, dir); }
@@ -193,11 +215,13 @@ class Shading {
     return finiteOrZero(sum);
   }
 
-  // Reflected radiance from the point, spot and directional lights with shadow rays:
-  // sum (diffuse / pi) E_l cos(theta_l) V_l, with the rasteriser's units and falloffs.
-  glm::vec3 directLights(const SurfaceHit& hit, const glm::vec3& diffuse) const {
+  // Radiance the point reflects towards `v` (unit) from the point, spot and directional lights
+  // with shadow rays: sum (diffuse / pi + f0 (s + 8) / (8 pi) max(n.h, 0)^s) E_l cos(theta_l)
+  // V_l, with the rasteriser's units, falloffs and lobe (lights.glsl sumLights).
+  glm::vec3 directLights(const SurfaceHit& hit, const SurfaceMaterial& m,
+                         const glm::vec3& v) const {
     glm::vec3 sum(0.0f);
-    if (lights_.empty() || diffuse == glm::vec3(0.0f)) return sum;
+    if (lights_.empty()) return sum;
     const glm::vec3 n = hit.shadingNormal;
     const glm::vec3 origin = RayScene::spawnOrigin(hit);
     for (const WorldLight& light : lights_) {
@@ -228,9 +252,12 @@ class Shading {
                                  : rays_.occluded(origin, light.position - origin, 0.0f, 0.9999f);
         if (blocked) continue;
       }
-      sum += diffuse / kPi * light.radiance * (attenuation * ndl);
+      const glm::vec3 h = safeNormalize(l + v, n);
+      const float lobe = (m.shininess + 8.0f) / (8.0f * kPi) *
+                         std::pow(std::max(glm::dot(n, h), 0.0f), m.shininess);
+      sum += (m.diffuse / kPi + m.f0 * lobe) * light.radiance * (attenuation * ndl);
     }
-    return sum;
+    return finiteOrZero(sum);
   }
 
   // Light-sampling density (per unit area) of a point on an emitter of radiance `le`.
@@ -251,8 +278,9 @@ class Shading {
     return float(pBsdf / (pBsdf + pLight));
   }
 
-  // Next-event estimation of the light the emissive surfaces send to `x` directly (two-sided
-  // emitters, shadow ray), MIS-weighted against the cosine-sampled bounce: returns
+  // Next-event estimation of the light the emissive surfaces send to `x` directly (from their
+  // front side, or both for double-sided ones; shadow ray), MIS-weighted against the
+  // cosine-sampled bounce: returns
   // Le cos_x / pi / (p_light + p_bsdf), to be multiplied by the diffuse colour.
   glm::vec3 sampleEmitters(const SurfaceHit& x, Rng& rng) const {
     if (emitters_.empty()) return glm::vec3(0.0f);
@@ -262,11 +290,16 @@ class Shading {
         emitters_.size() - 1);
     const Emitter& e = emitters_[k];
     const float su = std::sqrt(rng.uniform()), v = rng.uniform();
-    const glm::vec3 point = e.p0 + su * (1.0f - v) * e.e1 + su * v * e.e2;
+    const float b1 = su * (1.0f - v), b2 = su * v;
+    const glm::vec3 point = e.p0 + b1 * e.e1 + b2 * e.e2;
     const glm::vec3 w = point - x.position;
     const float d2 = glm::dot(w, w);
     if (!(d2 > 0.0f) || !std::isfinite(d2)) return glm::vec3(0.0f);
     const glm::vec3 wn = w / std::sqrt(d2);
+    // The same side test as a ray that hits the emitter (SurfaceHit::frontFacing).
+    const glm::vec3 front = (1.0f - b1 - b2) * e.n0 + b1 * e.n1 + b2 * e.n2;
+    if (!e.doubleSided && glm::dot(safeNormalize(front, e.normal), -wn) < 0.0f)
+      return glm::vec3(0.0f);
     const float cosX = glm::dot(x.shadingNormal, wn);
     const float cosY = std::abs(glm::dot(e.normal, wn));
     if (!(cosX > 0.0f) || !(cosY > 0.0f)) return glm::vec3(0.0f);
@@ -309,9 +342,9 @@ glm::vec3 cosineDirection(const glm::vec3& n, Rng& rng) {
 // their only estimator there, plus the same reflection one level down). With more = 0 this is
 // the one-bounce estimator's vertex exactly (same random numbers, an occlusion ray).
 glm::vec3 reflected(const Shading& shading, const SurfaceHit& y, const SurfaceMaterial& my,
-                    uint32_t more, bool emitterLight, Rng& rng) {
+                    const glm::vec3& toPrevious, uint32_t more, bool emitterLight, Rng& rng) {
   const RayScene& rays = shading.rays();
-  glm::vec3 l = shading.directLights(y, my.diffuse);
+  glm::vec3 l = shading.directLights(y, my, toPrevious);
   const glm::vec3 dir = cosineDirection(y.shadingNormal, rng);
   const glm::vec3 origin = RayScene::spawnOrigin(y);
   if (more == 0) {
@@ -324,7 +357,7 @@ glm::vec3 reflected(const Shading& shading, const SurfaceHit& y, const SurfaceMa
   l += my.diffuse * shading.environmentLight(y, dir, false, rng);
   const SurfaceMaterial mz = shading.material(z);
   glm::vec3 lz = emitterLight ? mz.emission : glm::vec3(0.0f);
-  if (mz.diffuse != glm::vec3(0.0f)) lz += reflected(shading, z, mz, more - 1, emitterLight, rng);
+  lz += reflected(shading, z, mz, -dir, more - 1, emitterLight, rng);
   return l + my.diffuse * lz;
 }
 
@@ -369,8 +402,7 @@ glm::vec3 sampleQuantity(const Settings& s, const Shading& shading, const Primar
       glm::vec3 ly(0.0f);
       if (my.emission != glm::vec3(0.0f) && s.emitterLight)
         ly += my.emission * shading.bsdfWeight(p.hit, dir, y, my.emission);
-      if (my.diffuse != glm::vec3(0.0f))
-        ly += reflected(shading, y, my, s.bounces - 1, s.emitterLight, rng);
+      ly += reflected(shading, y, my, -dir, s.bounces - 1, s.emitterLight, rng);
       return p.base + emitted + sky + p.material.diffuse * ly;
     }
     case Quantity::Depth:
@@ -711,7 +743,10 @@ Result render(const Scene& scene, const Settings& settings) {
       setPixel(result.position, i, p.hit.position, 1.0f);
       if (lighting) {
         p.material = shading.material(p.hit);
-        p.base = p.material.emission + shading.directLights(p.hit, p.material.diffuse);
+        // Towards the eye, as the lighting pass's v = -position in view space (orthographic
+        // cameras too).
+        const glm::vec3 toEye = safeNormalize(glm::vec3(eye) - p.hit.position, -dirWorld);
+        p.base = p.material.emission + shading.directLights(p.hit, p.material, toEye);
       }
     }
   });

@@ -173,12 +173,12 @@ void SceneGpu::upload() {
   // scene's primitives each bring a material of their own, often the same one.
   std::vector<uint32_t> canonical(materials_.size());
   {
-    std::map<std::tuple<std::array<float, 9>, int>, uint32_t> seen;
+    std::map<std::tuple<std::array<float, 10>, int>, uint32_t> seen;
     for (uint32_t i = 0; i < materials_.size(); ++i) {
       const Material& m = materials_[i];
-      const std::array<float, 9> v = {m.baseColor.r, m.baseColor.g, m.baseColor.b,
-                                      m.baseColor.a, m.emission.r,  m.emission.g,
-                                      m.emission.b,  m.roughness,   m.metallic};
+      const std::array<float, 10> v = {
+          m.baseColor.r, m.baseColor.g, m.baseColor.b, m.baseColor.a, m.emission.r,
+          m.emission.g,  m.emission.b,  m.roughness,   m.metallic,    m.doubleSided ? 1.0f : 0.0f};
       const bool finite = std::all_of(v.begin(), v.end(), [](float x) { return std::isfinite(x); });
       canonical[i] = finite ? seen.try_emplace({v, m.baseColorTexture}, i).first->second : i;
     }
@@ -272,7 +272,7 @@ void SceneGpu::upload() {
                         ? m.baseColorTexture
                         : -1;
     materials.push_back({m.baseColor, glm::vec4(m.emission, 0.0f),
-                         glm::vec4(m.roughness, m.metallic, float(tex), 0.0f)});
+                         glm::vec4(m.roughness, m.metallic, float(tex), m.doubleSided)});
   }
   materialBuffer_ =
       createDeviceBuffer(ctx_, materials.data(), materials.size() * sizeof(GpuMaterial),
@@ -283,7 +283,7 @@ void SceneGpu::upload() {
     const MaterialUniforms u{
         m.baseColor, glm::vec4(glm::vec3(m.emission), 1.0f),
         glm::vec4(std::clamp(m.params.x, 0.0f, 1.0f), std::clamp(m.params.y, 0.0f, 1.0f),
-                  m.params.z >= 0.0f ? 1.0f : 0.0f, 0.0f)};
+                  m.params.z >= 0.0f ? 1.0f : 0.0f, m.params.w)};
     std::memcpy(&slots[i * kMaterialSlotBytes], &u, sizeof u);
   }
   materialUniforms_ =

@@ -743,6 +743,7 @@ class GltfLoader {
         invalid(where + ".extensions.KHR_materials_emissive_strength.emissiveStrength",
                 "must not be negative, got " + num(double(strength)));
       mat.emission = glm::vec3(float(e[0]), float(e[1]), float(e[2])) * strength;
+      mat.doubleSided = gm.doubleSided;
       scene_.materials.push_back(mat);
     }
   }

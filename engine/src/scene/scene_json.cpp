@@ -26,7 +26,8 @@
 //       "segments": 1,                     // box: s x s quads per face (1..64)
 //       "radius": 0.5, "segments": 32, "rings": 16,  // sphere only
 //       "material": { "name": "...", "base_color": [r, g, b(, a)], "emission": [r, g, b],
-//                     "roughness": 0.8, "metallic": 0.0 },
+//                     "roughness": 0.8, "metallic": 0.0, "double_sided": false },
+//       (emission leaves the side the normal points to; "double_sided": both sides)
 //       "name", "translation", "rotation", "scale", "animation" as above }
 //   ],
 //   "camera": { "position": [x, y, z] (required), "target": [x, y, z] (required),
@@ -215,7 +216,7 @@ float nonNegative(const JsonObject& o, const char* key, float fallback) {
 }
 
 Material readMaterial(const JsonObject& o) {
-  o.allowOnly({"name", "base_color", "emission", "roughness", "metallic"});
+  o.allowOnly({"name", "base_color", "emission", "roughness", "metallic", "double_sided"});
   Material m;
   m.name = o.string("name").value_or("material");
   if (auto c = o.numbers("base_color", {3, 4})) {
@@ -226,6 +227,7 @@ Material readMaterial(const JsonObject& o) {
   m.emission = nonNegativeColor(o, "emission", glm::vec3(0.0f));
   m.roughness = o.number("roughness").value_or(m.roughness);
   m.metallic = o.number("metallic").value_or(m.metallic);
+  m.doubleSided = o.boolean("double_sided").value_or(false);
   if (m.roughness < 0 || m.roughness > 1) o.invalid("roughness", "must be in [0, 1]");
   if (m.metallic < 0 || m.metallic > 1) o.invalid("metallic", "must be in [0, 1]");
   return m;

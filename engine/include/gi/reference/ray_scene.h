@@ -20,6 +20,9 @@ struct SurfaceHit {
   glm::vec3 position{0.0f};  // world space, from barycentrics (not org + t * dir)
   glm::vec3 geometricNormal{0.0f, 1.0f, 0.0f};  // unit, facing the ray's origin
   glm::vec3 shadingNormal{0.0f, 1.0f, 0.0f};    // interpolated, unit, facing the ray's origin
+  // The ray came from the side the interpolated normal points to as authored (before it was
+  // turned to face the origin): the side a one-sided emitter lights (Material::doubleSided).
+  bool frontFacing = true;
   glm::vec2 uv{0.0f};
   uint32_t material = 0;     // index into the scene's materials (clamped like the rasteriser)
   float offsetScale = 0.0f;  // scale of the surface's coordinates, for offsetting new rays
@@ -29,6 +32,7 @@ struct SurfaceHit {
 
 struct WorldTriangle {
   glm::vec3 p0{0.0f}, p1{0.0f}, p2{0.0f};  // world space, as intersected
+  glm::vec3 n0{0.0f}, n1{0.0f}, n2{0.0f};  // the vertex normals (world, unit), as authored
   uint32_t material = 0;
 };
 

@@ -17,14 +17,20 @@
 //  - Obscurance (seed 001 eq. 5):  O = (1/pi) int mu(t(w)) cos(theta) dw, mu a membership
 //    function reaching 1 at distance R = r (a miss counts 1).
 //  - Alchemy (seed 003): the integral the Alchemy AO estimator claims to estimate, see below.
-//  - Direct: L = Le + sum over point/spot/directional lights of (rho/pi) E_l cos V_l (the
+//  - Direct: L = Le + sum over point/spot/directional lights of f_r(l, v) E_l cos V_l (the
 //    rasteriser's light units and falloffs, plus a shadow ray) + (rho/pi) int L_env(w) V(w) cos
-//    dw (the procedural sky or constant environment, occluded by the scene), with rho the
-//    diffuse colour albedo * (1 - metallic). Diffuse only: no specular term.
+//    dw (the procedural sky or constant environment, occluded by the scene). The BRDF is the
+//    lighting pass's: f_r = rho/pi + f0 (s + 8)/(8 pi) max(n.h, 0)^s for the punctual lights
+//    (rho = albedo * (1 - metallic), f0 = mix(0.04, albedo, metallic), s the Blinn-Phong
+//    exponent of the roughness, lights.glsl shininessOf; v towards the eye), Lambert alone for
+//    the environment and for indirect light (the renderer has no specular term for them).
+//    Le only where the emitter is seen from its front side: the side its interpolated normal
+//    points to, or either side when the material is double-sided (the rasteriser's rule).
 //  - DirectIndirect: Direct + one diffuse bounce: (rho/pi) int L_1(y(w)) cos dw over the
 //    directions that hit a surface y, where L_1(y) = Le(y) + Direct-without-Le at y, i.e.
 //    emissive surfaces count as light sources here (only here: Direct ignores them as lights).
-//    Emitters are two-sided, like the rasteriser's surfaces.
+//    An emitter lights only its front side unless its material is double-sided. A bounce vertex
+//    y reflects the punctual lights with the same BRDF towards the previous vertex.
 //  - Depth, Normal: the primary hit (deterministic, one sample).
 //  - AOSplit ("ao-split"): AO as above, with its occlusion split by what a single-layer screen-
 //    space method can see. Each occluded direction of the AO estimator (something within r) is
@@ -122,6 +128,11 @@
 #include "gi/scene.h"
 
 namespace gi::reference {
+
+// The estimators' version: bumped whenever a quantity's definition or estimator changes, so
+// that results cached from an older one (gi-bench's reference cache) are not reused.
+// 2: the lighting pass's Blinn-Phong lobe for the punctual lights; one-sided emitters.
+inline constexpr int kVersion = 2;
 
 enum class Quantity {
   AO,
