@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <random>
+#include <stdexcept>
 
 #include "metrics.h"
 
@@ -92,11 +93,41 @@ TEST(BenchMetrics, DegenerateInputsAreFinite) {
   EXPECT_NEAR(compare(one, one, {}).ssim, 1.0, 1e-12);
   EXPECT_NEAR(compare(half, one, {}).nrmse, 0.5, 1e-9);
   EXPECT_NEAR(compare(one, zero, {}).nrmse, 1.0, 1e-9);  // reference mean 0: divided by 1
+  // An empty comparison is no result: the parts stay finite, compare() refuses it.
   const std::vector<unsigned char> none(256, 0);
-  const Metrics m = compare(half, one, none);
-  EXPECT_EQ(m.pixels, 0u);
-  EXPECT_EQ(m.nrmse, 0.0);
-  EXPECT_EQ(m.ssim, 1.0);
+  EXPECT_EQ(nrmse(half, one, none), 0.0);
+  EXPECT_EQ(ssim(half, one, none), 1.0);
+  EXPECT_THROW(compare(half, one, none), std::invalid_argument);
+}
+
+// The normaliser: the mean over the normaliser's pixels among the scored ones (the scored ones
+// when it keeps none of them); the noise floor on the same scale.
+TEST(BenchMetrics, NormaliserLeavesOutPixelsAndNoiseFloorSharesItsScale) {
+  // 16 x 16: a bright 2 x 2 "emitter" (10) on a 0.5 background; the test image is 0.1 off
+  // everywhere; the reference's standard error is 0.02 everywhere.
+  Plane ref{16, 16, std::vector<float>(256, 0.5f)};
+  std::vector<unsigned char> notEmitter(256, 1);
+  for (int y = 0; y < 2; ++y)
+    for (int x = 0; x < 2; ++x) {
+      ref.values[size_t(y) * 16 + size_t(x)] = 10.0f;
+      notEmitter[size_t(y) * 16 + size_t(x)] = 0;
+    }
+  Plane test = ref;
+  for (float& v : test.values) v += 0.1f;
+  const Plane stdError{16, 16, std::vector<float>(256, 0.02f)};
+  const Metrics all = compare(test, ref, {}, 1.0, nullptr, &stdError);
+  EXPECT_NEAR(all.normaliser, (252 * 0.5 + 4 * 10.0) / 256, 1e-6);
+  EXPECT_EQ(all.normaliserPixels, 256u);
+  const Metrics m = compare(test, ref, {}, 1.0, &notEmitter, &stdError);
+  EXPECT_EQ(m.pixels, 256u);  // still scored
+  EXPECT_EQ(m.normaliserPixels, 252u);
+  EXPECT_NEAR(m.normaliser, 0.5, 1e-6);
+  EXPECT_NEAR(m.nrmse, 0.1 / 0.5, 1e-5);
+  EXPECT_NEAR(m.noiseFloor, 0.02 / 0.5, 1e-6);
+  EXPECT_GT(m.nrmse, all.nrmse * 1.2);  // the emitter's pixels had hidden a quarter of it
+  // A normaliser keeping none of the scored pixels falls back to them.
+  const std::vector<unsigned char> none(256, 0);
+  EXPECT_EQ(compare(test, ref, {}, 1.0, &none).normaliserPixels, 256u);
 }
 
 // e = S - T splits into the declared quantity's gap D - T and the estimator's S - D.

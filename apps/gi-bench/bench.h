@@ -53,7 +53,12 @@ struct Row {
   unsigned referenceSpp = 0;
   double referenceStdError = 0.0;  // mean per-pixel standard error of the reference
   double nrmse = 0.0, ssim = 1.0;  // against the target
-  std::string declared;            // "obscurance linear r=0.5 spp=256" ...
+  // The target reference's own noise on NRMSE's scale (RMS standard error / normaliser over
+  // the scored pixels: what a perfect renderer would score) and the normaliser: the mean target
+  // over the scored pixels but emitters (lighting quantities), normaliserPixels of them.
+  double noiseFloor = 0.0, normaliser = 1.0;
+  size_t normaliserPixels = 0;
+  std::string declared;  // "obscurance linear r=0.5 spp=256" ...
   double declaredStdError = 0.0;
   double declaredNrmse = 0.0, declaredSsim = 1.0;
   // When the declared quantity is not the target: metrics.h QuantityGap (the target error a

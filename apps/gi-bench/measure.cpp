@@ -186,8 +186,7 @@ std::vector<Measurement> measureAll(
       m.floorReps = t.floor;
       m.out = renderers[i - first]->readTarget(jobs[i].resource);
       m.depth = renderers[i - first]->readTarget(gi::resources::kDepth);
-      if (o.excludeEmitters)
-        m.emission = renderers[i - first]->readTarget(gi::resources::kEmission);
+      m.emission = renderers[i - first]->readTarget(gi::resources::kEmission);
       renderers[i - first].reset();
       scoreNow(i, m);
       m.out = {};
@@ -221,28 +220,48 @@ std::vector<unsigned char> comparedMask(const Measurement& m, const Reference& r
   return mask;
 }
 
+// The pixels whose reference mean normalises the error: the scored ones but emitters (G-buffer
+// emission > 0), whose few bright pixels would otherwise set the scale (the room's lamp: 0.6% of
+// the pixels, 35% of the mean).
+std::vector<unsigned char> normaliserMask(const Measurement& m, std::vector<unsigned char> mask) {
+  if (m.emission.pixels.size() != mask.size() * 4) return mask;
+  for (size_t i = 0; i < mask.size(); ++i) {
+    const float* e = &m.emission.pixels[i * 4];
+    if (e[0] > 0.0f || e[1] > 0.0f || e[2] > 0.0f) mask[i] = 0;
+  }
+  return mask;
+}
+
 Scores score(const Measurement& m, const ReferenceSpec& spec, const Reference& reference,
              const Options& o, const std::string& scene) {
   const size_t n = size_t(o.width) * size_t(o.height);
   const std::vector<unsigned char> mask = comparedMask(m, reference, o);
+  if (std::none_of(mask.begin(), mask.end(), [](unsigned char k) { return k; }))
+    throw gi::Error(gi::ErrorKind::InvalidData, scene,
+                    "no pixel is geometry in both the frame and the reference (an empty scene, or "
+                    "a camera that sees nothing): there is nothing to score");
   const int w = int(o.width), h = int(o.height);
+  const bool stdError = reference.stdError.pixels.size() == n * 4;
   Scores s;
   if (gi::bench::isAoLike(spec.quantity)) {
+    const gi::bench::Plane noise = gi::bench::channel(w, h, reference.stdError.pixels, 0);
     s.metrics = gi::bench::compare(gi::bench::channel(w, h, m.out.pixels, 0),
-                                   gi::bench::channel(w, h, reference.value.pixels, 0), mask);
+                                   gi::bench::channel(w, h, reference.value.pixels, 0), mask, 1.0,
+                                   nullptr, stdError ? &noise : nullptr);
     if (spec.quantity == ref::Quantity::AOSplit && reference.split.pixels.size() == n * 4)
       s.split = splitError(m.out, reference, mask);
   } else {
     const gi::bench::Plane test = gi::bench::channel(w, h, m.out.pixels, -1);
     const gi::bench::Plane truth = gi::bench::channel(w, h, reference.value.pixels, -1);
-    s.metrics = gi::bench::compare(test, truth, mask);
+    // The luminance weights of the channels' standard errors: exact when the channels' errors
+    // are fully correlated (one path lights all three), an upper bound otherwise.
+    const gi::bench::Plane noise = gi::bench::channel(w, h, reference.stdError.pixels, -1);
+    const std::vector<unsigned char> normalised = normaliserMask(m, mask);
+    s.metrics =
+        gi::bench::compare(test, truth, mask, 1.0, &normalised, stdError ? &noise : nullptr);
     s.metrics.ssim =
         gi::bench::ssim(gi::bench::reinhard(test), gi::bench::reinhard(truth), mask, 1.0);
   }
-  if (s.metrics.pixels == 0)
-    throw gi::Error(gi::ErrorKind::InvalidData, scene,
-                    "no pixel is geometry in both the frame and the reference (an empty scene, or "
-                    "a camera that sees nothing): there is nothing to score");
   return s;
 }
 

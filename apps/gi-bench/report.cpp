@@ -113,7 +113,7 @@ std::string csv(const std::vector<Row>& rows) {
        "total_hi_ms,effect_ms,effect_lo_ms,effect_hi_ms,interval_coverage,floor_ms,"
        "total_over_floor,effect_over_floor,wall_ms,compared,reference,reference_spp,"
        "reference_stderr,pixels,nrmse,ssim,declared,declared_stderr,declared_nrmse,"
-       "declared_ssim,gap_nrmse,gap_share";
+       "declared_ssim,gap_nrmse,gap_share,noise_floor,normaliser,normaliser_pixels";
   // --ao-split runs only, so that other runs keep their columns.
   if (split)
     o << ",reference_seconds,limit_nrmse,offscreen_nrmse,hidden_nrmse,estimator_nrmse,"
@@ -133,7 +133,8 @@ std::string csv(const std::vector<Row>& rows) {
       << fmt(r.ssim, 6) << ',' << csvField(r.declared) << ',' << fmt(r.declaredStdError, 6) << ','
       << fmt(r.declaredNrmse, 6) << ',' << fmt(r.declaredSsim, 6) << ','
       << (r.gapPresent ? fmt(r.gapNrmse, 6) : std::string()) << ','
-      << (r.gapPresent ? fmt(r.gapShare, 6) : std::string());
+      << (r.gapPresent ? fmt(r.gapShare, 6) : std::string()) << ',' << fmt(r.noiseFloor, 6) << ','
+      << fmt(r.normaliser, 6) << ',' << r.normaliserPixels;
     if (split) {
       const Row::AoSplit& s = r.split;
       o << ',' << fmt(r.referenceSeconds, 6);
@@ -541,6 +542,7 @@ std::string profileTable(const std::vector<Row>& rows) {
       });
       line("effect ms", [](const Row& r) { return withInterval(r.effectCi, 3); });
       line("NRMSE vs target", [](const Row& r) { return fmt(r.nrmse, 3); });
+      line("reference noise", [](const Row& r) { return fmt(r.noiseFloor, 3); });
       line("NRMSE vs declared", [](const Row& r) { return fmt(r.declaredNrmse, 3); });
     }
   }
@@ -569,13 +571,17 @@ std::string markdown(const std::vector<Row>& rows, const RunInfo& info,
        "cost, not a portable one; its own median ranged "
     << floorRange(rows)
     << " ms across this run's configurations for identical work). NRMSE (RMSE / mean of the "
-       "reference) and "
+       "reference over the scored pixels, emitters left out of that mean for light: the "
+       "*normaliser* column gives it and its pixels) and "
        "SSIM compare the effect's output with CPU ray-traced references over the pixels that "
        "show geometry in both, twice: against the *target* (the physically meaningful quantity: "
        "AO of the effect's radius for AO-like effects, direct + indirect light for GI effects) "
        "and against the quantity the effect *declares* it estimates with these settings "
        "(obscurance with a membership, the Alchemy integral, ...; equal to the target when the "
-       "effect declares nothing else). Rows on the Pareto front of (time, NRMSE vs target) "
+       "effect declares nothing else). *Reference noise* is the target reference's own "
+       "error on the NRMSE scale (RMS of its per-pixel standard error / the normaliser): a "
+       "perfect renderer would score about that, so a difference between rows smaller than it "
+       "is no result. Rows on the Pareto front of (time, NRMSE vs target) "
        "within their scene and effect are marked *; a time difference inside the intervals "
        "does not keep a less accurate row on the front.\n\n";
   std::set<const Row*> onFront;
@@ -584,9 +590,10 @@ std::string markdown(const std::vector<Row>& rows, const RunInfo& info,
   for (const auto& [key, g] : groups)
     for (size_t i : paretoFront(g)) onFront.insert(g[i]);
   o << "| scene | effect | preset / params | GPU ms per pass [interval] | total ms [interval] | "
-       "effect ms [interval] | total x floor | effect x floor | target | NRMSE vs target | SSIM "
-       "vs target | declared | NRMSE vs declared | SSIM vs declared |\n"
-    << "|---|---|---|---|---:|---:|---:|---:|---|---:|---:|---|---:|---:|\n";
+       "effect ms [interval] | total x floor | effect x floor | target | NRMSE vs target | "
+       "reference noise | normaliser (pixels of scored) | SSIM vs target | declared | NRMSE vs "
+       "declared | SSIM vs declared |\n"
+    << "|---|---|---|---|---:|---:|---:|---:|---|---:|---:|---:|---:|---|---:|---:|\n";
   for (const Row& r : rows) {
     std::string passes;
     for (const PassTime& p : r.passes)
@@ -596,8 +603,10 @@ std::string markdown(const std::vector<Row>& rows, const RunInfo& info,
       << " | " << passes << " | " << withInterval(r.totalCi) << " | " << withInterval(r.effectCi)
       << " | " << fmt(r.floorMs > 0 ? r.totalMs / r.floorMs : 0.0, 3) << " | "
       << fmt(r.floorMs > 0 ? r.effectMs / r.floorMs : 0.0, 3) << " | " << r.compared << " vs "
-      << r.reference << " | " << fmt(r.nrmse, 4) << " | " << fmt(r.ssim, 4) << " | " << r.declared
-      << " | " << fmt(r.declaredNrmse, 4) << " | " << fmt(r.declaredSsim, 4) << " |\n";
+      << r.reference << " | " << fmt(r.nrmse, 4) << " | " << fmt(r.noiseFloor, 4) << " | "
+      << fmt(r.normaliser, 4) << " (" << r.normaliserPixels << " of " << r.pixels << ") | "
+      << fmt(r.ssim, 4) << " | " << r.declared << " | " << fmt(r.declaredNrmse, 4) << " | "
+      << fmt(r.declaredSsim, 4) << " |\n";
   }
   if (anySplit(rows)) o << splitSection(rows);
   o << gapSection(rows);

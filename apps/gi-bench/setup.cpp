@@ -20,6 +20,7 @@
 
 #include "cli.h"
 #include "gi/input_file.h"
+#include "gi/scene_hash.h"
 #include "gi/scene_io.h"
 #include "progress.h"
 #include "quantity.h"
@@ -35,7 +36,10 @@ uint64_t fnv1a(const std::string& s, uint64_t h = 1469598103934665603ULL) {
 
 std::string cacheStem(const Options& o, const LoadedScene& s, const ReferenceKey& k) {
   std::ostringstream key;
-  key << "gi-bench-reference-v3|" << s.contents.size() << '|';
+  // The reference code's version and the loaded scene's content (every file it read: meshes,
+  // textures, environment map), beside the scene file itself.
+  key << "gi-bench-reference-v3|" << ref::kVersion << '|' << gi::sceneContentHash(s.scene) << '|'
+      << s.contents.size() << '|';
   const gi::CameraView cam = gi::activeCamera(s.scene, float(o.width) / float(o.height));
   const float* v = &cam.view[0][0];
   const float* p = &cam.proj[0][0];
@@ -64,12 +68,14 @@ Reference computeReference(const Options& o, const LoadedScene& s, const Referen
       const nlohmann::json meta = nlohmann::json::parse(in);
       r.value = gi::readPfm(stem + ".value.pfm");
       r.depth = gi::readPfm(stem + ".depth.pfm");
+      r.stdError = gi::readPfm(stem + ".stderr.pfm");
       if (k.spec.quantity == ref::Quantity::AOSplit) r.split = gi::readPfm(stem + ".split.pfm");
       r.spp = meta.at("spp");
       r.meanStdError = meta.at("mean_stderr");
       r.seconds = meta.at("seconds");
       r.cached = true;
       if (r.value.width == int(o.width) && r.value.height == int(o.height) &&
+          r.stdError.width == r.value.width && r.stdError.height == r.value.height &&
           (k.spec.quantity != ref::Quantity::AOSplit ||
            (r.split.width == r.value.width && r.split.height == r.value.height)))
         return r;
@@ -88,11 +94,13 @@ Reference computeReference(const Options& o, const LoadedScene& s, const Referen
   rs.emitterLight = o.emitterLight;
   rs.bounces = o.refBounces;
   ref::Result res = ref::render(s.scene, rs);
-  r = Reference{res.value, res.depth, res.split, res.spp, res.meanStdError, res.seconds, false};
+  r = Reference{res.value, res.depth,        res.stdError, res.split,
+                res.spp,   res.meanStdError, res.seconds,  false};
   fs::create_directories(o.cache);
   // The metadata is written last: its presence marks a complete entry.
   gi::writePfm(stem + ".value.pfm", r.value);
   gi::writePfm(stem + ".depth.pfm", r.depth);
+  gi::writePfm(stem + ".stderr.pfm", r.stdError);
   if (k.spec.quantity == ref::Quantity::AOSplit) gi::writePfm(stem + ".split.pfm", r.split);
   nlohmann::json meta = {{"scene", s.name},
                          {"quantity", gi::bench::label(k.spec)},

@@ -18,7 +18,8 @@ namespace gi_bench {
 
 struct Reference {
   gi::ImageRGBA32F value, depth;
-  gi::ImageRGBA32F split;  // ao-split only: AO_visible, f_off, f_hid (reference.h)
+  gi::ImageRGBA32F stdError;  // per-pixel standard error of value (rgb)
+  gi::ImageRGBA32F split;     // ao-split only: AO_visible, f_off, f_hid (reference.h)
   uint32_t spp = 0;
   double meanStdError = 0.0, seconds = 0.0;
   bool cached = false;

@@ -261,6 +261,9 @@ int runSweep(const Options& o) {
     r.referenceSpp = target.spp;
     r.referenceStdError = target.meanStdError;
     r.nrmse = vsTarget.metrics.nrmse;
+    r.noiseFloor = vsTarget.metrics.noiseFloor;
+    r.normaliser = vsTarget.metrics.normaliser;
+    r.normaliserPixels = vsTarget.metrics.normaliserPixels;
     r.ssim = vsTarget.metrics.ssim;
     r.pixels = vsTarget.metrics.pixels;
     r.referenceSeconds = target.seconds;

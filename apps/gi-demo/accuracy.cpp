@@ -110,6 +110,13 @@ void AccuracyCheck::finish() {
   std::vector<unsigned char> mask(n);
   for (size_t i = 0; i < n; ++i)
     mask[i] = r.depth.pixels[i * 4 + 2] > 0.5f && p->depth.pixels[i * 4] > 0.0f;
+  if (std::find(mask.begin(), mask.end(), 1) == mask.end()) {
+    // As gi-bench: an empty comparison is not a perfect score.
+    error_ =
+        "no pixel is geometry in both the frame and the reference (the camera sees only "
+        "sky): there is nothing to score";
+    return;
+  }
   const int c = p->aoLike ? 0 : -1;  // AO-like: the scalar; lighting: luminance
   const gi::bench::Plane test = gi::bench::channel(w, h, p->test.pixels, c);
   const gi::bench::Plane truth = gi::bench::channel(w, h, r.value.pixels, c);

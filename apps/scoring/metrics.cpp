@@ -113,19 +113,53 @@ double ssim(const Plane& test, const Plane& reference, const std::vector<unsigne
   return std::isfinite(s) ? s : 0.0;
 }
 
+double normaliserMean(const Plane& reference, const std::vector<unsigned char>& mask,
+                      size_t* pixels) {
+  double sum = 0.0;
+  size_t n = 0;
+  for (size_t i = 0; i < reference.values.size(); ++i) {
+    if (!kept(mask, i)) continue;
+    sum += std::abs(double(sanitize(reference.values[i])));
+    ++n;
+  }
+  if (pixels) *pixels = n;
+  const double mean = n > 0 ? sum / double(n) : 0.0;
+  return mean > 1e-8 ? mean : 1.0;
+}
+
 Metrics compare(const Plane& test, const Plane& reference, const std::vector<unsigned char>& mask,
-                double dynamicRange) {
+                double dynamicRange, const std::vector<unsigned char>* normaliserMask,
+                const Plane* referenceStdError) {
+  checkSizes(test, reference, mask);
+  if (!mask.empty() && std::none_of(mask.begin(), mask.end(), [](unsigned char m) { return m; }))
+    throw std::invalid_argument("metrics: the mask keeps no pixel: there is nothing to score");
+  if (test.values.empty())
+    throw std::invalid_argument("metrics: empty images: there is nothing to score");
+  if (normaliserMask) checkSizes(test, reference, *normaliserMask);
+  if (referenceStdError) checkSizes(test, *referenceStdError, mask);
   Metrics r;
-  r.nrmse = nrmse(test, reference, mask);
   r.ssim = ssim(test, reference, mask, dynamicRange);
-  double se = 0.0;
+  double se = 0.0, var = 0.0;
   for (size_t i = 0; i < test.values.size(); ++i) {
     if (!kept(mask, i)) continue;
     const double d = double(sanitize(test.values[i])) - double(sanitize(reference.values[i]));
     se += d * d;
+    if (referenceStdError) var += std::pow(double(sanitize(referenceStdError->values[i])), 2);
     ++r.pixels;
   }
-  r.rmse = r.pixels ? std::sqrt(se / double(r.pixels)) : 0.0;
+  r.rmse = std::sqrt(se / double(r.pixels));
+  // The normaliser's pixels: the given ones among the scored; none left: the scored ones.
+  std::vector<unsigned char> normalised;
+  if (normaliserMask) {
+    normalised.resize(test.values.size());
+    for (size_t i = 0; i < normalised.size(); ++i)
+      normalised[i] = kept(mask, i) && (*normaliserMask)[i];
+  }
+  r.normaliser = normaliserMean(reference, normalised, &r.normaliserPixels);
+  if (normaliserMask && r.normaliserPixels == 0)
+    r.normaliser = normaliserMean(reference, mask, &r.normaliserPixels);
+  r.nrmse = r.rmse / r.normaliser;
+  r.noiseFloor = referenceStdError ? std::sqrt(var / double(r.pixels)) / r.normaliser : 0.0;
   return r;
 }
 

@@ -9,7 +9,12 @@
 //    (0.03 L)^2 with L the dynamic range (1 for AO and for tonemapped lighting). Window
 //    statistics are weighted by the mask, so masked pixels contribute nothing; the result is
 //    the mean SSIM over the kept pixels.
-//  - No kept pixel at all: NRMSE 0, SSIM 1 and pixels 0 (never NaN).
+//  - No kept pixel at all: nrmse() and ssim() give 0 and 1 (never NaN); compare(), what the
+//    apps score with, refuses it (std::invalid_argument): an empty comparison is no result.
+//  - compare() may divide by the mean over fewer pixels than it scores (`normaliserMask`, e.g.
+//    without the emitters, whose few bright pixels would dominate the mean) and report the
+//    reference's own noise on the same scale (`referenceStdError`: RMS of the per-pixel
+//    standard error / normaliser; a perfect renderer scores about this NRMSE).
 #pragma once
 
 #include <cstddef>
@@ -26,7 +31,10 @@ struct Metrics {
   double nrmse = 0.0;
   double rmse = 0.0;
   double ssim = 1.0;
-  size_t pixels = 0;  // kept pixels
+  size_t pixels = 0;            // kept (scored) pixels
+  double normaliser = 1.0;      // the mean |reference| NRMSE divides by
+  size_t normaliserPixels = 0;  // the pixels of that mean
+  double noiseFloor = 0.0;      // RMS(reference standard error) / normaliser; 0: not given
 };
 
 // `mask`: empty (keep everything) or width * height entries, nonzero = keep. Non-finite test
@@ -36,7 +44,9 @@ double nrmse(const Plane& test, const Plane& reference, const std::vector<unsign
 double ssim(const Plane& test, const Plane& reference, const std::vector<unsigned char>& mask,
             double dynamicRange = 1.0);
 Metrics compare(const Plane& test, const Plane& reference, const std::vector<unsigned char>& mask,
-                double dynamicRange = 1.0);
+                double dynamicRange = 1.0,
+                const std::vector<unsigned char>* normaliserMask = nullptr,
+                const Plane* referenceStdError = nullptr);
 
 // How much of an effect's error against its physical target T comes from the quantity it
 // declares, D, differing from T: e = S - T = (S - D) + (D - T). gapNrmse = RMS(D - T) / mean|T|
