@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -142,6 +144,38 @@ TEST(BenchTarget, ExcludeEmittersLeavesTheLampOut) {
   EXPECT_GT(c["pixels"].get<size_t>(), a["pixels"].get<size_t>() * 9 / 10);
   EXPECT_EQ(c["reference"], a["reference"]);
   EXPECT_NE(c["nrmse"], a["nrmse"]);
+}
+
+// The reference's noise: every row carries its floor (RMS standard error / normaliser) and the
+// normaliser, which leaves the lamp's pixels out. A 4-spp reference is far too noisy for the
+// engine alone's error (about 0.4 of the mean) and is rendered again with more samples until
+// the floor is at most a quarter of it (then within the cap), or stops at --ref-spp-max and
+// says so.
+TEST(BenchTarget, ReferencesAreRefinedUntilTheirNoiseIsAQuarterOfTheError) {
+  const std::string dir = test::makeTempDir("bench-ref-noise");
+  const std::string args = "--effects none --target direct+indirect --ref-spp 4";
+  const nlohmann::json fixed = sweep(dir, "fixed", args);  // --quick: no refinement
+  const nlohmann::json refined = sweep(dir, "refined", args + " --ref-spp-max 2048");
+  const nlohmann::json capped = sweep(dir, "capped", args + " --ref-spp-max 8");
+  const auto &f = row(fixed, "none"), &r = row(refined, "none"), &c = row(capped, "none");
+  std::printf("4 spp: NRMSE %.4f noise %.4f; refined to %d spp: NRMSE %.4f noise %.4f\n",
+              f["nrmse"].get<double>(), f["noise_floor"].get<double>(),
+              r["reference_spp"].get<int>(), r["nrmse"].get<double>(),
+              r["noise_floor"].get<double>());
+  EXPECT_EQ(f["reference_spp"].get<int>(), 4);
+  EXPECT_GT(f["noise_floor"].get<double>(), 0.25 * f["nrmse"].get<double>());
+  EXPECT_GT(r["reference_spp"].get<int>(), 4);
+  EXPECT_LE(r["noise_floor"].get<double>(), 0.25 * r["nrmse"].get<double>());
+  EXPECT_FALSE(r["noise_capped"].get<bool>());
+  // The noise falls as 1 / sqrt(spp), and the NRMSE with it (part of it was the reference's).
+  EXPECT_NEAR(r["noise_floor"].get<double>() / f["noise_floor"].get<double>() /
+                  std::sqrt(4.0 / r["reference_spp"].get<double>()),
+              1.0, 0.4);
+  EXPECT_LT(r["nrmse"].get<double>(), f["nrmse"].get<double>());
+  // The normaliser leaves the lamp out: fewer pixels than scored, a smaller mean.
+  EXPECT_LT(r["normaliser_pixels"].get<size_t>(), r["pixels"].get<size_t>());
+  EXPECT_EQ(c["reference_spp"].get<int>(), 8);
+  EXPECT_TRUE(c["noise_capped"].get<bool>());
 }
 
 // --no-emitter-light: the direct+indirect reference in which the default room's lamp (an

@@ -58,7 +58,8 @@ struct Row {
   // over the scored pixels but emitters (lighting quantities), normaliserPixels of them.
   double noiseFloor = 0.0, normaliser = 1.0;
   size_t normaliserPixels = 0;
-  std::string declared;  // "obscurance linear r=0.5 spp=256" ...
+  bool noiseCapped = false;  // the target reference stopped at --ref-spp-max above 1/4 NRMSE
+  std::string declared;      // "obscurance linear r=0.5 spp=256" ...
   double declaredStdError = 0.0;
   double declaredNrmse = 0.0, declaredSsim = 1.0;
   // When the declared quantity is not the target: metrics.h QuantityGap (the target error a

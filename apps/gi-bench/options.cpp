@@ -36,6 +36,11 @@ const char* kUsage =
     "                        95%; R = 5 gives [min, max], 93.75%)\n"
     "  --width W --height H  resolution (default 320x240)\n"
     "  --ref-spp N           reference samples per pixel (default 256)\n"
+    "  --ref-spp-max N       a sweep renders a reference again with more samples until its\n"
+    "                        noise floor (RMS standard error / normaliser) is at most a\n"
+    "                        quarter of the smallest NRMSE it scores, up to N samples\n"
+    "                        (default 8 x --ref-spp; --quick: --ref-spp, no refinement);\n"
+    "                        the report marks references that stopped at N\n"
     "  --ref-seed N          reference seed (default 1)\n"
     "  --target Q            score every configuration's lit image against light quantity Q\n"
     "                        (direct or direct+indirect) instead of each effect's own target:\n"
@@ -140,6 +145,8 @@ Options parseArgs(int argc, char** argv) {
     } else if (a.is("--ref-spp")) {
       o.refSpp = uint32_t(a.integer(1, 1 << 20));
       o.sppGiven = true;
+    } else if (a.is("--ref-spp-max")) {
+      o.refSppMax = uint32_t(a.integer(1, 1 << 20));
     } else if (a.is("--ref-seed"))
       o.refSeed = uint64_t(a.integer(0, 1000000000000000));
     else if (a.is("--cache"))
@@ -214,6 +221,8 @@ Options parseArgs(int argc, char** argv) {
     if (!o.framesGiven) o.frames = 2;
     if (!o.sppGiven) o.refSpp = 16;
   }
+  if (o.refSppMax == 0) o.refSppMax = o.quick ? o.refSpp : 8 * o.refSpp;
+  if (o.refSppMax < o.refSpp) usageError("--ref-spp-max", "must be at least --ref-spp");
   if (o.cache.empty()) o.cache = defaultCacheDir();
   // Where results go is checked now, not after the sweep and its references.
   if (o.calibrate) {

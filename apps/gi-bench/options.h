@@ -26,6 +26,9 @@ struct Options {
   std::vector<std::string> scenes{"default"}, presets{"none"}, grids;
   std::optional<std::vector<std::string>> effects;
   uint32_t width = 320, height = 240, refSpp = 256;
+  // Sweeps refine a reference (more samples) until its noise floor is at most a quarter of the
+  // smallest NRMSE it scores, up to this many samples (0: 8 x refSpp; --quick: refSpp).
+  uint32_t refSppMax = 0;
   uint64_t refSeed = 1;
   int frames = 5, reps = 5;
   bool hardCases = false;

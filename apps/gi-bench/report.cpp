@@ -113,7 +113,7 @@ std::string csv(const std::vector<Row>& rows) {
        "total_hi_ms,effect_ms,effect_lo_ms,effect_hi_ms,interval_coverage,floor_ms,"
        "total_over_floor,effect_over_floor,wall_ms,compared,reference,reference_spp,"
        "reference_stderr,pixels,nrmse,ssim,declared,declared_stderr,declared_nrmse,"
-       "declared_ssim,gap_nrmse,gap_share,noise_floor,normaliser,normaliser_pixels";
+       "declared_ssim,gap_nrmse,gap_share,noise_floor,normaliser,normaliser_pixels,noise_capped";
   // --ao-split runs only, so that other runs keep their columns.
   if (split)
     o << ",reference_seconds,limit_nrmse,offscreen_nrmse,hidden_nrmse,estimator_nrmse,"
@@ -134,7 +134,7 @@ std::string csv(const std::vector<Row>& rows) {
       << fmt(r.declaredNrmse, 6) << ',' << fmt(r.declaredSsim, 6) << ','
       << (r.gapPresent ? fmt(r.gapNrmse, 6) : std::string()) << ','
       << (r.gapPresent ? fmt(r.gapShare, 6) : std::string()) << ',' << fmt(r.noiseFloor, 6) << ','
-      << fmt(r.normaliser, 6) << ',' << r.normaliserPixels;
+      << fmt(r.normaliser, 6) << ',' << r.normaliserPixels << ',' << (r.noiseCapped ? 1 : 0);
     if (split) {
       const Row::AoSplit& s = r.split;
       o << ',' << fmt(r.referenceSeconds, 6);
@@ -188,6 +188,10 @@ std::string json(const std::vector<Row>& rows, const RunInfo& info) {
                             {"reference_stderr", r.referenceStdError},
                             {"pixels", r.pixels},
                             {"nrmse", r.nrmse},
+                            {"noise_floor", r.noiseFloor},
+                            {"noise_capped", r.noiseCapped},
+                            {"normaliser", r.normaliser},
+                            {"normaliser_pixels", r.normaliserPixels},
                             {"ssim", r.ssim},
                             {"declared", r.declared},
                             {"declared_stderr", r.declaredStdError},
@@ -581,7 +585,9 @@ std::string markdown(const std::vector<Row>& rows, const RunInfo& info,
        "effect declares nothing else). *Reference noise* is the target reference's own "
        "error on the NRMSE scale (RMS of its per-pixel standard error / the normaliser): a "
        "perfect renderer would score about that, so a difference between rows smaller than it "
-       "is no result. Rows on the Pareto front of (time, NRMSE vs target) "
+       "is no result. References are rendered with more samples until it is at most a "
+       "quarter of the smallest NRMSE they score, up to --ref-spp-max; *(cap)* marks one that "
+       "stopped there. Rows on the Pareto front of (time, NRMSE vs target) "
        "within their scene and effect are marked *; a time difference inside the intervals "
        "does not keep a less accurate row on the front.\n\n";
   std::set<const Row*> onFront;
@@ -603,10 +609,10 @@ std::string markdown(const std::vector<Row>& rows, const RunInfo& info,
       << " | " << passes << " | " << withInterval(r.totalCi) << " | " << withInterval(r.effectCi)
       << " | " << fmt(r.floorMs > 0 ? r.totalMs / r.floorMs : 0.0, 3) << " | "
       << fmt(r.floorMs > 0 ? r.effectMs / r.floorMs : 0.0, 3) << " | " << r.compared << " vs "
-      << r.reference << " | " << fmt(r.nrmse, 4) << " | " << fmt(r.noiseFloor, 4) << " | "
-      << fmt(r.normaliser, 4) << " (" << r.normaliserPixels << " of " << r.pixels << ") | "
-      << fmt(r.ssim, 4) << " | " << r.declared << " | " << fmt(r.declaredNrmse, 4) << " | "
-      << fmt(r.declaredSsim, 4) << " |\n";
+      << r.reference << " | " << fmt(r.nrmse, 4) << " | " << fmt(r.noiseFloor, 4)
+      << (r.noiseCapped ? " (cap)" : "") << " | " << fmt(r.normaliser, 4) << " ("
+      << r.normaliserPixels << " of " << r.pixels << ") | " << fmt(r.ssim, 4) << " | " << r.declared
+      << " | " << fmt(r.declaredNrmse, 4) << " | " << fmt(r.declaredSsim, 4) << " |\n";
   }
   if (anySplit(rows)) o << splitSection(rows);
   o << gapSection(rows);

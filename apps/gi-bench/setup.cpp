@@ -34,7 +34,7 @@ uint64_t fnv1a(const std::string& s, uint64_t h = 1469598103934665603ULL) {
   return h;
 }
 
-std::string cacheStem(const Options& o, const LoadedScene& s, const ReferenceKey& k) {
+std::string cacheStem(const Options& o, const LoadedScene& s, const ReferenceKey& k, uint32_t spp) {
   std::ostringstream key;
   // The reference code's version and the loaded scene's content (every file it read: meshes,
   // textures, environment map), beside the scene file itself.
@@ -48,9 +48,9 @@ std::string cacheStem(const Options& o, const LoadedScene& s, const ReferenceKey
     std::snprintf(buf, sizeof buf, "%a,%a,", double(v[i]), double(p[i]));
     key << buf;
   }
-  key << '|' << o.width << 'x' << o.height << '|' << gi::bench::keyText(k.spec) << '|' << o.refSpp
-      << '|' << o.refSeed << '|' << s.scene.triangleCount()
-      << (o.emitterLight ? "" : "|dark-emitters") << "|bounces" << o.refBounces;
+  key << '|' << o.width << 'x' << o.height << '|' << gi::bench::keyText(k.spec) << '|' << spp << '|'
+      << o.refSeed << '|' << s.scene.triangleCount() << (o.emitterLight ? "" : "|dark-emitters")
+      << "|bounces" << o.refBounces;
   char hex[17];
   std::snprintf(hex, sizeof hex, "%016llx",
                 static_cast<unsigned long long>(fnv1a(s.contents, fnv1a(key.str()))));
@@ -59,8 +59,10 @@ std::string cacheStem(const Options& o, const LoadedScene& s, const ReferenceKey
 
 }  // namespace
 
-Reference computeReference(const Options& o, const LoadedScene& s, const ReferenceKey& k) {
-  const std::string stem = cacheStem(o, s, k);
+Reference computeReference(const Options& o, const LoadedScene& s, const ReferenceKey& k,
+                           uint32_t spp) {
+  if (spp == 0) spp = o.refSpp;
+  const std::string stem = cacheStem(o, s, k, spp);
   Reference r;
   if (fs::exists(stem + ".json")) {
     try {
@@ -88,8 +90,8 @@ Reference computeReference(const Options& o, const LoadedScene& s, const Referen
   rs.width = o.width;
   rs.height = o.height;
   gi::bench::apply(k.spec, rs);
-  rs.spp = o.refSpp;
-  rs.minSpp = std::min(rs.minSpp, o.refSpp);
+  rs.spp = spp;
+  rs.minSpp = std::min(rs.minSpp, spp);
   rs.seed = o.refSeed;
   rs.emitterLight = o.emitterLight;
   rs.bounces = o.refBounces;

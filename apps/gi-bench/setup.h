@@ -47,8 +47,10 @@ struct Setup {
 };
 
 void loadInputs(const Options& o, Setup& s);
-// The CPU reference of one key, from the cache (o.cache) or rendered and cached.
-Reference computeReference(const Options& o, const LoadedScene& s, const ReferenceKey& k);
+// The CPU reference of one key at `spp` samples (0: o.refSpp), from the cache (o.cache) or
+// rendered and cached.
+Reference computeReference(const Options& o, const LoadedScene& s, const ReferenceKey& k,
+                           uint32_t spp = 0);
 // Every key's reference (each once), with a progress bar.
 std::map<ReferenceKey, Reference> computeReferences(const Options& o, const Setup& s,
                                                     const std::vector<ReferenceKey>& keys);

@@ -12,6 +12,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -177,6 +178,68 @@ void checkFinite(const Row& r) {
                       "non-finite measurement for " + r.effect + " " + r.params);
 }
 
+// A reference's noise is part of every error measured against it: NRMSE^2 is about the
+// renderer's own error^2 plus the noise floor^2. Each reference is rendered again with more
+// samples (noise ~ 1 / sqrt(spp)) until its floor is at most a quarter of the smallest NRMSE
+// it scores (the floor then adds at most 3% to that NRMSE), or o.refSppMax; `rescore(i)`
+// scores configuration i again. Returns the references that stopped at the cap.
+std::set<ReferenceKey> refineReferences(const Options& o, const Setup& s,
+                                        const std::vector<Config>& configs,
+                                        std::map<ReferenceKey, Reference>& refs,
+                                        const std::vector<Scores>& vsTargets,
+                                        const std::vector<Scores>& vsDeclareds,
+                                        const std::function<void(size_t)>& rescore) {
+  std::set<ReferenceKey> capped;
+  for (int round = 0; round < 4; ++round) {
+    // Per reference: the smallest NRMSE it scores and its noise floor there.
+    std::map<ReferenceKey, std::pair<double, double>> worst;  // key -> (min nrmse, floor)
+    for (size_t i = 0; i < configs.size(); ++i)
+      for (const auto& [spec, sc] : {std::pair{configs[i].comparison.target, &vsTargets[i]},
+                                     std::pair{configs[i].comparison.declared, &vsDeclareds[i]}}) {
+        const ReferenceKey k{configs[i].scene, spec};
+        auto [it, added] = worst.try_emplace(k, sc->metrics.nrmse, sc->metrics.noiseFloor);
+        if (!added && sc->metrics.nrmse < it->second.first)
+          it->second = {sc->metrics.nrmse, sc->metrics.noiseFloor};
+      }
+    std::set<ReferenceKey> renewed;
+    for (const auto& [k, v] : worst) {
+      const auto [nrmse, floor] = v;
+      Reference& r = refs.at(k);
+      if (!(floor > 0.25 * nrmse)) {
+        capped.erase(k);
+        continue;
+      }
+      if (r.spp >= o.refSppMax) {
+        capped.insert(k);
+        continue;
+      }
+      // (floor / target)^2 more samples, 10% beyond, in whole powers of two of the base.
+      const double target = std::max(0.25 * nrmse, 1e-9);
+      const double want = double(r.spp) * std::pow(floor / target, 2.0) * 1.1;
+      uint32_t spp = r.spp;
+      while (double(spp) < want && spp < o.refSppMax) spp = std::min(spp * 2, o.refSppMax);
+      std::fprintf(stderr,
+                   "gi-bench: %s %s: reference noise %.4f > 1/4 of the smallest NRMSE %.4f: "
+                   "%u -> %u spp\n",
+                   s.scenes[k.scene].name.c_str(), gi::bench::label(k.spec).c_str(), floor, nrmse,
+                   r.spp, spp);
+      r = computeReference(o, s.scenes[k.scene], k, spp);
+      renewed.insert(k);
+    }
+    if (renewed.empty()) break;
+    for (size_t i = 0; i < configs.size(); ++i)
+      if (renewed.count({configs[i].scene, configs[i].comparison.target}) ||
+          renewed.count({configs[i].scene, configs[i].comparison.declared}))
+        rescore(i);
+  }
+  for (const ReferenceKey& k : capped)
+    std::fprintf(stderr,
+                 "gi-bench: warning: %s %s: the reference stopped at --ref-spp-max %u samples with "
+                 "its noise floor above a quarter of the smallest NRMSE it scores\n",
+                 s.scenes[k.scene].name.c_str(), gi::bench::label(k.spec).c_str(), o.refSppMax);
+  return capped;
+}
+
 }  // namespace
 
 int runSweep(const Options& o) {
@@ -195,7 +258,7 @@ int runSweep(const Options& o) {
                        [&](const ReferenceKey& x) { return !(x < k) && !(k < x); }) == keys.end())
         keys.push_back(k);
     }
-  const std::map<ReferenceKey, Reference> refs = computeReferences(o, s, keys);
+  std::map<ReferenceKey, Reference> refs = computeReferences(o, s, keys);
   gi::vk::Context ctx = makeContext(o);
   std::vector<RenderJob> jobs;
   for (const Config& c : configs)
@@ -203,18 +266,35 @@ int runSweep(const Options& o) {
   ProgressBar bar(o.progress, "configurations", configs.size());
   std::vector<Scores> vsTargets(configs.size()), vsDeclareds(configs.size());
   std::vector<std::optional<gi::bench::QuantityGap>> gaps(configs.size());
+  // The images scores are made from, kept while a reference may still be refined.
+  std::vector<Measurement> images(configs.size());
+  auto scoreConfig = [&](size_t i, const Measurement& m) {
+    const Config& c = configs[i];
+    const std::string& scene = s.scenes[c.scene].name;
+    vsTargets[i] = score(m, c.comparison.target,
+                         refs.at(ReferenceKey{c.scene, c.comparison.target}), o, scene);
+    vsDeclareds[i] = score(m, c.comparison.declared,
+                           refs.at(ReferenceKey{c.scene, c.comparison.declared}), o, scene);
+    gaps[i] = gapOf(m, c.comparison, refs.at(ReferenceKey{c.scene, c.comparison.target}),
+                    refs.at(ReferenceKey{c.scene, c.comparison.declared}), o);
+  };
+  const bool refine = o.refSppMax > o.refSpp;
   const std::vector<Measurement> measured =
       measureAll(ctx, s.registry, jobs, o, true, [&](size_t i, const Measurement& m) {
-        const Config& c = configs[i];
-        const std::string& scene = s.scenes[c.scene].name;
-        vsTargets[i] = score(m, c.comparison.target,
-                             refs.at(ReferenceKey{c.scene, c.comparison.target}), o, scene);
-        vsDeclareds[i] = score(m, c.comparison.declared,
-                               refs.at(ReferenceKey{c.scene, c.comparison.declared}), o, scene);
-        gaps[i] = gapOf(m, c.comparison, refs.at(ReferenceKey{c.scene, c.comparison.target}),
-                        refs.at(ReferenceKey{c.scene, c.comparison.declared}), o);
-        bar.step(s.scenes[c.scene].name + " " + c.effectLabel + " " + c.params);
+        scoreConfig(i, m);
+        if (refine) {
+          images[i].out = m.out;
+          images[i].depth = m.depth;
+          images[i].emission = m.emission;
+        }
+        bar.step(s.scenes[configs[i].scene].name + " " + configs[i].effectLabel + " " +
+                 configs[i].params);
       });
+  const std::set<ReferenceKey> capped =
+      refine ? refineReferences(o, s, configs, refs, vsTargets, vsDeclareds,
+                                [&](size_t i) { scoreConfig(i, images[i]); })
+             : std::set<ReferenceKey>{};
+  images.clear();
   std::vector<Row> rows;
   for (size_t i = 0; i < configs.size(); ++i) {
     const Config& c = configs[i];
@@ -262,6 +342,7 @@ int runSweep(const Options& o) {
     r.referenceStdError = target.meanStdError;
     r.nrmse = vsTarget.metrics.nrmse;
     r.noiseFloor = vsTarget.metrics.noiseFloor;
+    r.noiseCapped = capped.count(ReferenceKey{c.scene, c.comparison.target}) > 0;
     r.normaliser = vsTarget.metrics.normaliser;
     r.normaliserPixels = vsTarget.metrics.normaliserPixels;
     r.ssim = vsTarget.metrics.ssim;
