@@ -178,6 +178,23 @@ TEST(BenchTarget, ReferencesAreRefinedUntilTheirNoiseIsAQuarterOfTheError) {
   EXPECT_TRUE(c["noise_capped"].get<bool>());
 }
 
+// Against the engine alone: the share of its error a configuration removes, and the share of
+// the reference's indirect light it delivers. SSAO only darkens: it delivers less than none.
+TEST(BenchTarget, RowsSayWhatTheyRecoverOfTheEngineAlonesError) {
+  if (!hasPlugin("ssao")) GTEST_SKIP() << "ssao plugin needed";
+  const std::string dir = test::makeTempDir("bench-recovered");
+  const nlohmann::json j = sweep(dir, "out", "--effects none,ssao --target direct+indirect");
+  const auto &none = row(j, "none"), &ssao = row(j, "ssao");
+  EXPECT_DOUBLE_EQ(none["error_removed"].get<double>(), 0.0);
+  EXPECT_DOUBLE_EQ(none["indirect_delivered"].get<double>(), 0.0);
+  EXPECT_NEAR(ssao["error_removed"].get<double>(),
+              1.0 - ssao["nrmse"].get<double>() / none["nrmse"].get<double>(), 1e-12);
+  EXPECT_LT(ssao["indirect_delivered"].get<double>(), 0.0);
+  // Without an engine-alone row of the same target there is nothing to compare with.
+  const nlohmann::json alone = sweep(dir, "alone", "--effects ssao --target direct+indirect");
+  EXPECT_FALSE(row(alone, "ssao").contains("error_removed"));
+}
+
 // --no-emitter-light: the direct+indirect reference in which the default room's lamp (an
 // emissive quad) is seen but lights nothing, as for effects whose light comes from the lights
 // only; labelled, cached apart from the lit one, and a different score.

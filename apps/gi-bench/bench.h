@@ -59,6 +59,15 @@ struct Row {
   double noiseFloor = 0.0, normaliser = 1.0;
   size_t normaliserPixels = 0;
   bool noiseCapped = false;  // the target reference stopped at --ref-spp-max above 1/4 NRMSE
+  // Means over the scored pixels: the compared image, the target and declared references.
+  double testMean = 0.0, targetMean = 0.0, declaredMean = 0.0;
+  // Against the engine alone (the 'none' row of the same scene, preset and target, when the
+  // sweep has one): the share of its error this row removes, 1 - NRMSE / NRMSE(none) (negative:
+  // added), and with a direct+indirect target the share of the reference's indirect light
+  // (target - direct reference) this row adds to the engine's image.
+  bool recoveredPresent = false;
+  double errorRemoved = 0.0, indirectDelivered = 0.0;
+  bool indirectPresent = false;
   std::string declared;      // "obscurance linear r=0.5 spp=256" ...
   double declaredStdError = 0.0;
   double declaredNrmse = 0.0, declaredSsim = 1.0;
@@ -91,6 +100,10 @@ struct RunInfo {
 
 // results.csv, results.json, report.md and plots/<scene>_<effect>.svg under `dir`.
 void writeResults(const std::string& dir, const std::vector<Row>& rows, const RunInfo& info);
+// Fills errorRemoved and indirectDelivered of every row that has an engine-alone row ('none',
+// no parameters) of the same scene, preset, size and target.
+void fillRecovered(std::vector<Row>& rows);
+
 // Indices of the rows on the Pareto front of (plotted time with its interval, nrmse against
 // the target), ordered by time: stats.h's paretoFront, so time differences inside the
 // intervals do not keep a less accurate row on the front.

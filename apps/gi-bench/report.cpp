@@ -39,6 +39,28 @@ std::vector<size_t> paretoFront(const std::vector<const Row*>& rows) {
   return paretoFront(points);
 }
 
+void fillRecovered(std::vector<Row>& rows) {
+  auto startsWith = [](const std::string& s, const char* p) { return s.rfind(p, 0) == 0; };
+  for (Row& r : rows) {
+    const auto alone = std::find_if(rows.begin(), rows.end(), [&](const Row& n) {
+      return n.effect == "none" && n.params.empty() && n.scene == r.scene &&
+             n.preset == r.preset && n.width == r.width && n.height == r.height &&
+             n.reference == r.reference;
+    });
+    if (alone == rows.end()) continue;
+    r.recoveredPresent = true;
+    r.errorRemoved = alone->nrmse > 0.0 ? 1.0 - r.nrmse / alone->nrmse : 0.0;
+    // The reference's indirect light: the target minus the direct reference the engine alone
+    // declares, both over the scored pixels.
+    const double indirect = alone->targetMean - alone->declaredMean;
+    if (startsWith(r.reference, "direct+indirect") && startsWith(alone->declared, "direct ") &&
+        indirect > 1e-9) {
+      r.indirectPresent = true;
+      r.indirectDelivered = (r.testMean - alone->testMean) / indirect;
+    }
+  }
+}
+
 namespace {
 
 std::string fmt(double v, int digits = 4) {
@@ -113,7 +135,8 @@ std::string csv(const std::vector<Row>& rows) {
        "total_hi_ms,effect_ms,effect_lo_ms,effect_hi_ms,interval_coverage,floor_ms,"
        "total_over_floor,effect_over_floor,wall_ms,compared,reference,reference_spp,"
        "reference_stderr,pixels,nrmse,ssim,declared,declared_stderr,declared_nrmse,"
-       "declared_ssim,gap_nrmse,gap_share,noise_floor,normaliser,normaliser_pixels,noise_capped";
+       "declared_ssim,gap_nrmse,gap_share,noise_floor,normaliser,normaliser_pixels,noise_capped,"
+       "error_removed,indirect_delivered";
   // --ao-split runs only, so that other runs keep their columns.
   if (split)
     o << ",reference_seconds,limit_nrmse,offscreen_nrmse,hidden_nrmse,estimator_nrmse,"
@@ -134,7 +157,9 @@ std::string csv(const std::vector<Row>& rows) {
       << fmt(r.declaredNrmse, 6) << ',' << fmt(r.declaredSsim, 6) << ','
       << (r.gapPresent ? fmt(r.gapNrmse, 6) : std::string()) << ','
       << (r.gapPresent ? fmt(r.gapShare, 6) : std::string()) << ',' << fmt(r.noiseFloor, 6) << ','
-      << fmt(r.normaliser, 6) << ',' << r.normaliserPixels << ',' << (r.noiseCapped ? 1 : 0);
+      << fmt(r.normaliser, 6) << ',' << r.normaliserPixels << ',' << (r.noiseCapped ? 1 : 0)
+      << ',' << (r.recoveredPresent ? fmt(r.errorRemoved, 6) : std::string()) << ','
+      << (r.indirectPresent ? fmt(r.indirectDelivered, 6) : std::string());
     if (split) {
       const Row::AoSplit& s = r.split;
       o << ',' << fmt(r.referenceSeconds, 6);
@@ -200,6 +225,8 @@ std::string json(const std::vector<Row>& rows, const RunInfo& info) {
                             {"reference_seconds", r.referenceSeconds}});
     if (r.gapPresent)
       j["results"].back()["quantity_gap"] = {{"gap_nrmse", r.gapNrmse}, {"gap_share", r.gapShare}};
+    if (r.recoveredPresent) j["results"].back()["error_removed"] = r.errorRemoved;
+    if (r.indirectPresent) j["results"].back()["indirect_delivered"] = r.indirectDelivered;
     if (r.split.present) {
       const Row::AoSplit& s = r.split;
       j["results"].back()["ao_split"] = {
@@ -505,6 +532,37 @@ std::string gapSection(const std::vector<Row>& rows) {
   return o.str();
 }
 
+// What each configuration recovers of what the engine alone misses (fillRecovered).
+std::string recoveredSection(const std::vector<Row>& rows) {
+  std::ostringstream o;
+  for (const Row& r : rows) {
+    if (!r.recoveredPresent || r.effect == "none") continue;
+    if (o.tellp() == 0)
+      o << "\n## Missing light recovered\n\n"
+           "Against the engine alone (the `none` row of the same scene and preset, scored against "
+           "the same reference): *error removed* = 1 - NRMSE / NRMSE(engine alone), the share of "
+           "its error this configuration takes away (negative: it adds error); *indirect "
+           "delivered* = (mean of this image - mean of the engine alone's) / (mean of the "
+           "direct+indirect reference - mean of the direct reference), over the scored pixels: "
+           "the share of the reference's indirect light it adds, net: AO effects remove light and "
+           "score below 0, and so may an effect that also shadows the environment term (ISM's "
+           "environment VPLs). A difference of NRMSE inside the reference noise is no result.\n\n"
+           "| scene | effect | preset / params | effect ms [interval] | NRMSE | engine alone | "
+           "reference noise | error removed | indirect delivered |\n"
+           "|---|---|---|---:|---:|---:|---:|---:|---:|\n";
+    const auto alone = std::find_if(rows.begin(), rows.end(), [&](const Row& n) {
+      return n.effect == "none" && n.params.empty() && n.scene == r.scene &&
+             n.preset == r.preset && n.reference == r.reference;
+    });
+    o << "| " << r.scene << " | " << r.effect << " | " << r.preset
+      << (r.params.empty() ? "" : " " + r.params) << " | " << withInterval(r.effectCi, 3) << " | "
+      << fmt(r.nrmse, 4) << " | " << (alone != rows.end() ? fmt(alone->nrmse, 4) : "-") << " | "
+      << fmt(r.noiseFloor, 4) << " | " << percent(r.errorRemoved) << " | "
+      << (r.indirectPresent ? percent(r.indirectDelivered) : std::string("-")) << " |\n";
+  }
+  return o.str();
+}
+
 // With several presets and no grid: one table per scene shaped like seed 003's Table 1, a
 // column per preset (platform profile), for each effect the settings its preset sets, its time
 // and its errors against the target and against its declared quantity.
@@ -547,6 +605,12 @@ std::string profileTable(const std::vector<Row>& rows) {
       line("effect ms", [](const Row& r) { return withInterval(r.effectCi, 3); });
       line("NRMSE vs target", [](const Row& r) { return fmt(r.nrmse, 3); });
       line("reference noise", [](const Row& r) { return fmt(r.noiseFloor, 3); });
+      line("error of the engine alone removed", [](const Row& r) {
+        return r.recoveredPresent ? percent(r.errorRemoved) : std::string("-");
+      });
+      line("indirect light delivered", [](const Row& r) {
+        return r.indirectPresent ? percent(r.indirectDelivered) : std::string("-");
+      });
       line("NRMSE vs declared", [](const Row& r) { return fmt(r.declaredNrmse, 3); });
     }
   }
@@ -616,6 +680,7 @@ std::string markdown(const std::vector<Row>& rows, const RunInfo& info,
   }
   if (anySplit(rows)) o << splitSection(rows);
   o << gapSection(rows);
+  o << recoveredSection(rows);
   o << profileTable(rows);
   if (!plots.empty()) {
     o << "\n## Error against time\n\n";

@@ -343,6 +343,9 @@ int runSweep(const Options& o) {
     r.nrmse = vsTarget.metrics.nrmse;
     r.noiseFloor = vsTarget.metrics.noiseFloor;
     r.noiseCapped = capped.count(ReferenceKey{c.scene, c.comparison.target}) > 0;
+    r.testMean = vsTarget.metrics.testMean;
+    r.targetMean = vsTarget.metrics.referenceMean;
+    r.declaredMean = vsDeclared.metrics.referenceMean;
     r.normaliser = vsTarget.metrics.normaliser;
     r.normaliserPixels = vsTarget.metrics.normaliserPixels;
     r.ssim = vsTarget.metrics.ssim;
@@ -366,6 +369,7 @@ int runSweep(const Options& o) {
                  ctx.validationErrors());
     return 3;
   }
+  gi::bench::fillRecovered(rows);
   gi::bench::RunInfo info{
       ctx.deviceName(), o.commandLine, nowString(),
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()};

@@ -145,8 +145,12 @@ Metrics compare(const Plane& test, const Plane& reference, const std::vector<uns
     const double d = double(sanitize(test.values[i])) - double(sanitize(reference.values[i]));
     se += d * d;
     if (referenceStdError) var += std::pow(double(sanitize(referenceStdError->values[i])), 2);
+    r.testMean += double(sanitize(test.values[i]));
+    r.referenceMean += double(sanitize(reference.values[i]));
     ++r.pixels;
   }
+  r.testMean /= double(r.pixels);
+  r.referenceMean /= double(r.pixels);
   r.rmse = std::sqrt(se / double(r.pixels));
   // The normaliser's pixels: the given ones among the scored; none left: the scored ones.
   std::vector<unsigned char> normalised;

@@ -35,6 +35,7 @@ struct Metrics {
   double normaliser = 1.0;      // the mean |reference| NRMSE divides by
   size_t normaliserPixels = 0;  // the pixels of that mean
   double noiseFloor = 0.0;      // RMS(reference standard error) / normaliser; 0: not given
+  double testMean = 0.0, referenceMean = 0.0;  // over the scored pixels (compare())
 };
 
 // `mask`: empty (keep everything) or width * height entries, nonzero = keep. Non-finite test
