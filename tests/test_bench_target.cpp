@@ -190,6 +190,11 @@ TEST(BenchTarget, RowsSayWhatTheyRecoverOfTheEngineAlonesError) {
   EXPECT_NEAR(ssao["error_removed"].get<double>(),
               1.0 - ssao["nrmse"].get<double>() / none["nrmse"].get<double>(), 1e-12);
   EXPECT_LT(ssao["indirect_delivered"].get<double>(), 0.0);
+  // The report says how loaded the machine was, and has the recovered section.
+  const std::string report = test::readAll(dir + "/out/report.md");
+  EXPECT_NE(report.find("Load average (1 min) at the start and end: "), std::string::npos);
+  EXPECT_EQ(report.find("Load average (1 min) at the start and end: unknown"), std::string::npos);
+  EXPECT_NE(report.find("## Missing light recovered"), std::string::npos);
   // Without an engine-alone row of the same target there is nothing to compare with.
   const nlohmann::json alone = sweep(dir, "alone", "--effects ssao --target direct+indirect");
   EXPECT_FALSE(row(alone, "ssao").contains("error_removed"));

@@ -573,6 +573,15 @@ TEST_F(EffectGraphTest, UnknownViewListsTheAvailableOnes) {
 
 // Every preset shipped in assets/presets names real effects and in-range settings, and is
 // found by name from the build tree.
+// `--presets all` and every table list the quality levels in their order, then the others.
+TEST(ShippedPresets, NamesListTheQualityLevelsInOrderFirst) {
+  const std::vector<std::string> names = presetNames();
+  ASSERT_GE(names.size(), 5u);
+  EXPECT_EQ(std::vector<std::string>(names.begin(), names.begin() + 4),
+            (std::vector<std::string>{"low", "medium", "high", "ultra"}));
+  EXPECT_NE(std::find(names.begin() + 4, names.end(), "lavapipe"), names.end());
+}
+
 TEST(ShippedPresets, ValidateAgainstThePlugins) {
   EffectRegistry registry;
   registry.scanDirectory(test::binPath("plugins"));

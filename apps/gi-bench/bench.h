@@ -68,7 +68,7 @@ struct Row {
   bool recoveredPresent = false;
   double errorRemoved = 0.0, indirectDelivered = 0.0;
   bool indirectPresent = false;
-  std::string declared;      // "obscurance linear r=0.5 spp=256" ...
+  std::string declared;  // "obscurance linear r=0.5 spp=256" ...
   double declaredStdError = 0.0;
   double declaredNrmse = 0.0, declaredSsim = 1.0;
   // When the declared quantity is not the target: metrics.h QuantityGap (the target error a
@@ -96,7 +96,12 @@ struct Row {
 struct RunInfo {
   std::string device, commandLine, date;
   double seconds = 0.0;
+  // The machine's 1-minute load average when the run started and ended (/proc/loadavg; < 0:
+  // unknown): timings on a loaded shared machine spread, and the report says how loaded it was.
+  double loadStart = -1.0, loadEnd = -1.0;
 };
+// The 1-minute load average, or -1 where the system does not say.
+double loadAverage();
 
 // results.csv, results.json, report.md and plots/<scene>_<effect>.svg under `dir`.
 void writeResults(const std::string& dir, const std::vector<Row>& rows, const RunInfo& info);

@@ -18,6 +18,7 @@
 #include "gi/errors.h"
 #include "gi/image_io.h"
 #include "plot.h"
+#include "stats.h"
 
 namespace gi::bench {
 
@@ -39,13 +40,19 @@ std::vector<size_t> paretoFront(const std::vector<const Row*>& rows) {
   return paretoFront(points);
 }
 
+double loadAverage() {
+  std::ifstream in("/proc/loadavg");
+  double load = -1.0;
+  if (!(in >> load)) return -1.0;
+  return load;
+}
+
 void fillRecovered(std::vector<Row>& rows) {
   auto startsWith = [](const std::string& s, const char* p) { return s.rfind(p, 0) == 0; };
   for (Row& r : rows) {
     const auto alone = std::find_if(rows.begin(), rows.end(), [&](const Row& n) {
-      return n.effect == "none" && n.params.empty() && n.scene == r.scene &&
-             n.preset == r.preset && n.width == r.width && n.height == r.height &&
-             n.reference == r.reference;
+      return n.effect == "none" && n.params.empty() && n.scene == r.scene && n.preset == r.preset &&
+             n.width == r.width && n.height == r.height && n.reference == r.reference;
     });
     if (alone == rows.end()) continue;
     r.recoveredPresent = true;
@@ -157,8 +164,8 @@ std::string csv(const std::vector<Row>& rows) {
       << fmt(r.declaredNrmse, 6) << ',' << fmt(r.declaredSsim, 6) << ','
       << (r.gapPresent ? fmt(r.gapNrmse, 6) : std::string()) << ','
       << (r.gapPresent ? fmt(r.gapShare, 6) : std::string()) << ',' << fmt(r.noiseFloor, 6) << ','
-      << fmt(r.normaliser, 6) << ',' << r.normaliserPixels << ',' << (r.noiseCapped ? 1 : 0)
-      << ',' << (r.recoveredPresent ? fmt(r.errorRemoved, 6) : std::string()) << ','
+      << fmt(r.normaliser, 6) << ',' << r.normaliserPixels << ',' << (r.noiseCapped ? 1 : 0) << ','
+      << (r.recoveredPresent ? fmt(r.errorRemoved, 6) : std::string()) << ','
       << (r.indirectPresent ? fmt(r.indirectDelivered, 6) : std::string());
     if (split) {
       const Row::AoSplit& s = r.split;
@@ -532,6 +539,35 @@ std::string gapSection(const std::vector<Row>& rows) {
   return o.str();
 }
 
+// A warning listing the rows whose time interval is wider than their median: on a loaded
+// machine such a time is no basis for a comparison (per-pass CPU time, --isolate-passes, is).
+std::string wideIntervals(const std::vector<Row>& rows) {
+  std::string list;
+  size_t n = 0;
+  for (const Row& r : rows) {
+    const Interval& i = r.effectMs > 0.0 ? r.effectCi : r.totalCi;
+    if (!(i.hi - i.lo > i.median)) continue;
+    if (n++ < 12)
+      list += (list.empty() ? "" : ", ") + r.scene + " " + r.effect + " " + r.preset +
+              (r.params.empty() ? "" : " " + r.params);
+  }
+  if (n == 0) return "";
+  return "**Warning:** " + std::to_string(n) + " of " + std::to_string(rows.size()) +
+         " time intervals are wider than their median (" + list + (n > 12 ? ", ..." : "") +
+         "): those times are inside the machine's noise; compare them by per-pass CPU time "
+         "(--isolate-passes, repetitions.csv).\n\n";
+}
+
+// The effect passes' process CPU ms (median over repetitions) beside their GPU time, when
+// measured (--isolate-passes): it stays within a few percent on a loaded machine.
+std::string cpuCell(const Row& r) {
+  std::vector<double> cpu;
+  for (double v : r.effectRepsCpu)
+    if (v >= 0.0) cpu.push_back(v);
+  if (cpu.empty()) return "";
+  return " (CPU " + fmt(median(cpu), 3) + ")";
+}
+
 // What each configuration recovers of what the engine alone misses (fillRecovered).
 std::string recoveredSection(const std::vector<Row>& rows) {
   std::ostringstream o;
@@ -551,8 +587,8 @@ std::string recoveredSection(const std::vector<Row>& rows) {
            "reference noise | error removed | indirect delivered |\n"
            "|---|---|---|---:|---:|---:|---:|---:|---:|\n";
     const auto alone = std::find_if(rows.begin(), rows.end(), [&](const Row& n) {
-      return n.effect == "none" && n.params.empty() && n.scene == r.scene &&
-             n.preset == r.preset && n.reference == r.reference;
+      return n.effect == "none" && n.params.empty() && n.scene == r.scene && n.preset == r.preset &&
+             n.reference == r.reference;
     });
     o << "| " << r.scene << " | " << r.effect << " | " << r.preset
       << (r.params.empty() ? "" : " " + r.params) << " | " << withInterval(r.effectCi, 3) << " | "
@@ -622,7 +658,12 @@ std::string markdown(const std::vector<Row>& rows, const RunInfo& info,
   std::ostringstream o;
   o << "# gi-bench report\n\n"
     << "Device: " << info.device << "  \nCommand: `" << info.commandLine
-    << "`  \nDate: " << info.date << " (" << fmt(info.seconds, 3) << " s)\n\n"
+    << "`  \nDate: " << info.date << " (" << fmt(info.seconds, 3)
+    << " s)  \nLoad average "
+       "(1 min) at the start and end: "
+    << (info.loadStart >= 0 ? fmt(info.loadStart, 3) : std::string("unknown")) << ", "
+    << (info.loadEnd >= 0 ? fmt(info.loadEnd, 3) : std::string("unknown")) << "\n\n"
+    << wideIntervals(rows)
     << "GPU times come from Vulkan timestamp queries. Each configuration is measured in "
     << (rows.empty() ? 0 : rows.front().reps)
     << " repetitions, interleaved round-robin across configurations (repetition 1 of all, "
@@ -660,7 +701,8 @@ std::string markdown(const std::vector<Row>& rows, const RunInfo& info,
   for (const auto& [key, g] : groups)
     for (size_t i : paretoFront(g)) onFront.insert(g[i]);
   o << "| scene | effect | preset / params | GPU ms per pass [interval] | total ms [interval] | "
-       "effect ms [interval] | total x floor | effect x floor | target | NRMSE vs target | "
+       "effect ms [interval] (CPU ms with --isolate-passes) | total x floor | effect x floor | "
+       "target | NRMSE vs target | "
        "reference noise | normaliser (pixels of scored) | SSIM vs target | declared | NRMSE vs "
        "declared | SSIM vs declared |\n"
     << "|---|---|---|---|---:|---:|---:|---:|---|---:|---:|---:|---:|---|---:|---:|\n";
@@ -671,7 +713,7 @@ std::string markdown(const std::vector<Row>& rows, const RunInfo& info,
     std::string pp = r.preset + (r.params.empty() ? "" : " " + r.params);
     o << "| " << r.scene << " | " << r.effect << " | " << pp << (onFront.count(&r) ? " *" : "")
       << " | " << passes << " | " << withInterval(r.totalCi) << " | " << withInterval(r.effectCi)
-      << " | " << fmt(r.floorMs > 0 ? r.totalMs / r.floorMs : 0.0, 3) << " | "
+      << cpuCell(r) << " | " << fmt(r.floorMs > 0 ? r.totalMs / r.floorMs : 0.0, 3) << " | "
       << fmt(r.floorMs > 0 ? r.effectMs / r.floorMs : 0.0, 3) << " | " << r.compared << " vs "
       << r.reference << " | " << fmt(r.nrmse, 4) << " | " << fmt(r.noiseFloor, 4)
       << (r.noiseCapped ? " (cap)" : "") << " | " << fmt(r.normaliser, 4) << " ("

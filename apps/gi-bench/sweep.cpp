@@ -244,6 +244,7 @@ std::set<ReferenceKey> refineReferences(const Options& o, const Setup& s,
 
 int runSweep(const Options& o) {
   const auto start = std::chrono::steady_clock::now();
+  const double loadStart = gi::bench::loadAverage();
   Setup s;
   loadInputs(o, s);
   const std::vector<std::string> items = effectItems(o, s.registry);
@@ -371,8 +372,12 @@ int runSweep(const Options& o) {
   }
   gi::bench::fillRecovered(rows);
   gi::bench::RunInfo info{
-      ctx.deviceName(), o.commandLine, nowString(),
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()};
+      ctx.deviceName(),
+      o.commandLine,
+      nowString(),
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+      loadStart,
+      gi::bench::loadAverage()};
   gi::bench::writeResults(o.out, rows, info);
   std::printf("%zu configuration(s) in %.1f s -> %s/report.md\n", rows.size(), info.seconds,
               o.out.c_str());

@@ -38,7 +38,8 @@ struct Preset {
 // <executable dir>/../share/gi/presets (the build tree and installs both have it).
 std::vector<std::string> presetLocations();
 // The names of every preset found there (an earlier folder's file hides a later one's of the
-// same name), sorted.
+// same name): the quality levels low, medium, high, ultra in that order, then the others by
+// name.
 std::vector<std::string> presetNames();
 // `nameOrPath`: a preset name ("medium") or a .json path. Throws gi::Error naming the file.
 Preset loadPreset(const std::string& nameOrPath);

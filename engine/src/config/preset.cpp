@@ -1,5 +1,6 @@
 // Quality presets: finding one by name, reading and checking its file (gi/effect_config.h).
 // Kept apart from resolving effects so that the preset fuzzer (tests/fuzz) links only this.
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <set>
@@ -39,7 +40,14 @@ std::vector<std::string> presetNames() {
       if (e.path().extension() == ".json" && e.is_regular_file(ec))
         names.insert(e.path().stem().string());
   }
-  return {names.begin(), names.end()};
+  // The quality levels in their order, then the rest (device profiles) by name.
+  const std::vector<std::string> levels = {"low", "medium", "high", "ultra"};
+  std::vector<std::string> out;
+  for (const std::string& l : levels)
+    if (names.count(l)) out.push_back(l);
+  for (const std::string& n : names)
+    if (std::find(levels.begin(), levels.end(), n) == levels.end()) out.push_back(n);
+  return out;
 }
 
 namespace {
