@@ -27,13 +27,21 @@ struct Plot {
   std::vector<PlotPoint> front;  // the Pareto front in time order (a staircase)
 };
 
-// Layout shared by both renderings (pixels).
+// Layout shared by both renderings (pixels). The error axis runs from 0; the time axis too,
+// unless the times span more than 10x: then it is logarithmic over whole decades
+// [xMin, xMax] (ticks 1, 2, 5 per decade), so a 12 ms and a 700 ms point both stay readable.
 struct PlotLayout {
   double width = 760, height = 480, left = 70, right = 230, top = 40, bottom = 50;
-  double xMax = 1, yMax = 1;  // axis ranges [0, max] from "nice" ticks
+  double xMin = 0, xMax = 1, yMax = 1;  // axis ranges from "nice" ticks
+  bool logX = false;
   std::vector<double> xTicks, yTicks;
-  double x(double t) const { return left + (width - left - right) * t / xMax; }
+  double x(double t) const;
   double y(double e) const { return top + (height - top - bottom) * (1.0 - e / yMax); }
+  // Per series, per point: whether its label and values are drawn. A label that would overlap
+  // one already placed (series in order, points in order) is left out; the SVG keeps every
+  // point's values in its tooltip.
+  std::vector<std::vector<bool>> labelShown;
+  std::string xLabel(const Plot& plot) const;  // the plot's, with ", log scale" when logX
 };
 PlotLayout layoutFor(const Plot& plot);
 const char* seriesColour(size_t i);  // "#rrggbb"

@@ -173,7 +173,8 @@ ImageRGBA8 rasterPlot(const Plot& plot) {
   cv.line(l.left, l.top + ph, l.left + pw, l.top + ph, black);
   cv.line(l.left, l.top, l.left, l.top + ph, black);
   cv.line(l.left + pw, l.top, l.left + pw, l.top + ph, black);
-  cv.text(l.left + pw / 2 - Canvas::textWidth(plot.xLabel) / 2, l.height - 20, plot.xLabel, black);
+  const std::string xLabel = l.xLabel(plot);
+  cv.text(l.left + pw / 2 - Canvas::textWidth(xLabel) / 2, l.height - 20, xLabel, black);
   cv.text(14, l.top + ph / 2 + Canvas::textWidth(plot.yLabel) / 2, plot.yLabel, black, 1, true);
   for (size_t s = 0; s < plot.series.size(); ++s) {
     const PlotSeries& ser = plot.series[s];
@@ -181,12 +182,14 @@ ImageRGBA8 rasterPlot(const Plot& plot) {
     for (size_t k = 1; k < ser.points.size(); ++k)
       cv.line(l.x(ser.points[k - 1].time), l.y(ser.points[k - 1].error), l.x(ser.points[k].time),
               l.y(ser.points[k].error), c, 1.5);
-    for (const PlotPoint& p : ser.points) {
+    for (size_t k = 0; k < ser.points.size(); ++k) {
+      const PlotPoint& p = ser.points[k];
       const double x = l.x(p.time), y = l.y(p.error);
       cv.line(l.x(p.timeLo), y, l.x(p.timeHi), y, c);
       cv.line(l.x(p.timeLo), y - 4, l.x(p.timeLo), y + 4, c);
       cv.line(l.x(p.timeHi), y - 4, l.x(p.timeHi), y + 4, c);
       cv.disc(x, y, 3.5, c);
+      if (!l.labelShown[s][k]) continue;
       cv.text(x + 6, y - 13, p.label, c);
       cv.text(x + 6, y + 6, pointValues(p), grey);
     }

@@ -340,18 +340,58 @@ Plot buildPlot(const std::string& title, const std::vector<const Row*>& rows,
 
 }  // namespace
 
+double PlotLayout::x(double t) const {
+  const double pw = width - left - right;
+  if (!logX) return left + pw * t / xMax;
+  const double lt = std::log10(std::max(t, xMin));
+  return left + pw * (lt - std::log10(xMin)) / (std::log10(xMax) - std::log10(xMin));
+}
+
+std::string PlotLayout::xLabel(const Plot& plot) const {
+  return plot.xLabel + (logX ? ", log scale" : "");
+}
+
 PlotLayout layoutFor(const Plot& plot) {
   PlotLayout l;
-  double tmax = 0, emax = 0;
+  double tmax = 0, tmin = INFINITY, emax = 0;
   for (const PlotSeries& s : plot.series)
     for (const PlotPoint& p : s.points) {
       tmax = std::max(tmax, std::max(p.time, p.timeHi));
+      if (p.time > 0.0) tmin = std::min(tmin, std::min(p.time, p.timeLo > 0.0 ? p.timeLo : p.time));
       emax = std::max(emax, p.error);
     }
-  l.xTicks = ticks(tmax);
+  if (std::isfinite(tmin) && tmin > 0.0 && tmax > 10.0 * tmin) {
+    l.logX = true;
+    l.xMin = std::pow(10.0, std::floor(std::log10(tmin)));
+    l.xMax = std::pow(10.0, std::ceil(std::log10(tmax)));
+    for (double decade = l.xMin; decade < l.xMax * 1.001; decade *= 10.0)
+      for (double m : {1.0, 2.0, 5.0})
+        if (decade * m <= l.xMax * 1.001) l.xTicks.push_back(decade * m);
+  } else {
+    l.xTicks = ticks(tmax);
+    l.xMax = l.xTicks.back();
+  }
   l.yTicks = ticks(emax);
-  l.xMax = l.xTicks.back();
   l.yMax = l.yTicks.back();
+  // Labels: a box of ~6 px per character (both renderings' fonts), the label above the point
+  // and its values below.
+  struct Box {
+    double x0, y0, x1, y1;
+  };
+  std::vector<Box> placed;
+  for (const PlotSeries& s : plot.series) {
+    l.labelShown.emplace_back();
+    for (const PlotPoint& p : s.points) {
+      const double x = l.x(p.time), y = l.y(p.error);
+      const double w = 6.0 * double(std::max(p.label.size(), pointValues(p).size()));
+      const Box b{x + 4, y - 16, x + 8 + w, y + 16};
+      const bool free = std::none_of(placed.begin(), placed.end(), [&](const Box& o) {
+        return b.x0 < o.x1 && o.x0 < b.x1 && b.y0 < o.y1 && o.y0 < b.y1;
+      });
+      l.labelShown.back().push_back(free);
+      if (free) placed.push_back(b);
+    }
+  }
   return l;
 }
 
@@ -362,6 +402,8 @@ const char* seriesColour(size_t i) {
 }
 
 std::string formatTick(double v) {
+  // Whole numbers as such (a log axis reaches 1000: "1000", not "1e+03").
+  if (v >= 1.0 && v < 1e7 && v == std::floor(v)) return std::to_string(int64_t(v));
   return fmt(v, 3);
 }
 
@@ -390,7 +432,7 @@ std::string svgPlot(const Plot& plot) {
   o << "<rect x=\"" << l.left << "\" y=\"" << l.top << "\" width=\"" << pw << "\" height=\"" << ph
     << "\" fill=\"none\" stroke=\"black\"/>\n"
     << "<text x=\"" << l.left + pw / 2 << "\" y=\"" << l.height - 12 << "\" text-anchor=\"middle\">"
-    << xmlEscape(plot.xLabel) << "</text>\n"
+    << xmlEscape(l.xLabel(plot)) << "</text>\n"
     << "<text transform=\"translate(18," << l.top + ph / 2
     << ") rotate(-90)\" text-anchor=\"middle\">" << xmlEscape(plot.yLabel) << "</text>\n";
   for (size_t s = 0; s < plot.series.size(); ++s) {
@@ -399,7 +441,8 @@ std::string svgPlot(const Plot& plot) {
     o << "<polyline fill=\"none\" stroke=\"" << c << "\" stroke-width=\"1.5\" points=\"";
     for (const PlotPoint& p : ser.points) o << l.x(p.time) << ',' << l.y(p.error) << ' ';
     o << "\"/>\n";
-    for (const PlotPoint& p : ser.points) {
+    for (size_t k = 0; k < ser.points.size(); ++k) {
+      const PlotPoint& p = ser.points[k];
       const double x = l.x(p.time), y = l.y(p.error);
       // Error bar: the time interval, with end ticks.
       o << "<path d=\"M" << l.x(p.timeLo) << ' ' << y << "H" << l.x(p.timeHi) << "M"
@@ -408,9 +451,10 @@ std::string svgPlot(const Plot& plot) {
       o << "<circle cx=\"" << x << "\" cy=\"" << y << "\" r=\"3.5\" fill=\"" << c << "\"><title>"
         << xmlEscape(p.label) << ": " << fmt(p.time) << " ms [" << fmt(p.timeLo) << ", "
         << fmt(p.timeHi) << "], NRMSE " << fmt(p.error) << "</title></circle>\n";
-      o << "<text x=\"" << x + 6 << "\" y=\"" << y - 6 << "\" font-size=\"10\" fill=\"" << c
-        << "\">" << xmlEscape(p.label) << "</text><text x=\"" << x + 6 << "\" y=\"" << y + 12
-        << "\" font-size=\"9\" fill=\"#555\">" << xmlEscape(pointValues(p)) << "</text>\n";
+      if (l.labelShown[s][k])
+        o << "<text x=\"" << x + 6 << "\" y=\"" << y - 6 << "\" font-size=\"10\" fill=\"" << c
+          << "\">" << xmlEscape(p.label) << "</text><text x=\"" << x + 6 << "\" y=\"" << y + 12
+          << "\" font-size=\"9\" fill=\"#555\">" << xmlEscape(pointValues(p)) << "</text>\n";
     }
     const double ly = l.top + 10 + 18 * double(s);
     o << "<line x1=\"" << l.left + pw + 12 << "\" y1=\"" << ly << "\" x2=\"" << l.left + pw + 32
