@@ -195,6 +195,17 @@ TEST(BenchTarget, RowsSayWhatTheyRecoverOfTheEngineAlonesError) {
   EXPECT_NE(report.find("Load average (1 min) at the start and end: "), std::string::npos);
   EXPECT_EQ(report.find("Load average (1 min) at the start and end: unknown"), std::string::npos);
   EXPECT_NE(report.find("## Missing light recovered"), std::string::npos);
+  // The room defines regions: each is scored apart, the faces of the room are disjoint and
+  // cover part of the image, the floor is seen.
+  const auto& regions = none["regions"];
+  ASSERT_EQ(regions.size(), 7u);
+  size_t faces = 0;
+  for (size_t k = 0; k < 5; ++k) faces += regions[k]["pixels"].get<size_t>();
+  EXPECT_EQ(regions[0]["name"], "floor");
+  EXPECT_GT(regions[0]["pixels"].get<size_t>(), 0u);
+  EXPECT_LE(faces, none["pixels"].get<size_t>());
+  EXPECT_GT(regions[0]["nrmse"].get<double>(), 0.0);
+  EXPECT_NE(report.find("## Errors by region"), std::string::npos);
   // Without an engine-alone row of the same target there is nothing to compare with.
   const nlohmann::json alone = sweep(dir, "alone", "--effects ssao --target direct+indirect");
   EXPECT_FALSE(row(alone, "ssao").contains("error_removed"));

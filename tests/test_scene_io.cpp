@@ -567,6 +567,25 @@ TEST(SceneIo, JsonGridRepeatsAModelSharingItsMeshes) {
   expectError([&] { gi::loadScene(seg); }, gi::ErrorKind::InvalidData, seg, "segments");
 }
 
+// Regions: named world boxes for per-region scores; the shipped benchmark scenes define theirs.
+TEST(SceneIo, RegionsAreNamedBoxes) {
+  TempDir dir;
+  const gi::Scene s = gi::loadScene(dir.write("r.json", R"({
+      "models": [ { "primitive": "plane", "size": 2 } ],
+      "regions": [ { "name": "floor", "min": [-1, -0.01, -1], "max": [1, 0.01, 1] },
+                   { "name": "above", "min": [-1, 0.5, -1], "max": [1, 1, 1] } ] })"));
+  ASSERT_EQ(s.regions.size(), 2u);
+  EXPECT_EQ(s.regions[0].name, "floor");
+  EXPECT_TRUE(s.regions[0].contains({0.5f, 0.0f, -0.5f}));
+  EXPECT_FALSE(s.regions[0].contains({0.5f, 0.2f, -0.5f}));
+  EXPECT_TRUE(s.regions[1].contains({0.0f, 1.0f, 0.0f}));  // bounds included
+  EXPECT_EQ(gi::loadScene("default").regions.size(), 7u);
+  for (const char* scene : {"cornell_box.json", "bunny_on_plane.json"})
+    EXPECT_GE(gi::loadScene(std::string(GI_SOURCE_DIR) + "/assets/scenes/" + scene).regions.size(),
+              3u)
+        << scene;
+}
+
 TEST(SceneIo, JsonErrors) {
   TempDir dir;
   using K = gi::ErrorKind;
@@ -597,6 +616,14 @@ TEST(SceneIo, JsonErrors) {
       {"wrong_elem", R"({"camera": {"position": [0, "a", 0], "target": [0, 0, 1]}})", K::Schema,
        "camera.position[1]"},
       {"wrong_bool", R"({"include_default_scene": 1})", K::Schema, "include_default_scene"},
+      {"region_without_max", R"({"regions": [{"name": "floor", "min": [0, 0, 0]}]})", K::Schema,
+       "regions[0].max"},
+      {"region_inverted", R"({"regions": [{"name": "floor", "min": [0, 1, 0], "max": [1, 0, 1]}]})",
+       K::InvalidData, "regions[0].max: must be at least min"},
+      {"region_twice",
+       R"({"regions": [{"name": "a", "min": [0, 0, 0], "max": [1, 1, 1]},
+                       {"name": "a", "min": [0, 0, 0], "max": [1, 1, 1]}]})",
+       K::InvalidData, "regions[1].name: 'a' is used twice"},
       {"missing_key", R"({"camera": {"target": [0, 0, 1]}})", K::Schema,
        "camera.position: missing required key"},
       {"light_type", R"({"lights": [{"type": "area", "position": [0, 0, 0]}]})", K::Schema,

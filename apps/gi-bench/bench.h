@@ -65,6 +65,14 @@ struct Row {
   // sweep has one): the share of its error this row removes, 1 - NRMSE / NRMSE(none) (negative:
   // added), and with a direct+indirect target the share of the reference's indirect light
   // (target - direct reference) this row adds to the engine's image.
+  // Per region the scene defines (SceneRegion): NRMSE against the target over the scored
+  // pixels inside it (normalised by the region's own mean), and how many; pixels 0: not seen.
+  struct RegionScore {
+    std::string name;
+    double nrmse = 0.0;
+    size_t pixels = 0;
+  };
+  std::vector<RegionScore> regions;
   bool recoveredPresent = false;
   double errorRemoved = 0.0, indirectDelivered = 0.0;
   bool indirectPresent = false;

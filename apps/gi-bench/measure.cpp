@@ -265,6 +265,48 @@ Scores score(const Measurement& m, const ReferenceSpec& spec, const Reference& r
   return s;
 }
 
+std::vector<Row::RegionScore> regionScores(const Measurement& m, const ReferenceSpec& spec,
+                                           const Reference& reference, const Options& o,
+                                           const gi::Scene& scene) {
+  std::vector<Row::RegionScore> out;
+  if (scene.regions.empty()) return out;
+  const int w = int(o.width), h = int(o.height);
+  const size_t n = size_t(w) * size_t(h);
+  // World positions of the reference's primary hits: the pixel centre's view ray, scaled to
+  // the view-space z the reference stored (depth image, g), through the same camera.
+  const gi::CameraView cam = gi::activeCamera(scene, float(w) / float(h));
+  const glm::mat4 invProj = glm::inverse(cam.proj), invView = glm::inverse(cam.view);
+  const bool orthographic = cam.proj[3][3] != 0.0f;
+  std::vector<glm::vec3> world(n);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const size_t i = size_t(y) * size_t(w) + size_t(x);
+      const float viewZ = reference.depth.pixels[i * 4 + 1];
+      const glm::vec2 ndc((x + 0.5f) / float(w) * 2.0f - 1.0f, (y + 0.5f) / float(h) * 2.0f - 1.0f);
+      glm::vec4 nearPoint = invProj * glm::vec4(ndc, 1.0f, 1.0f);
+      glm::vec3 v = glm::vec3(nearPoint) / nearPoint.w;
+      v = orthographic ? glm::vec3(v.x, v.y, viewZ) : v * (viewZ / v.z);
+      world[i] = glm::vec3(invView * glm::vec4(v, 1.0f));
+    }
+  const std::vector<unsigned char> mask = comparedMask(m, reference, o);
+  const bool aoLike = gi::bench::isAoLike(spec.quantity);
+  const gi::bench::Plane test = gi::bench::channel(w, h, m.out.pixels, aoLike ? 0 : -1);
+  const gi::bench::Plane truth = gi::bench::channel(w, h, reference.value.pixels, aoLike ? 0 : -1);
+  for (const gi::SceneRegion& region : scene.regions) {
+    std::vector<unsigned char> inside(n);
+    for (size_t i = 0; i < n; ++i) inside[i] = mask[i] && region.contains(world[i]);
+    Row::RegionScore r{region.name, 0.0, 0};
+    if (std::any_of(inside.begin(), inside.end(), [](unsigned char k) { return k; })) {
+      const std::vector<unsigned char> normalised = aoLike ? inside : normaliserMask(m, inside);
+      const gi::bench::Metrics metrics = gi::bench::compare(test, truth, inside, 1.0, &normalised);
+      r.nrmse = metrics.nrmse;
+      r.pixels = metrics.pixels;
+    }
+    out.push_back(r);
+  }
+  return out;
+}
+
 // The part of the error against the target that the declared quantity's own distance from it
 // explains (metrics.h QuantityGap); nullopt when the effect declares its target.
 std::optional<gi::bench::QuantityGap> gapOf(const Measurement& m, const Comparison& cmp,

@@ -51,6 +51,11 @@ std::vector<Measurement> measureAll(
 // reference (an empty scene, a camera that sees nothing): nothing would be scored.
 Scores score(const Measurement& m, const ReferenceSpec& spec, const Reference& reference,
              const Options& o, const std::string& scene);
+// Scores against `reference` within each of the scene's regions (the reference's primary hit
+// inside the region's box), as score() over the whole image.
+std::vector<Row::RegionScore> regionScores(const Measurement& m, const ReferenceSpec& spec,
+                                           const Reference& reference, const Options& o,
+                                           const gi::Scene& scene);
 // The part of the error against the target that the declared quantity's own distance from it
 // explains (metrics.h QuantityGap); nullopt when the effect declares its target.
 std::optional<gi::bench::QuantityGap> gapOf(const Measurement& m, const Comparison& cmp,

@@ -232,6 +232,9 @@ std::string json(const std::vector<Row>& rows, const RunInfo& info) {
                             {"reference_seconds", r.referenceSeconds}});
     if (r.gapPresent)
       j["results"].back()["quantity_gap"] = {{"gap_nrmse", r.gapNrmse}, {"gap_share", r.gapShare}};
+    for (const Row::RegionScore& g : r.regions)
+      j["results"].back()["regions"].push_back(
+          {{"name", g.name}, {"nrmse", g.nrmse}, {"pixels", g.pixels}});
     if (r.recoveredPresent) j["results"].back()["error_removed"] = r.errorRemoved;
     if (r.indirectPresent) j["results"].back()["indirect_delivered"] = r.indirectDelivered;
     if (r.split.present) {
@@ -612,6 +615,43 @@ std::string cpuCell(const Row& r) {
   return " (CPU " + fmt(median(cpu), 3) + ")";
 }
 
+// Per scene that defines regions: a row per configuration, a column per region.
+std::string regionSection(const std::vector<Row>& rows) {
+  std::ostringstream o;
+  std::vector<std::string> scenes;
+  for (const Row& r : rows)
+    if (!r.regions.empty() && std::find(scenes.begin(), scenes.end(), r.scene) == scenes.end())
+      scenes.push_back(r.scene);
+  if (scenes.empty()) return "";
+  o << "\n## Errors by region\n\nNRMSE against the target within each region the scene "
+       "defines (its reference pixels whose surface lies in the region's box; normalised by the "
+       "region's own mean), with the region's pixel count in the header; - where the region is "
+       "not seen.\n";
+  for (const std::string& scene : scenes) {
+    const Row* first = nullptr;
+    for (const Row& r : rows)
+      if (r.scene == scene && !r.regions.empty()) {
+        first = &r;
+        break;
+      }
+    o << "\n### " << scene << "\n\n| effect | preset / params | whole image |";
+    for (const Row::RegionScore& g : first->regions)
+      o << ' ' << g.name << " (" << g.pixels << " px) |";
+    o << "\n|---|---|---:|";
+    for (size_t k = 0; k < first->regions.size(); ++k) o << "---:|";
+    o << "\n";
+    for (const Row& r : rows) {
+      if (r.scene != scene) continue;
+      o << "| " << r.effect << " | " << r.preset << (r.params.empty() ? "" : " " + r.params)
+        << " | " << fmt(r.nrmse, 4) << " |";
+      for (const Row::RegionScore& g : r.regions)
+        o << ' ' << (g.pixels > 0 ? fmt(g.nrmse, 4) : std::string("-")) << " |";
+      o << "\n";
+    }
+  }
+  return o.str();
+}
+
 // What each configuration recovers of what the engine alone misses (fillRecovered).
 std::string recoveredSection(const std::vector<Row>& rows) {
   std::ostringstream o;
@@ -767,6 +807,7 @@ std::string markdown(const std::vector<Row>& rows, const RunInfo& info,
   if (anySplit(rows)) o << splitSection(rows);
   o << gapSection(rows);
   o << recoveredSection(rows);
+  o << regionSection(rows);
   o << profileTable(rows);
   if (!plots.empty()) {
     o << "\n## Error against time\n\n";

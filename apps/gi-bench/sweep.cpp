@@ -267,6 +267,7 @@ int runSweep(const Options& o) {
   ProgressBar bar(o.progress, "configurations", configs.size());
   std::vector<Scores> vsTargets(configs.size()), vsDeclareds(configs.size());
   std::vector<std::optional<gi::bench::QuantityGap>> gaps(configs.size());
+  std::vector<std::vector<Row::RegionScore>> regions(configs.size());
   // The images scores are made from, kept while a reference may still be refined.
   std::vector<Measurement> images(configs.size());
   auto scoreConfig = [&](size_t i, const Measurement& m) {
@@ -278,6 +279,9 @@ int runSweep(const Options& o) {
                            refs.at(ReferenceKey{c.scene, c.comparison.declared}), o, scene);
     gaps[i] = gapOf(m, c.comparison, refs.at(ReferenceKey{c.scene, c.comparison.target}),
                     refs.at(ReferenceKey{c.scene, c.comparison.declared}), o);
+    regions[i] =
+        regionScores(m, c.comparison.target, refs.at(ReferenceKey{c.scene, c.comparison.target}), o,
+                     s.scenes[c.scene].scene);
   };
   const bool refine = o.refSppMax > o.refSpp;
   const std::vector<Measurement> measured =
@@ -344,6 +348,7 @@ int runSweep(const Options& o) {
     r.nrmse = vsTarget.metrics.nrmse;
     r.noiseFloor = vsTarget.metrics.noiseFloor;
     r.noiseCapped = capped.count(ReferenceKey{c.scene, c.comparison.target}) > 0;
+    r.regions = regions[i];
     r.testMean = vsTarget.metrics.testMean;
     r.targetMean = vsTarget.metrics.referenceMean;
     r.declaredMean = vsDeclared.metrics.referenceMean;

@@ -174,6 +174,18 @@ struct EffectRequest {
   nlohmann::json settings = nlohmann::json::object();
 };
 
+// A named part of the scene for per-region scores (gi-bench): the surface points inside an
+// axis-aligned world-space box (e.g. the floor, a wall, the strip where an object meets the
+// floor).
+struct SceneRegion {
+  std::string name;
+  glm::vec3 min{0.0f}, max{0.0f};
+  bool contains(const glm::vec3& p) const {
+    return p.x >= min.x && p.y >= min.y && p.z >= min.z && p.x <= max.x && p.y <= max.y &&
+           p.z <= max.z;
+  }
+};
+
 struct Scene {
   std::string sourcePath;  // file it came from ("default" for the built-in scene)
   std::vector<Mesh> meshes;
@@ -188,6 +200,7 @@ struct Scene {
   int activeCameraNode = -1;  // node carrying the camera used for rendering, -1: frame bounds
   Environment environment;
   std::vector<EffectRequest> effects;
+  std::vector<SceneRegion> regions;   // for per-region scores; none: the image as a whole
   std::vector<std::string> warnings;  // things sanitised while loading (e.g. recomputed normals)
   // Multiplies the defaults of effects' world-length settings (SettingDesc::worldLength): 1 for
   // scene files and the built-in room; a model loaded without a scene file gets its bounding-box

@@ -98,6 +98,17 @@ Scene makeDefaultScene() {
       addMeshNode(s, "sphere", detail::makeSphere(0.25f, 32, 16), sphere, translate(rest));
   addBounce(s, ball, rest);
 
+  // Regions scored apart (gi-bench): each face of the room, and the floor around each block
+  // (the contact strips, where screen-space methods and the bounce differ most).
+  const float e = 0.002f;
+  s.regions = {{"floor", {-1, -1 - e, -1}, {1, -1 + e, 1}},
+               {"ceiling", {-1, 1 - e, -1}, {1, 1 + e, 1}},
+               {"back wall", {-1, -1, -1 - e}, {1, 1, -1 + e}},
+               {"red wall", {-1 - e, -1, -1}, {-1 + e, 1, 1}},
+               {"green wall", {1 - e, -1, -1}, {1 + e, 1, 1}},
+               {"floor by the short block", {-0.22f, -1 - e, -0.25f}, {0.88f, -1 + e, 0.85f}},
+               {"floor by the tall block", {-0.9f, -1 - e, -0.9f}, {0.2f, -1 + e, 0.2f}}};
+
   // Lamp: a small emissive quad just under the ceiling plus a point light below it (the
   // rasteriser's direct lighting comes from the point light; the quad is what is seen).
   addMeshNode(s, "lamp", detail::makePlane(0.5f, 0.4f), lamp,

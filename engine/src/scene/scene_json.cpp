@@ -44,7 +44,9 @@
 //                    "file": "sky.hdr" (map only, required: equirectangular Radiance .hdr,
 //                            relative to the scene file; ${ASSIMP_MODELS} expands),
 //                    "zenith_color", "horizon_color", "ground_color": [r, g, b] (sky only) },
-//   "effects": [ "ssao", { "name": "bloom", "settings": { ... } } ]
+//   "effects": [ "ssao", { "name": "bloom", "settings": { ... } } ],
+//   "regions": [ { "name": "floor", "min": [x, y, z], "max": [x, y, z] } ]   // world boxes,
+//                                          // scored apart by gi-bench (names unique)
 // }
 //
 // "animation" (models, lights, camera): a looping clip of its own driving the entry's node:
@@ -289,7 +291,7 @@ class SceneJsonLoader {
     const json root = parseJsonText(text, path_, /*allowComments=*/true);
     JsonObject top(root, "", path_);
     top.allowOnly({"description", "include_default_scene", "models", "camera", "lights",
-                   "environment", "effects"});
+                   "environment", "effects", "regions"});
     top.string("description");  // type check only
     if (top.boolean("include_default_scene").value_or(false)) scene_ = makeDefaultScene();
     scene_.sourcePath = path_;
@@ -300,6 +302,7 @@ class SceneJsonLoader {
     if (top.has("environment"))
       readEnvironment(JsonObject(top.at("environment"), "environment", path_));
     if (top.has("effects")) readEffects(top);
+    if (top.has("regions")) readRegions(top);
 
     addDefaultCameraAndLight(scene_);  // also updates the world transforms
     return std::move(scene_);
@@ -758,6 +761,28 @@ class SceneJsonLoader {
       if (request.name.empty())
         throw Error(ErrorKind::Schema, path_, indexed("effects", i) + ": empty effect name");
       scene_.effects.push_back(std::move(request));
+    }
+  }
+
+  void readRegions(const JsonObject& top) {
+    const json& regions = array(top, "regions");
+    scene_.regions.clear();  // an included default scene's regions are replaced
+    for (size_t i = 0; i < regions.size(); ++i) {
+      JsonObject o(regions[i], indexed("regions", i), path_);
+      o.allowOnly({"name", "min", "max"});
+      SceneRegion r;
+      r.name = o.requireString("name");
+      const std::optional<glm::vec3> lo = o.vec3("min"), hi = o.vec3("max");
+      if (!lo) o.schemaError("min", "required: [x, y, z]");
+      if (!hi) o.schemaError("max", "required: [x, y, z]");
+      r.min = *lo;
+      r.max = *hi;
+      if (r.name.empty()) o.invalid("name", "must not be empty");
+      if (!(r.min.x <= r.max.x && r.min.y <= r.max.y && r.min.z <= r.max.z))
+        o.invalid("max", "must be at least min in every component");
+      for (const SceneRegion& other : scene_.regions)
+        if (other.name == r.name) o.invalid("name", "'" + r.name + "' is used twice");
+      scene_.regions.push_back(r);
     }
   }
 
