@@ -105,6 +105,18 @@ class SsdoTest : public test::EffectTest {
     }
     return loadSceneJson(path);
   }
+  // A yellow emissive wall (emission 1; x = 0, y in [0, 2], z in [-1, 1], facing +x) on a
+  // white floor, no other light, seen from (3, 2.5, 0).
+  Scene yellowWall(const std::string& name) {
+    return jsonScene(name, R"({
+      "models": [
+        { "primitive": "plane", "size": 40, "material": { "base_color": [1, 1, 1] } },
+        { "primitive": "plane", "size": 2, "translation": [0, 1, 0], "rotation": [0, 0, -90],
+          "material": { "base_color": [1, 1, 0], "emission": [1, 1, 0] } } ],
+      "lights": [ { "type": "directional", "intensity": 0, "casts_shadows": false } ],
+      "camera": { "position": [3, 2.5, 0], "target": [0.5, 0, 0] },
+      "environment": { "type": "constant", "color": [0, 0, 0] } })");
+  }
   // Mean of `img` over the pixels whose world position satisfies `pick`; `count` the pixels.
   template <class Pick>
   glm::dvec3 mean(const Result& r, const ImageRGBA32F& img, Pick pick, int* count = nullptr) {
@@ -472,14 +484,7 @@ TEST_F(SsdoTest, BounceFromAYellowWallFadesAndBackFacingSendersGiveNothing) {
 // (the blocked share of the ball shrinks), and a large R overshoots next to the wall
 // (effects/ssdo/README.md).
 TEST_F(SsdoTest, BounceEnergyIsTheMethodsExpectationAndDepartsFromTheFormFactorWithDistance) {
-  const Scene scene = jsonScene("energy", R"({
-      "models": [
-        { "primitive": "plane", "size": 40, "material": { "base_color": [1, 1, 1] } },
-        { "primitive": "plane", "size": 2, "translation": [0, 1, 0], "rotation": [0, 0, -90],
-          "material": { "base_color": [1, 1, 0], "emission": [1, 1, 0] } } ],
-      "lights": [ { "type": "directional", "intensity": 0, "casts_shadows": false } ],
-      "camera": { "position": [3, 2.5, 0], "target": [0.5, 0, 0] },
-      "environment": { "type": "constant", "color": [0, 0, 0] } })");
+  const Scene scene = yellowWall("energy");
   const glm::dvec3 eye(3.0, 2.5, 0.0);
   const glm::dvec3 viewDir = glm::normalize(glm::dvec3(0.5, 0.0, 0.0) - eye);
   auto onWall = [](const glm::dvec3& p) {
@@ -620,14 +625,7 @@ TEST_F(SsdoTest, BounceEnergyIsTheMethodsExpectationAndDepartsFromTheFormFactorW
 // d -> 0) stays finite even at the smallest clamp, and each sender's term is bounded by
 // L_s x bounce scale / d_min^2 (so the pixel by N times that, times the albedo).
 TEST_F(SsdoTest, TouchingOccludersStayFiniteAndBoundedByTheDistanceClamp) {
-  const Scene s = jsonScene("touch", R"({
-      "models": [
-        { "primitive": "plane", "size": 40, "material": { "base_color": [1, 1, 1] } },
-        { "primitive": "plane", "size": 2, "translation": [0, 1, 0], "rotation": [0, 0, -90],
-          "material": { "base_color": [1, 1, 0], "emission": [1, 1, 0] } } ],
-      "lights": [ { "type": "directional", "intensity": 0, "casts_shadows": false } ],
-      "camera": { "position": [3, 2.5, 0], "target": [0.5, 0, 0] },
-      "environment": { "type": "constant", "color": [0, 0, 0] } })");
+  const Scene s = yellowWall("touch");
   for (double clamp : {1e-6, 0.02, 0.1}) {
     const std::string c = "ssdo.distance_clamp=" + std::to_string(clamp);
     const Result r = render(s, {"ssdo.radius=0.5", "ssdo.samples=12", "ssdo.bounce_strength=1", c,
