@@ -367,9 +367,11 @@ PlotLayout layoutFor(const Plot& plot) {
     l.logX = true;
     l.xMin = std::pow(10.0, std::floor(std::log10(tmin)));
     l.xMax = std::pow(10.0, std::ceil(std::log10(tmax)));
-    for (double decade = l.xMin; decade < l.xMax * 1.001; decade *= 10.0)
+    const int first = int(std::lround(std::log10(l.xMin))),
+              last = int(std::lround(std::log10(l.xMax)));
+    for (int e = first; e <= last; ++e)
       for (double m : {1.0, 2.0, 5.0})
-        if (decade * m <= l.xMax * 1.001) l.xTicks.push_back(decade * m);
+        if (e < last || m == 1.0) l.xTicks.push_back(m * std::pow(10.0, double(e)));
   } else {
     l.xTicks = ticks(tmax);
     l.xMax = l.xTicks.back();
