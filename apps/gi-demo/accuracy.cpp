@@ -16,9 +16,11 @@ struct AccuracyCheck::Pending {
   gi::Scene scene;  // posed copy with the renderer's camera
   ref::Settings settings;
   gi::ImageRGBA32F test, depth;
+  gi::ImageRGBA32F alone;  // light quantities: the same frame with no effect
   bool aoLike = false;
+  bool indirect = false;  // the quantity is direct + indirect: the direct reference too
   std::string effect, label;
-  ref::Result reference;
+  ref::Result reference, direct;
 };
 
 AccuracyCheck::~AccuracyCheck() {
@@ -29,9 +31,10 @@ float AccuracyCheck::progress() const {
   return std::clamp(float(sppReached_) / float(std::max(sppAsked_, 1u)), 0.0f, 1.0f);
 }
 
-void AccuracyCheck::start(gi::Renderer& renderer, const gi::Scene& scene, double time,
-                          const gi::EffectRegistry& registry, const std::string& effect,
-                          const gi::SettingValues& settings, uint32_t spp) {
+void AccuracyCheck::start(gi::vk::Context& ctx, gi::Renderer& renderer, const gi::Scene& scene,
+                          double time, const gi::EffectRegistry& registry,
+                          const std::string& effect, const gi::SettingValues& settings,
+                          uint32_t spp) {
   wait();
   auto p = std::make_shared<Pending>();
   const gi::bench::ReferenceSpec spec =
@@ -46,6 +49,21 @@ void AccuracyCheck::start(gi::Renderer& renderer, const gi::Scene& scene, double
   if (p->test.width != int(size.width) || p->test.height != int(size.height))
     throw gi::Error(gi::ErrorKind::Unsupported, "",
                     "accuracy: " + effect + "'s image is not at the output's size");
+
+  if (!p->aoLike) {
+    // The engine alone on the same frame: its settings, no effect, the same clock and camera.
+    gi::RenderSettings alone = renderer.settings();
+    alone.effects.clear();
+    alone.width = size.width;
+    alone.height = size.height;
+    alone.view = gi::resources::kLit;
+    gi::Renderer engine(ctx, scene, alone, &registry);
+    engine.setTime(time);
+    engine.setCameraOverride(renderer.camera());
+    engine.renderFrame();
+    p->alone = engine.readTarget(gi::resources::kLit);
+    p->indirect = spec.quantity == ref::Quantity::DirectIndirect;
+  }
 
   // The scene posed at the clock, seen by the renderer's camera (a camera node of its own).
   p->scene = scene;
@@ -80,6 +98,11 @@ void AccuracyCheck::start(gi::Renderer& renderer, const gi::Scene& scene, double
   thread_ = std::thread([this, p] {
     try {
       p->reference = ref::render(p->scene, p->settings);
+      if (p->indirect) {
+        ref::Settings direct = p->settings;
+        direct.quantity = ref::Quantity::Direct;
+        p->direct = ref::render(p->scene, direct);
+      }
     } catch (const std::exception& e) {
       std::lock_guard<std::mutex> lock(mutex_);
       threadError_ = e.what();
@@ -124,6 +147,23 @@ void AccuracyCheck::finish() {
   out.effect = p->effect;
   out.quantity = p->label;
   out.nrmse = gi::bench::nrmse(test, truth, mask);
+  if (p->alone.pixels.size() == p->test.pixels.size()) {
+    const gi::bench::Plane alone = gi::bench::channel(w, h, p->alone.pixels, c);
+    out.recovered = true;
+    out.aloneNrmse = gi::bench::nrmse(alone, truth, mask);
+    out.errorRemoved = out.aloneNrmse > 0.0 ? 1.0 - out.nrmse / out.aloneNrmse : 0.0;
+    if (p->direct.value.pixels.size() == r.value.pixels.size()) {
+      const gi::bench::Plane direct = gi::bench::channel(w, h, p->direct.value.pixels, c);
+      const gi::bench::Metrics withEffect = gi::bench::compare(test, truth, mask);
+      const gi::bench::Metrics engineAlone = gi::bench::compare(alone, truth, mask);
+      const gi::bench::Metrics directRef = gi::bench::compare(direct, truth, mask);
+      const double missing = withEffect.referenceMean - directRef.testMean;
+      if (missing > 1e-9) {
+        out.indirect = true;
+        out.indirectDelivered = (withEffect.testMean - engineAlone.testMean) / missing;
+      }
+    }
+  }
   out.pixels = size_t(std::count(mask.begin(), mask.end(), 1));
   out.spp = r.spp;
   out.seconds = r.seconds;

@@ -26,6 +26,12 @@ struct AccuracyResult {
   double seconds = 0.0;
   // |effect - reference| / mean reference, x2, as grey in [0, 1]; blue where not compared.
   gi::ImageRGBA8 error;
+  // Light quantities: what the effect recovers of what the engine alone misses (as gi-bench):
+  // the engine alone's NRMSE on the same frame and the share of it removed, 1 - NRMSE /
+  // that; against direct + indirect also the share of the reference's indirect light
+  // (direct+indirect - direct reference) the effect adds to the engine alone's image.
+  bool recovered = false, indirect = false;
+  double aloneNrmse = 0.0, errorRemoved = 0.0, indirectDelivered = 0.0;
 };
 
 class AccuracyCheck {
@@ -37,10 +43,12 @@ class AccuracyCheck {
 
   // Keeps the renderer's current image of the effect's quantity (call after renderFrame) and
   // starts the reference of `scene` posed at `time`, seen by the renderer's camera, at the
-  // renderer's size, with at most `spp` samples per pixel. Throws gi::Error when the effect
-  // is unknown or its quantity's image is not in the frame; a check already running is
-  // abandoned (waited for).
-  void start(gi::Renderer& renderer, const gi::Scene& scene, double time,
+  // renderer's size, with at most `spp` samples per pixel. For a light quantity it also
+  // renders the same frame with no effect (a renderer of its own on `ctx`) and, against
+  // direct + indirect, the direct reference too. Throws gi::Error when the effect is unknown
+  // or its quantity's image is not in the frame; a check already running is abandoned
+  // (waited for).
+  void start(gi::vk::Context& ctx, gi::Renderer& renderer, const gi::Scene& scene, double time,
              const gi::EffectRegistry& registry, const std::string& effect,
              const gi::SettingValues& settings, uint32_t spp);
   bool running() const { return thread_.joinable() && !done_; }

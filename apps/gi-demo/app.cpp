@@ -337,7 +337,7 @@ void App::startAccuracy(const std::string& effect, uint32_t spp) {
             throw gi::Error(gi::ErrorKind::Usage, "", why);
           }
     }
-    accuracy_.start(controller_->renderer(), scene_, state_.time, registry_, effect,
+    accuracy_.start(*ctx_, controller_->renderer(), scene_, state_.time, registry_, effect,
                     controller_->settings(effect), spp);
     state_.message = "accuracy check of " + effect + " started";
   } catch (const std::exception& e) {
@@ -499,6 +499,12 @@ void App::execute(const ScriptStep& s) {
                           (accuracy_.error().empty() ? state_.message : accuracy_.error()));
     std::printf("accuracy: %s nrmse %.6f pixels %zu spp %u seconds %.2f quantity %s\n",
                 r->effect.c_str(), r->nrmse, r->pixels, r->spp, r->seconds, r->quantity.c_str());
+    if (r->recovered)
+      std::printf("accuracy: %s engine alone nrmse %.6f error removed %.6f%s\n", r->effect.c_str(),
+                  r->aloneNrmse, r->errorRemoved,
+                  r->indirect
+                      ? (" indirect delivered " + std::to_string(r->indirectDelivered)).c_str()
+                      : "");
   } else if (s.verb == "reload") {
     reloadPlugins(false);
     reloadShaders(true);

@@ -165,6 +165,12 @@ void accuracySection(DemoState& state, const AccuracyCheck& accuracy) {
   if (const auto& r = accuracy.result()) {
     ImGui::Text("%s vs %s: NRMSE %.4f", r->effect.c_str(), r->quantity.c_str(), r->nrmse);
     ImGui::Text("%zu pixels, %u spp, %.1f s", r->pixels, r->spp, r->seconds);
+    if (r->recovered)
+      ImGui::Text("engine alone %.4f: %.0f%% of its error removed", r->aloneNrmse,
+                  100.0 * r->errorRemoved);
+    if (r->indirect)
+      ImGui::Text("%.0f%% of the reference's indirect light delivered",
+                  100.0 * r->indirectDelivered);
     ImGui::Checkbox("show the error image", &state.showError);
   }
 }
