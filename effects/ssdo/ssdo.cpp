@@ -418,10 +418,15 @@ class SsdoEffect : public gi::Effect {
             io->surface = b.write(b.create("ssdo_surface", gi::TextureDesc{kPackedFormat}),
                                   gi::TextureUsage::StorageWrite);
             if (bounce_ && contact_) io->contact = b.read(io->contact);
-            // Written and published only with the bounce; without it the image stands in for
-            // the binding (a storage image of the declared format).
-            io->direct = b.write(b.create(res::kDirectLight, gi::TextureDesc{kOutFormat}),
-                                 gi::TextureUsage::StorageWrite);
+            // Written and published only with the bounce; without it a 1x1 image stands in for
+            // the binding (a storage image of the declared format; ssdo_surface.comp writes
+            // its one texel so that it holds a defined value).
+            io->direct = b.write(
+                bounce_
+                    ? b.create(res::kDirectLight, gi::TextureDesc{kOutFormat})
+                    : b.create("ssdo_direct_stand_in",
+                               gi::TextureDesc{kOutFormat, gi::SizeClass::Absolute, 1.0f, 1, 1}),
+                gi::TextureUsage::StorageWrite);
             if (layers_ > 2) {
               for (size_t k = 1; k < io->peeled.size(); ++k) io->peeled[k] = b.read(io->peeled[k]);
               io->layers23 = b.write(b.create("ssdo_layers23", gi::TextureDesc{kLayersFormat}),

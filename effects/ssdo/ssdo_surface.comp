@@ -60,6 +60,11 @@ void main() {
   iz = geometry ? iz : 0.0;
   vec3 n = giGBufferNormal(g);
 
+  // Without kDirectOut the pass binds a 1x1 stand-in for outDirect (the cameras' pass): it is
+  // written once, so that it never holds whatever its memory held before (the hard cases read
+  // every texture back).
+  if (!kDirectOut && p == ivec2(0)) imageStore(outDirect, p, vec4(0.0));
+
   vec3 radiance = vec3(0.0);
   if (kBounce) {
     vec2 uv = (vec2(p) + 0.5) * frame.viewport.zw;
