@@ -129,6 +129,69 @@ TEST_F(HardCasesTest, ObscuranceTransferModesStayFiniteOnEveryHardCase) {
 }
 
 // Every effect joins: the sweep covers the registry, not a list.
+// Guard counting (gi/vk/guard_counters.h, engine/shaders/guards.glsl): the sweep counts, per
+// pipeline, the guards that changed a value. SSDO's distance clamp fires next to the contact
+// occluder, the engine alone's guards do not; outside the sweep counting is compiled out.
+TEST_F(HardCasesTest, GuardsCountWhereTheyFireAndAreCompiledOutOtherwise) {
+  bench::HardCaseOptions o;
+  o.effects = {"none", "ssdo"};
+  o.cases = {"contact_occluder"};
+  o.flickerFrames = 0;
+  const auto runs = bench::runHardCases(ctx(), registry, o);
+  ASSERT_EQ(runs.size(), 2u);
+  EXPECT_TRUE(runs[0].guards.empty()) << bench::guardSummary(runs[0].guards);
+  uint64_t distance = 0;
+  for (const vk::GuardCounters::Count& c : runs[1].guards)
+    if (c.pipeline.rfind("ssdo:", 0) == 0) distance += c.fired[2];
+  EXPECT_GT(distance, 0u) << bench::guardSummary(runs[1].guards);
+  std::printf("contact_occluder x ssdo: %s\n", bench::guardSummary(runs[1].guards).c_str());
+  EXPECT_FALSE(ctx().guards().enabled());  // the sweep restored the setting
+
+  // The same frame outside the sweep: counting compiled out, nothing counted.
+  Scene scene;
+  for (const bench::HardCase& c : bench::hardCases())
+    if (c.name == "contact_occluder") scene = c.build();
+  RenderSettings base;
+  base.width = 160;
+  base.height = 120;
+  RenderRequest request;
+  request.overrides.effects = {"ssdo"};
+  ctx().guards().reset();
+  Renderer r(ctx(), scene, configureRender(scene, registry, request, base), &registry);
+  r.renderFrame();
+  r.readTarget("lit");
+  EXPECT_TRUE(ctx().guards().read().empty()) << bench::guardSummary(ctx().guards().read());
+}
+
+// On an ordinary scene (the built-in room), which guards fire is a finding, not a failure:
+// printed, and bounded where the guard must stay silent (the lighting pass sees no non-finite
+// value, no radiance beyond half-float range and no zero view vector).
+TEST_F(HardCasesTest, GuardsOnTheOrdinaryRoom) {
+  const Scene scene = loadScene("default");
+  ctx().guards().setEnabled(true);
+  for (const std::string& effect : registry.names()) {
+    RenderSettings base;
+    base.width = 160;
+    base.height = 120;
+    RenderRequest request;
+    request.overrides.effects = {effect};
+    ctx().guards().reset();
+    {
+      Renderer r(ctx(), scene, configureRender(scene, registry, request, base), &registry);
+      r.renderFrame();
+      r.readTarget("lit");
+    }
+    const auto counts = ctx().guards().read();
+    std::printf("room x %-10s guards fired: %s\n", effect.c_str(),
+                bench::guardSummary(counts).c_str());
+    for (const vk::GuardCounters::Count& c : counts)
+      if (c.pipeline.find("lighting") != std::string::npos ||
+          c.pipeline.find("tonemap") != std::string::npos)
+        ADD_FAILURE() << effect << ": " << bench::guardSummary({c});
+  }
+  ctx().guards().setEnabled(false);
+}
+
 TEST_F(HardCasesTest, SweepCoversEveryRegisteredEffect) {
   bench::HardCaseOptions o;
   o.width = 32;

@@ -24,25 +24,29 @@ int runHardCaseSweep(const Options& o) {
     for (const std::string& item : *o.effects) hc.effects.push_back(item);
   gi::vk::Context ctx = makeContext(o);
   std::string csv =
-      "case,effect,textures,undecoded,values,non_finite,sky_fraction,flicker,seconds,problems\n";
+      "case,effect,textures,undecoded,values,non_finite,sky_fraction,flicker,seconds,problems,"
+      "guards_fired\n";
   int failed = 0;
   size_t nonFinite = 0;
   const auto runs =
       gi::bench::runHardCases(ctx, registry, hc, [&](const gi::bench::HardCaseRun& r) {
         std::string problems;
         for (const std::string& p : r.problems) problems += (problems.empty() ? "" : "; ") + p;
+        const std::string guards = gi::bench::guardSummary(r.guards);
         std::printf(
             "%-20s %-12s %2d textures (%d packed) %8zu values, %zu NaN/Inf, flicker %.3g, "
-            "%.1f s%s%s\n",
+            "%.1f s%s%s%s%s\n",
             r.scene.c_str(), r.effect.c_str(), r.textures, r.undecoded, r.values, r.nonFinite,
-            r.flicker, r.seconds, problems.empty() ? "" : "  FAIL: ", problems.c_str());
+            r.flicker, r.seconds, problems.empty() ? "" : "  FAIL: ", problems.c_str(),
+            guards.empty() ? "" : "  guards fired: ", guards.c_str());
         std::fflush(stdout);
         std::string quoted = problems;
         std::replace(quoted.begin(), quoted.end(), '"', '\'');
         csv += r.scene + "," + r.effect + "," + std::to_string(r.textures) + "," +
                std::to_string(r.undecoded) + "," + std::to_string(r.values) + "," +
                std::to_string(r.nonFinite) + "," + formatDouble(r.skyFraction) + "," +
-               formatDouble(r.flicker) + "," + formatDouble(r.seconds) + ",\"" + quoted + "\"\n";
+               formatDouble(r.flicker) + "," + formatDouble(r.seconds) + ",\"" + quoted + "\",\"" +
+               guards + "\"\n";
         failed += !r.problems.empty();
         nonFinite += r.nonFinite;
       });

@@ -370,6 +370,15 @@ std::vector<HardCaseRun> runHardCases(vk::Context& ctx, const EffectRegistry& re
   Environment map;
   if (!options.environmentMap.empty()) loadEnvironmentMap(map, options.environmentMap);
 
+  // Every pipeline made for the sweep counts its guards; the context's setting is restored.
+  vk::GuardCounters& guards = ctx.guards();
+  struct Restore {
+    vk::GuardCounters& g;
+    bool was;
+    ~Restore() { g.setEnabled(was); }
+  } restore{guards, guards.enabled()};
+  guards.setEnabled(true);
+
   std::vector<HardCaseRun> runs;
   for (const HardCase& hc : cases) {
     Scene scene = hc.build();
@@ -390,6 +399,7 @@ std::vector<HardCaseRun> runHardCases(vk::Context& ctx, const EffectRegistry& re
       base.shadowMapSize = 256;
       base.aliasTransients = false;  // each transient keeps its own last version
       const RenderSettings rs = configureRender(scene, registry, {.overrides = ov}, base);
+      guards.reset();
       Renderer r(ctx, scene, rs, &registry);
       for (int i = 0; i < std::max(options.warmupFrames, 1); ++i) r.renderFrame();
       for (const Renderer::NamedTexture& t : r.readAllTextures()) {
@@ -414,6 +424,7 @@ std::vector<HardCaseRun> runHardCases(vk::Context& ctx, const EffectRegistry& re
           run.skyFraction = double(sky) / double(std::max<size_t>(1, t.image.pixels.size() / 4));
         }
       }
+      run.guards = guards.read();  // the warm-up frames' (the read-backs waited for them)
       // Buffers: the vertices the skinning pass deformed.
       for (const Renderer::DeformedMesh& m : r.readDeformedMeshes()) {
         size_t bad = 0;
@@ -451,6 +462,16 @@ std::vector<HardCaseRun> runHardCases(vk::Context& ctx, const EffectRegistry& re
     }
   }
   return runs;
+}
+
+std::string guardSummary(const std::vector<vk::GuardCounters::Count>& guards) {
+  std::string s;
+  for (const vk::GuardCounters::Count& c : guards)
+    for (uint32_t k = 0; k < vk::GuardCounters::kKinds; ++k)
+      if (c.fired[k] > 0)
+        s += (s.empty() ? "" : ", ") + c.pipeline + " " + vk::GuardCounters::kindName(k) + " " +
+             std::to_string(c.fired[k]);
+  return s;
 }
 
 }  // namespace gi::bench

@@ -16,6 +16,7 @@
 #include "gi/image_io.h"
 #include "gi/scene.h"
 #include "gi/vk/context.h"
+#include "gi/vk/guard_counters.h"
 
 namespace gi::bench {
 
@@ -59,7 +60,14 @@ struct HardCaseRun {
   double flicker = -1.0;     // largest relative frame-to-frame change (-1: not measured)
   double seconds = 0.0;
   std::vector<std::string> problems;  // empty: the run passed
+  // The shaders' guards that changed a value during the warm-up frames, per pipeline (guard
+  // counting is on for the sweep: gi/vk/guard_counters.h). Not a failure: where a formula
+  // needed its guard, and how often.
+  std::vector<vk::GuardCounters::Count> guards;
 };
+
+// "ssdo: ssdo.comp distance 120, lighting.comp non-finite 3" (empty: none fired).
+std::string guardSummary(const std::vector<vk::GuardCounters::Count>& guards);
 
 // Checks one image of the named resource: counts non-finite values and appends range problems
 // ("ao" in [0, 1], radiance "lit"/"ambient"/"indirect" >= 0, "depth" in [0, 1]).

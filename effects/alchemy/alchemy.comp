@@ -1,6 +1,7 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "common.glsl"
+#include "guards.glsl"
 
 // Alchemy ambient obscurance (McGuire et al. 2011, seed 003 eq. 10). The estimator, its guards
 // and the tap pattern are described in alchemy_kernel.h (gi::alchemy::estimate is this shader
@@ -96,6 +97,8 @@ void main() {
     // 1 / (2 sqrt(epsilon))). Sky taps and taps beyond r (eq. 9's Heaviside) count nothing.
     float term = it * max(0.0, dot(w, N) - biasZ * it) / (ww + eps * it2);
     sum += (inside && !isSky(d) && ww < r2 * it2) ? term : 0.0;
+    // The epsilon counted where it dominates the denominator of a counted tap (v.v < epsilon).
+    giGuard(GI_GUARD_DENOMINATOR, inside && !isSky(d) && ww < eps * it2 && term > 0.0);
   }
   float base = max(0.0, 1.0 - params.scale * sum);
   float ao = base > 0.0 ? min(pow(base, params.contrast), 1.0) : 0.0;  // NaN sum: 0, never NaN

@@ -4,6 +4,8 @@
 #ifndef ISM_LOOKUP_GLSL
 #define ISM_LOOKUP_GLSL
 
+#include "guards.glsl"
+
 #ifdef ISM_CLASSIC
 layout(set = 0, binding = 5) uniform sampler2D maps;
 #else
@@ -34,6 +36,8 @@ vec3 vplIrradiance(Vpl v, uint tile, vec3 x, vec3 n) {
   ismBasis(v.normal.xyz, s, u);
   ivec2 t = ismTexel(tile, dir, s, u, max(cv, 1e-4));
   float visible = d - (ism.bias.x + ism.bias.y * d) <= storedDistance(t) ? 1.0 : 0.0;
+  // The VPL singularity clamp, counted where it changes a visible term.
+  giGuard(GI_GUARD_DISTANCE, d2 < ism.gather.x && visible * cv * cr > 0.0);
   return v.flux.rgb * (visible * cv * cr / (3.14159265 * max(d2, ism.gather.x)));
 }
 

@@ -15,6 +15,7 @@
 // its r and D + eta). One fetch per tap, no G-buffer reads. MODE 3 resolves to the RGBA16F
 // "ambient" (GI_AMBIENT), the other modes to the R16F "ao".
 #include "depth_aware_blur.glsl"  // depthAwareBlurWeight
+#include "guards.glsl"
 
 layout(local_size_x = 32, local_size_y = 16) in;
 
@@ -46,6 +47,8 @@ void store(ivec2 p, vec4 sums, uvec4 centre) {
   // D + eta >= eta > 0 per pixel, so the window's mean is too. Sky / no geometry (1 / distance
   // 0): alpha 0, the lighting pass's own term. Guards: finite, below the half-float maximum.
   vec3 a = max(vec3(sums.x, sums.zw) / max(sums.y, 1e-30), vec3(0.0));
+  giGuard(GI_GUARD_NONFINITE, any(isnan(a)));
+  giGuard(GI_GUARD_RANGE, any(greaterThan(a, vec3(65000.0))));
   a = mix(min(a, vec3(65000.0)), vec3(0.0), isnan(a));
   imageStore(outImage, p, uintBitsToFloat(centre.y) > 0.0 ? vec4(a, 2.0) : vec4(0.0));
 #elif GI_RESOLVE
@@ -54,6 +57,7 @@ void store(ivec2 p, vec4 sums, uvec4 centre) {
     // Guarded transfer ratio (obscurance_kernel.h: the phantom open sample): finite, in [0, 1]
     // for albedo in [0, 1] since N <= D, and 1 when every ray is closed by white occluders.
     float eta = obs.guard;
+    giGuard(GI_GUARD_DENOMINATOR, sums.y < eta);  // the phantom sample outweighs the rays
     w = (sums.x + eta) / (sums.y + eta);
     if (MODE == 2) w = clamp(w, 0.0, 1.0);
   }

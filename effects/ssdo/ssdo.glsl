@@ -1,4 +1,5 @@
 #include "common.glsl"
+#include "guards.glsl"
 
 // Screen-space directional occlusion with one indirect bounce (Ritschel, Grosch, Seidel 2009;
 // seed 000). Per pixel P with normal N, N samples Q_i = P + R s_i w_i (ssdo_samples.h: cosine-
@@ -113,6 +114,7 @@ vec3 sendFrom(vec3 S, vec3 Ns, vec3 Ls, vec3 P, vec3 N, float dMin2) {
   vec3 rdir = safeNormalize(d, N);
   float cosR = max(dot(N, rdir), 0.0);
   float cosS = max(-dot(Ns, rdir), 0.0);  // back-facing: 0
+  giGuard(GI_GUARD_DISTANCE, d2 < dMin2 && cosS * cosR > 0.0);
   return Ls * (cosS * cosR / max(d2, dMin2));
 }
 

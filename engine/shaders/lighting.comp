@@ -1,6 +1,7 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "common.glsl"
+#include "guards.glsl"
 
 // Lighting composition from the G-buffer: emission + direct light (Lambert + normalised
 // Blinn-Phong, PCF shadow maps) + the environment term + indirect light. The environment term
@@ -77,7 +78,7 @@ void main() {
       sky = frame.skyGround.rgb * frame.skyZenith.w;
     else
       sky = proceduralSkyRadiance(frame, viewDirWorld);
-    imageStore(outLit, p, vec4(giClampRadiance(sky), 1.0));
+    imageStore(outLit, p, vec4(giClampRadianceCounted(sky), 1.0));
     return;
   }
   vec3 pos = viewPositionFromDepth(frame.invProj, uv, depth);
@@ -86,7 +87,7 @@ void main() {
   vec3 albedo = giGBufferAlbedo(g);
   vec3 emission = giGBufferEmission(g);
   float metallic = giGBufferMetallic(g);
-  vec3 v = safeNormalize(-pos, vec3(0, 0, 1));
+  vec3 v = safeNormalizeCounted(-pos, vec3(0, 0, 1));
   vec3 diffuseColor = albedo * (1.0 - metallic);
 
   vec3 color = emission;
@@ -110,5 +111,5 @@ void main() {
   }
   if (kIndirectInput != 0)
     color += max(optionalInput(indirectTexture, kIndirectInput, p, uv).rgb, vec3(0.0));
-  imageStore(outLit, p, vec4(giClampRadiance(color), 1.0));
+  imageStore(outLit, p, vec4(giClampRadianceCounted(color), 1.0));
 }

@@ -1,6 +1,7 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "common.glsl"
+#include "guards.glsl"
 
 // Exposure, ACES filmic curve (Narkowicz fit) and sRGB encoding into the 8-bit output.
 layout(local_size_x = 32, local_size_y = 16) in;  // kScreenGroupX/Y (builtin_passes.h)
@@ -21,6 +22,6 @@ void main() {
   if (p.x >= int(frame.viewport.x) || p.y >= int(frame.viewport.y)) return;
   vec3 hdr = texelFetch(litColor, p, 0).rgb * frame.params.x;
   // Guard: a non-finite input pixel is shown as black rather than spreading NaN.
-  if (any(isnan(hdr)) || any(isinf(hdr))) hdr = vec3(0.0);
+  if (giGuard(GI_GUARD_NONFINITE, any(isnan(hdr)) || any(isinf(hdr)))) hdr = vec3(0.0);
   imageStore(outColor, p, vec4(linearToSrgb(aces(max(hdr, 0.0))), 1.0));
 }

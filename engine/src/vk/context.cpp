@@ -13,6 +13,7 @@
 
 #include "gi/errors.h"
 #include "gi/vk/common.h"
+#include "gi/vk/guard_counters.h"
 
 namespace gi::vk {
 
@@ -96,12 +97,18 @@ Context::Context(const ContextOptions& options) : validation_(options.validation
   loadPipelineCache();
 }
 
+GuardCounters& Context::guards() {
+  if (!guards_) guards_ = std::make_unique<GuardCounters>(*this);
+  return *guards_;
+}
+
 Context::~Context() {
   if (device_) {
     vkDeviceWaitIdle(device_);
     savePipelineCache();
     vkDestroyPipelineCache(device_, pipelineCache_, nullptr);
     vkDestroyCommandPool(device_, commandPool_, nullptr);
+    guards_.reset();
     allocator_.reset();
     vkDestroyDevice(device_, nullptr);
   }

@@ -5,11 +5,16 @@
 
 #include "gi/errors.h"
 #include "gi/vk/common.h"
+#include "gi/vk/guard_counters.h"
 #include "gi/vk/shader_overrides.h"
 
 namespace gi::vk {
 
 namespace {
+
+// guards.glsl's counter block and specialization constant.
+constexpr const char* kGuardBlock = "GiGuardCounters";
+constexpr const char* kGuardConstant = "giCountGuards";
 // `code` is what resolveShader returned: a hot-reloaded override of a registered effect shader,
 // or the shader itself.
 VkShaderModule createModule(VkDevice device, const std::vector<uint32_t>& code) {
@@ -121,16 +126,27 @@ VkComputePipelineCreateInfo computeInfo(VkShaderModule module, VkPipelineLayout 
   return info;
 }
 
+// `specialization` gives constant_id 0, 1, ...; `extra` more (id, value) pairs.
 VkPipeline createCompute(Context& ctx, const std::vector<uint32_t>& code, VkPipelineLayout layout,
-                         const std::vector<uint32_t>& specialization) {
+                         const std::vector<uint32_t>& specialization,
+                         const std::vector<std::pair<uint32_t, uint32_t>>& extra = {}) {
   VkShaderModule module = createModule(ctx.device(), code);
   std::vector<VkSpecializationMapEntry> entries;
+  std::vector<uint32_t> values = specialization;
   for (uint32_t i = 0; i < specialization.size(); ++i)
     entries.push_back({i, i * uint32_t(sizeof(uint32_t)), sizeof(uint32_t)});
+  for (const auto& [id, value] : extra) {
+    if (id < specialization.size()) {  // a positional list that already reaches it (by name)
+      values[id] = value;
+      continue;
+    }
+    entries.push_back({id, uint32_t(values.size() * sizeof(uint32_t)), sizeof(uint32_t)});
+    values.push_back(value);
+  }
   const VkSpecializationInfo spec{uint32_t(entries.size()), entries.data(),
-                                  specialization.size() * sizeof(uint32_t), specialization.data()};
+                                  values.size() * sizeof(uint32_t), values.data()};
   const VkComputePipelineCreateInfo info =
-      computeInfo(module, layout, specialization.empty() ? nullptr : &spec);
+      computeInfo(module, layout, entries.empty() ? nullptr : &spec);
   VkPipeline pipeline = VK_NULL_HANDLE;
   VkResult r =
       vkCreateComputePipelines(ctx.device(), ctx.pipelineCache(), 1, &info, nullptr, &pipeline);
@@ -146,7 +162,17 @@ Pipeline Pipeline::compute(Context& ctx, const ComputeDesc& d) {
   p.bindPoint_ = VK_PIPELINE_BIND_POINT_COMPUTE;
   const std::vector<uint32_t> code = resolveShader(d.spirv);
   p.useReflection(d.name, reflectShader(code, VK_SHADER_STAGE_COMPUTE_BIT, d.name), d.blocks);
-  p.pipeline_ = createCompute(ctx, code, p.layout_, d.specialization);
+  // Guard counting (guards.glsl): the counters bound for this pipeline's name, and counting
+  // compiled in while the context counts.
+  std::vector<std::pair<uint32_t, uint32_t>> extra;
+  if (const ShaderBinding* g = p.interface_.find(kGuardBlock); g && p.interface_.bound(*g)) {
+    const GuardCounters::Slot slot = ctx.guards().slot(p.name_);
+    p.guards_ = {int(g->binding), slot.buffer, slot.offset, slot.range};
+    for (const SpecializationConstant& c : reflectSpecializationConstants(code, p.name_))
+      if (c.name == kGuardConstant && extra.empty())
+        extra.push_back({c.id, ctx.guards().enabled() ? 1u : 0u});
+  }
+  p.pipeline_ = createCompute(ctx, code, p.layout_, d.specialization, extra);
   return p;
 }
 
@@ -273,6 +299,7 @@ Pipeline& Pipeline::operator=(Pipeline&& o) noexcept {
     name_ = std::move(o.name_);
     cppPushSize_ = o.cppPushSize_;
     pushRange_ = o.pushRange_;
+    guards_ = o.guards_;
   }
   return *this;
 }
@@ -404,6 +431,13 @@ DescriptorWriter& DescriptorWriter::buffer(std::string_view name, VkBuffer buffe
 }
 
 void DescriptorWriter::update(VkDevice device, VkDescriptorSet set) {
+  // The guard counters are the engine's to bind (gi/vk/guard_counters.h).
+  if (pipeline_ && pipeline_->guardBinding().binding >= 0) {
+    const Pipeline::GuardBinding& g = pipeline_->guardBinding();
+    if (std::none_of(pending_.begin(), pending_.end(),
+                     [&](const Pending& p) { return p.binding == uint32_t(g.binding); }))
+      buffer(uint32_t(g.binding), VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, g.buffer, g.offset, g.range);
+  }
   if (pipeline_)  // a binding the shader declares and nobody wrote is an error, not a crash
     for (const ShaderBinding& b : pipeline_->shaderInterface().bindings)
       if (pipeline_->shaderInterface().bound(b) &&

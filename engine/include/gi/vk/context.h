@@ -16,6 +16,8 @@
 
 namespace gi::vk {
 
+class GuardCounters;  // gi/vk/guard_counters.h
+
 struct ContextOptions {
   // Enables VK_LAYER_KHRONOS_validation and the debug messenger. Default: GI_VALIDATION=1.
   bool validation = false;
@@ -61,6 +63,8 @@ class Context {
   uint32_t validationWarnings() const { return warnings_.load(); }
   std::vector<std::string> validationMessages() const;
   void savePipelineCache() const;
+  // The shaders' guard counters (made on first use).
+  GuardCounters& guards();
 
  private:
   static VKAPI_ATTR VkBool32 VKAPI_CALL debugCallback(
@@ -83,6 +87,7 @@ class Context {
   VkPipelineCache pipelineCache_ = VK_NULL_HANDLE;
   std::string pipelineCachePath_;
   std::unique_ptr<MemoryAllocator> allocator_;
+  std::unique_ptr<GuardCounters> guards_;
   std::atomic<uint32_t> errors_{0}, warnings_{0};
   mutable std::mutex messagesMutex_;
   std::vector<std::string> messages_;

@@ -104,6 +104,14 @@ class Pipeline {
   }
   void pushBytes(VkCommandBuffer cmd, const void* data, size_t size) const;
   void reset();
+  // The guard counters (gi/vk/guard_counters.h) a compute shader declares, which every
+  // descriptor set made for it binds: binding -1 when it declares none.
+  struct GuardBinding {
+    int binding = -1;
+    VkBuffer buffer = VK_NULL_HANDLE;
+    VkDeviceSize offset = 0, range = 0;
+  };
+  const GuardBinding& guardBinding() const { return guards_; }
 
  private:
   void createLayout(const std::vector<Binding>& bindings, uint32_t pushConstantBytes);
@@ -117,6 +125,7 @@ class Pipeline {
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
   VkPipeline pipeline_ = VK_NULL_HANDLE;
   VkPipelineBindPoint bindPoint_ = VK_PIPELINE_BIND_POINT_COMPUTE;
+  GuardBinding guards_;
 };
 
 // Descriptor sets that live for one frame: allocate freely, reset() when the frame is done.
