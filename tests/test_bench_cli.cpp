@@ -224,6 +224,10 @@ TEST(BenchCli, RepetitionsArePairedRoundByRound) {
     EXPECT_TRUE(std::isfinite(cpuMs) && cpuMs > 0.0) << line;
     cpu[config].push_back(cpuMs);
   }
+  // The report puts each pass's and the effect's CPU ms beside their GPU times.
+  const std::string report = readAll(out + "/report.md");
+  EXPECT_NE(report.find("ssao (CPU "), std::string::npos) << "per pass";
+  EXPECT_NE(report.find("] (CPU "), std::string::npos) << "the effect's";
   const std::string ssao = "ssao ssao.samples=4", gtao = "gtao ";
   ASSERT_EQ(cpu[ssao].size(), 3u);
   ASSERT_EQ(cpu[gtao].size(), 3u);

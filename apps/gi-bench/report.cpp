@@ -786,7 +786,8 @@ std::string markdown(const std::vector<Row>& rows, const RunInfo& info,
   for (const Row& r : rows) groups[{r.scene, r.effect}].push_back(&r);
   for (const auto& [key, g] : groups)
     for (size_t i : paretoFront(g)) onFront.insert(g[i]);
-  o << "| scene | effect | preset / params | GPU ms per pass [interval] | total ms [interval] | "
+  o << "| scene | effect | preset / params | GPU ms per pass [interval] (CPU ms with "
+       "--isolate-passes) | total ms [interval] | "
        "effect ms [interval] (CPU ms with --isolate-passes) | total x floor | effect x floor | "
        "target | NRMSE vs target | "
        "reference noise | normaliser (pixels of scored) | SSIM vs target | declared | NRMSE vs "
@@ -794,8 +795,13 @@ std::string markdown(const std::vector<Row>& rows, const RunInfo& info,
     << "|---|---|---|---|---:|---:|---:|---:|---|---:|---:|---:|---:|---|---:|---:|\n";
   for (const Row& r : rows) {
     std::string passes;
-    for (const PassTime& p : r.passes)
+    for (const PassTime& p : r.passes) {
       passes += (passes.empty() ? "" : ", ") + p.name + " " + withInterval(p.ms, 3);
+      std::vector<double> cpu;  // --isolate-passes: the pass's process CPU ms beside it
+      for (double v : p.repsCpu)
+        if (v >= 0.0) cpu.push_back(v);
+      if (!cpu.empty()) passes += " (CPU " + fmt(median(cpu), 3) + ")";
+    }
     std::string pp = r.preset + (r.params.empty() ? "" : " " + r.params);
     o << "| " << r.scene << " | " << r.effect << " | " << pp << (onFront.count(&r) ? " *" : "")
       << " | " << passes << " | " << withInterval(r.totalCi) << " | " << withInterval(r.effectCi)

@@ -1,6 +1,7 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "common.glsl"
+#include "guards.glsl"
 
 // transfer = radiance: per pixel, once, the radiance an occluder at this pixel sends besides its
 // share of the ambient light (seed 001 §3: "the radiance stored in the pixel"): emission +
@@ -54,6 +55,8 @@ void main() {
   vec3 radiance = giGBufferEmission(g) + diffuseDirect;
   vec3 direct = diffuseDirect + lights.specular;
   // Guards: finite, non-negative, below the half-float maximum; NaN inputs read 0.
+  giGuard(GI_GUARD_NONFINITE, any(isnan(radiance)) || any(isnan(direct)));
+  giGuard(GI_GUARD_RANGE, any(greaterThan(max(radiance, direct), vec3(kMaxRadiance))));
   radiance = clamp(radiance, vec3(0.0), vec3(kMaxRadiance));
   radiance = mix(radiance, vec3(0.0), isnan(radiance));
   direct = clamp(direct, vec3(0.0), vec3(kMaxRadiance));

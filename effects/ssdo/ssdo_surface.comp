@@ -1,6 +1,7 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "common.glsl"
+#include "guards.glsl"
 
 // Per pixel, once: what every SSDO tap reads at the pixel it lands on, in one texel
 // (ssdo_common.glsl): 1 / view distance, the view normal and, with the bounce, the pixel's
@@ -89,6 +90,8 @@ void main() {
     vec3 nWorld = mat3(frame.invView) * n;
     radiance = giGBufferEmission(g) + diffuseDirect + diffuse * ssdoIrradianceOverPi(nWorld);
     // Guard: half floats overflow to inf above 65504; non-finite inputs read 0.
+    giGuard(GI_GUARD_NONFINITE, geometry && any(isnan(radiance)));
+    giGuard(GI_GUARD_RANGE, geometry && any(greaterThan(radiance, vec3(65000.0))));
     radiance = geometry ? clamp(radiance, vec3(0.0), vec3(65000.0)) : vec3(0.0);
     radiance = vec3(isnan(radiance.r) ? 0.0 : radiance.r, isnan(radiance.g) ? 0.0 : radiance.g,
                     isnan(radiance.b) ? 0.0 : radiance.b);

@@ -6,6 +6,7 @@
 // when the weights vanish; normals by the blended matrix's cofactor, rest normal as fallback.
 #extension GL_GOOGLE_include_directive : require
 #include "common.glsl"
+#include "guards.glsl"
 
 layout(local_size_x = 256) in;
 
@@ -42,18 +43,18 @@ void main() {
     m += jointMatrices[pc.jointFirst + j[k]] * wk;
     sum += wk;
   }
-  if (!(sum > 1e-8) || isinf(sum))
+  if (giGuard(GI_GUARD_DENOMINATOR, !(sum > 1e-8) || isinf(sum)))  // no usable weight
     m = mat4(1.0);
   else
     m *= 1.0 / sum;
 
   vec3 sp = (m * vec4(p, 1.0)).xyz;
-  bool finite = !any(isnan(sp)) && !any(isinf(sp));
+  bool finite = !giGuard(GI_GUARD_NONFINITE, any(isnan(sp)) || any(isinf(sp)));
   sp = finite ? sp : p;
   vec3 a = m[0].xyz, b = m[1].xyz, c = m[2].xyz;
   mat3 cof = mat3(cross(b, c), cross(c, a), cross(a, b));
   if (dot(a, cross(b, c)) < 0.0) cof = -cof;
-  vec3 sn = safeNormalize(cof * n, n);
+  vec3 sn = safeNormalizeCounted(cof * n, n);
 
   outVertices[d] = sp.x;
   outVertices[d + 1u] = sp.y;
