@@ -130,7 +130,14 @@ class LightingPass final : public Effect {
       types |= bit;
       if (l.shadow.x >= 0.0f) shadowTypes |= bit;
     }
-    Variant key(constants_.empty() ? 0 : constants_.back().id + 1, 0u);
+    // Sized by the constants set here (the shader's others, e.g. guards.glsl's, keep their
+    // defaults and are not part of the key).
+    uint32_t size = 0;
+    for (const char* name : {"kLightTypes", "kShadowTypes", "kPcfRadius", "kEnvironmentKind"})
+      size = std::max(size, constant(name) + 1);
+    for (const LightingInput& in : kLightingInputs)
+      size = std::max(size, constant(in.constant) + 1);
+    Variant key(size, 0u);
     key[constant("kLightTypes")] = types;
     key[constant("kShadowTypes")] = shadowTypes;
     key[constant("kPcfRadius")] = std::min(s_.settings.pcfRadius, 3u);
