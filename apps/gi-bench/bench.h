@@ -62,7 +62,7 @@ struct Row {
   // Means over the scored pixels: the compared image, the target and declared references.
   double testMean = 0.0, targetMean = 0.0, declaredMean = 0.0;
   // Against the engine alone (the 'none' row of the same scene, preset and target, when the
-  // sweep has one): the share of its error this row removes, 1 - NRMSE / NRMSE(none) (negative:
+  // sweep has one): its NRMSE, the share of it this row removes, 1 - NRMSE / NRMSE(none) (negative:
   // added), and with a direct+indirect target the share of the reference's indirect light
   // (target - direct reference) this row adds to the engine's image.
   // Per region the scene defines (SceneRegion): NRMSE against the target over the scored
@@ -74,7 +74,7 @@ struct Row {
   };
   std::vector<RegionScore> regions;
   bool recoveredPresent = false;
-  double errorRemoved = 0.0, indirectDelivered = 0.0;
+  double aloneNrmse = 0.0, errorRemoved = 0.0, indirectDelivered = 0.0;
   bool indirectPresent = false;
   std::string declared;  // "obscurance linear r=0.5 spp=256" ...
   double declaredStdError = 0.0;

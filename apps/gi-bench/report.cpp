@@ -56,6 +56,7 @@ void fillRecovered(std::vector<Row>& rows) {
     });
     if (alone == rows.end()) continue;
     r.recoveredPresent = true;
+    r.aloneNrmse = alone->nrmse;
     r.errorRemoved = alone->nrmse > 0.0 ? 1.0 - r.nrmse / alone->nrmse : 0.0;
     // The reference's indirect light: the target minus the direct reference the engine alone
     // declares, both over the scored pixels.
@@ -672,14 +673,10 @@ std::string recoveredSection(const std::vector<Row>& rows) {
            "| scene | effect | preset / params | effect ms [interval] | NRMSE | engine alone | "
            "reference noise | error removed | indirect delivered |\n"
            "|---|---|---|---:|---:|---:|---:|---:|---:|\n";
-    const auto alone = std::find_if(rows.begin(), rows.end(), [&](const Row& n) {
-      return n.effect == "none" && n.params.empty() && n.scene == r.scene && n.preset == r.preset &&
-             n.reference == r.reference;
-    });
     o << "| " << r.scene << " | " << r.effect << " | " << r.preset
       << (r.params.empty() ? "" : " " + r.params) << " | " << withInterval(r.effectCi, 3) << " | "
-      << fmt(r.nrmse, 4) << " | " << (alone != rows.end() ? fmt(alone->nrmse, 4) : "-") << " | "
-      << fmt(r.noiseFloor, 4) << " | " << percent(r.errorRemoved) << " | "
+      << fmt(r.nrmse, 4) << " | " << fmt(r.aloneNrmse, 4) << " | " << fmt(r.noiseFloor, 4) << " | "
+      << percent(r.errorRemoved) << " | "
       << (r.indirectPresent ? percent(r.indirectDelivered) : std::string("-")) << " |\n";
   }
   return o.str();
