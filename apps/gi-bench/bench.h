@@ -61,10 +61,6 @@ struct Row {
   bool noiseCapped = false;  // the target reference stopped at --ref-spp-max above 1/4 NRMSE
   // Means over the scored pixels: the compared image, the target and declared references.
   double testMean = 0.0, targetMean = 0.0, declaredMean = 0.0;
-  // Against the engine alone (the 'none' row of the same scene, preset and target, when the
-  // sweep has one): its NRMSE, the share of it this row removes, 1 - NRMSE / NRMSE(none) (negative:
-  // added), and with a direct+indirect target the share of the reference's indirect light
-  // (target - direct reference) this row adds to the engine's image.
   // Per region the scene defines (SceneRegion): NRMSE against the target over the scored
   // pixels inside it (normalised by the region's own mean), and how many; pixels 0: not seen.
   struct RegionScore {
@@ -73,6 +69,10 @@ struct Row {
     size_t pixels = 0;
   };
   std::vector<RegionScore> regions;
+  // Against the engine alone (the 'none' row of the same scene, preset and target, when the
+  // sweep has one): its NRMSE, the share of it this row removes, 1 - NRMSE / NRMSE(none)
+  // (negative: added), and with a direct+indirect target the share of the reference's indirect
+  // light (target - direct reference) this row adds to the engine's image.
   bool recoveredPresent = false;
   double aloneNrmse = 0.0, errorRemoved = 0.0, indirectDelivered = 0.0;
   bool indirectPresent = false;
