@@ -53,6 +53,17 @@ std::vector<double> blur(const std::vector<double>& in, int w, int h,
 
 }  // namespace
 
+double mean(const Plane& image, const std::vector<unsigned char>& mask) {
+  double sum = 0.0;
+  size_t n = 0;
+  for (size_t i = 0; i < image.values.size(); ++i) {
+    if (!kept(mask, i)) continue;
+    sum += double(sanitize(image.values[i]));
+    ++n;
+  }
+  return n > 0 ? sum / double(n) : 0.0;
+}
+
 double nrmse(const Plane& test, const Plane& reference, const std::vector<unsigned char>& mask) {
   checkSizes(test, reference, mask);
   double se = 0.0, refSum = 0.0;

@@ -42,6 +42,8 @@ struct Metrics {
 // values count as the largest possible error (their pixels are compared as 0 vs the reference
 // plus 1e6), so a broken effect shows up instead of producing NaN.
 double nrmse(const Plane& test, const Plane& reference, const std::vector<unsigned char>& mask);
+// Mean over the pixels `mask` keeps (empty: all); 0 when it keeps none.
+double mean(const Plane& image, const std::vector<unsigned char>& mask);
 double ssim(const Plane& test, const Plane& reference, const std::vector<unsigned char>& mask,
             double dynamicRange = 1.0);
 Metrics compare(const Plane& test, const Plane& reference, const std::vector<unsigned char>& mask,
